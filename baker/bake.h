@@ -1,0 +1,58 @@
+/* Bakers: offline deformers that add channels to a raw model (issue #5).
+ *
+ * Every baker turns a deformation of one mesh into an ordinary channel: one or more targets
+ * (in-betweens with full weights in (0, 1], the last one at 1), so the runtime plays a baked
+ * channel like an authored shape. The recipe format is documented in docs/baking.md; the
+ * per-algorithm C APIs are in barr.h, ffd.h, cage_mvc.h, laplacian.h and inbetween.h.
+ */
+#ifndef MK_BAKE_H
+#define MK_BAKE_H
+
+#include "raw.h"
+
+typedef struct mk_bake_report {
+    uint32_t channels_added;
+    uint32_t targets_added;
+    double max_error;          /* achieved playback error, fraction of the bbox diagonal */
+} mk_bake_report;
+
+/* What one baked channel came out as (passed to mk_bake_options.channel_done). */
+typedef struct mk_bake_channel_report {
+    const char *name;          /* channel name */
+    const char *op;            /* "twist", "ffd", ... */
+    uint32_t mesh;
+    uint32_t targets;          /* targets written (in-betweens + the last one at weight 1) */
+    uint32_t evaluations;      /* deformations evaluated while placing in-betweens */
+    double max_error;          /* playback error, fraction of the mesh's bbox diagonal */
+    int error_measured_on_grid;/* 1: max over every sampled weight; 0: estimated at span midpoints */
+    uint32_t moved_vertices;   /* vertices moved by the last target */
+    uint32_t inverted_vertices;/* FFD/Barr: vertices where det J <= 0 (normals from the surface) */
+    uint32_t factorizations;   /* Laplacian/ARAP: sparse Cholesky factorizations (1 expected) */
+    double factor_seconds;     /* Laplacian/ARAP: analyze + factorize wall time */
+    double solve_seconds;      /* Laplacian/ARAP: total time of all triangular solves */
+    uint32_t solves;           /* Laplacian/ARAP: solves (each one with 3 right-hand sides) */
+    double seconds;            /* whole channel, wall time */
+} mk_bake_channel_report;
+
+typedef struct mk_bake_options {
+    /* Directory that relative paths in the recipe (cage OBJ files) resolve against; NULL or ""
+     * means the current directory. `morphkit bake` passes the recipe file's directory. */
+    const char *base_dir;
+    /* progress(user, stage, fraction in [0,1]); may be NULL. */
+    void (*progress)(void *user, const char *stage, double fraction);
+    /* Called once per baked channel; may be NULL. */
+    void (*channel_done)(void *user, const mk_bake_channel_report *channel);
+    void *user;
+} mk_bake_options;
+
+/* Applies a JSON recipe (docs/baking.md) to raw. progress(user, fraction) may be NULL.
+ * All or nothing: on error raw keeps its channels as they were and err names the field. */
+mk_result mk_bake_recipe(mk_raw_asset *raw, const char *recipe_json, size_t recipe_size,
+                         void (*progress)(void *user, const char *stage, double fraction),
+                         void *user, mk_bake_report *report, mk_error *err);
+
+/* The same with options (base directory, per-channel reports). options may be NULL. */
+mk_result mk_bake_recipe_ex(mk_raw_asset *raw, const char *recipe_json, size_t recipe_size,
+                            const mk_bake_options *options, mk_bake_report *report, mk_error *err);
+
+#endif

@@ -1,0 +1,125 @@
+/* mk_arena: every allocation is its own block from the user allocator, linked into a list so
+ * mk_arena_free_all releases everything (no leak on any error path) and single blocks can
+ * still be released or grown. A live-bytes limit and a fail-after-K hook make allocation
+ * failure testable. */
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "alloc.h"
+
+struct mk_arena_block {
+    mk_arena_block *prev, *next;
+    size_t size;
+    size_t pad;                 /* keeps the payload 16-byte aligned */
+};
+
+void mk_arena_init(mk_arena *arena, const mk_allocator *allocator)
+{
+    memset(arena, 0, sizeof *arena);
+    if (allocator) arena->allocator = *allocator;
+}
+
+static void *raw_alloc(mk_arena *arena, size_t size)
+{
+    arena->calls++;
+    if (arena->allocator.fail_after && arena->calls >= arena->allocator.fail_after) return NULL;
+    if (arena->allocator.alloc) return arena->allocator.alloc(arena->allocator.user, size);
+    return malloc(size);
+}
+
+static void raw_free(mk_arena *arena, void *ptr)
+{
+    if (arena->allocator.free) arena->allocator.free(arena->allocator.user, ptr);
+    else free(ptr);
+}
+
+void *mk_arena_alloc(mk_arena *arena, size_t size)
+{
+    if (size > SIZE_MAX - sizeof(mk_arena_block) - 16) { arena->failed = 1; return NULL; }
+    if (arena->allocator.memory_limit && size > arena->allocator.memory_limit - arena->bytes_live
+        && arena->bytes_live <= arena->allocator.memory_limit) {
+        arena->failed = 1;
+        return NULL;
+    }
+    mk_arena_block *b = raw_alloc(arena, sizeof(mk_arena_block) + size);
+    if (!b) { arena->failed = 1; return NULL; }
+    b->prev = NULL;
+    b->next = arena->blocks;
+    b->size = size;
+    if (arena->blocks) arena->blocks->prev = b;
+    arena->blocks = b;
+    arena->bytes_live += size;
+    if (arena->bytes_live > arena->bytes_peak) arena->bytes_peak = arena->bytes_live;
+    void *p = b + 1;
+    memset(p, 0, size);
+    return p;
+}
+
+void *mk_arena_array(mk_arena *arena, size_t count, size_t size)
+{
+    if (size && count > SIZE_MAX / size) { arena->failed = 1; return NULL; }
+    return mk_arena_alloc(arena, count * size);
+}
+
+void mk_arena_release(mk_arena *arena, void *ptr)
+{
+    if (!ptr) return;
+    mk_arena_block *b = (mk_arena_block *)ptr - 1;
+    if (b->prev) b->prev->next = b->next; else arena->blocks = b->next;
+    if (b->next) b->next->prev = b->prev;
+    arena->bytes_live -= b->size;
+    raw_free(arena, b);
+}
+
+void *mk_arena_realloc(mk_arena *arena, void *ptr, size_t old_size, size_t new_size)
+{
+    void *p = mk_arena_alloc(arena, new_size);
+    if (!p) return NULL;
+    if (ptr) {
+        memcpy(p, ptr, old_size < new_size ? old_size : new_size);
+        mk_arena_release(arena, ptr);
+    }
+    return p;
+}
+
+char *mk_arena_strndup(mk_arena *arena, const char *s, size_t n)
+{
+    char *p = mk_arena_alloc(arena, n + 1);
+    if (p && n) memcpy(p, s, n);
+    return p;
+}
+
+char *mk_arena_strdup(mk_arena *arena, const char *s)
+{
+    return mk_arena_strndup(arena, s ? s : "", s ? strlen(s) : 0);
+}
+
+void mk_arena_free_all(mk_arena *arena)
+{
+    mk_arena_block *b = arena->blocks;
+    while (b) {
+        mk_arena_block *next = b->next;
+        raw_free(arena, b);
+        b = next;
+    }
+    arena->blocks = NULL;
+    arena->bytes_live = 0;
+}
+
+mk_result mk_error_set(mk_error *err, mk_result code, uint64_t offset, const char *fmt, ...)
+{
+    if (!err) return code;
+    err->code = code;
+    err->offset = offset;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->message, sizeof err->message, fmt, ap);
+    va_end(ap);
+    return code;
+}
+
+mk_result mk_error_oom(mk_error *err, const char *what)
+{
+    return mk_error_set(err, MK_ERROR_OUT_OF_MEMORY, UINT64_MAX, "out of memory while %s", what);
+}

@@ -1,0 +1,57 @@
+/* Offline allocation for morphkit (importer, baker, tools). The runtime never allocates.
+ *
+ * mk_allocator is the user hook (zero-initialized means libc malloc/free, no limit).
+ * mk_arena hands out blocks from that allocator and frees them all at once; the raw model,
+ * parsers and writers allocate through one, so nothing leaks on any error path and a test can
+ * fail allocation K for every K (tests/offline/test_alloc_fail.c).
+ */
+#ifndef MK_ALLOC_H
+#define MK_ALLOC_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "morphkit.h"
+
+typedef struct mk_allocator {
+    void *(*alloc)(void *user, size_t size); /* NULL: malloc */
+    void (*free)(void *user, void *ptr);     /* NULL: free */
+    void *user;
+    size_t memory_limit;                     /* bytes live at once through one arena; 0: no limit */
+    uint64_t fail_after;                     /* testing: fail the (fail_after)-th call; 0: never */
+} mk_allocator;
+
+typedef struct mk_arena_block mk_arena_block;
+
+typedef struct mk_arena {
+    mk_allocator allocator;
+    mk_arena_block *blocks;    /* every allocation, newest first */
+    size_t bytes_live;
+    size_t bytes_peak;
+    uint64_t calls;
+    int failed;                /* set once an allocation was refused */
+} mk_arena;
+
+/* allocator may be NULL (defaults). */
+void mk_arena_init(mk_arena *arena, const mk_allocator *allocator);
+/* Zeroed memory, 16-byte aligned; NULL (and arena->failed set) when refused or size overflows.
+ * size 0 returns a valid unique pointer. */
+void *mk_arena_alloc(mk_arena *arena, size_t size);
+/* count * size with overflow check. */
+void *mk_arena_array(mk_arena *arena, size_t count, size_t size);
+/* Grows an array allocated from this arena: returns new zeroed-tail copy (old is released). */
+void *mk_arena_realloc(mk_arena *arena, void *ptr, size_t old_size, size_t new_size);
+void mk_arena_release(mk_arena *arena, void *ptr);
+char *mk_arena_strdup(mk_arena *arena, const char *s);
+char *mk_arena_strndup(mk_arena *arena, const char *s, size_t n);
+void mk_arena_free_all(mk_arena *arena);
+
+/* Fills err with code, offset (UINT64_MAX when none) and a printf-style message; returns code.
+ * err may be NULL. */
+mk_result mk_error_set(mk_error *err, mk_result code, uint64_t offset, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+mk_result mk_error_oom(mk_error *err, const char *what);
+
+#endif

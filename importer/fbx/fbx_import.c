@@ -1,0 +1,42 @@
+/* mk_import_fbx: binary or ASCII FBX from memory into the raw model.
+ *
+ * Steps: parse the file into a node tree (fbx_binary.c / fbx_ascii.c, with limits against
+ * hostile input), then interpret it (fbx_scene.c: objects, connections, meshes, blend shapes,
+ * curves). All parse memory comes from a scratch arena on the same allocator as the raw model
+ * and is released before returning, on success and on error.
+ */
+#include <string.h>
+#include "fbx_internal.h"
+
+mk_result mk_import_fbx(const void *data, size_t size, const mk_import_options *options,
+                        mk_raw_asset *out, mk_error *err)
+{
+    if (!data || !out) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "mk_import_fbx: NULL data or output");
+    mk_import_options defaults;
+    memset(&defaults, 0, sizeof defaults);
+    if (!options) options = &defaults;
+    size_t limit = options->max_input_size ? options->max_input_size : ((size_t)1 << 32);
+    if (size > limit)
+        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "FBX input of %zu bytes exceeds the limit of %zu", size, limit);
+    if (options->stacking != MK_STACKING_ASSET && options->stacking != MK_STACKING_ADDITIVE &&
+        options->stacking != MK_STACKING_SEQUENTIAL)
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "mk_import_fbx: unknown stacking %d", (int)options->stacking);
+    mk_error local;
+    if (!err) err = &local;
+    mk_arena scratch;
+    mk_arena_init(&scratch, &out->arena.allocator);
+    fbx_doc doc;
+    memset(&doc, 0, sizeof doc);
+    doc.arena = &scratch;
+    doc.data = data;
+    doc.size = size;
+    doc.err = err;
+    doc.binary = fbx_is_binary(data, size);
+    mk_result r = doc.binary ? fbx_parse_binary(&doc) : fbx_parse_ascii(&doc);
+    if (r == MK_OK) {
+        fbx_link_parents(&doc.root);
+        r = fbx_convert(&doc, options, out);
+    }
+    mk_arena_free_all(&scratch);
+    return r;
+}

@@ -1,0 +1,252 @@
+/* Target normals computed from target positions (DESIGN.md: "A target without normal data
+ * gets normals computed at import from its positions with the base mesh's triangles and
+ * smoothing (hard edges kept)").
+ *
+ * Smoothing groups: render vertices with the same control point and the same base normal
+ * share one computed normal, so vertices split only for UVs are smoothed together while
+ * vertices split for a hard edge (different base normals) stay apart. A group's normal is
+ * the normalized sum of the area-weighted face normals (cross products) of the triangles
+ * around it.
+ *
+ * The delta stored is N_target - N_base with both computed by this same rule, so at weight 0
+ * the authored base normals are untouched and at weight w the runtime gets
+ * normalize(B + w (N_target - N_base)). Neighbours of moved vertices change normal without
+ * moving, so the target's index set grows to include them (with zero position delta). When
+ * the mesh has tangents, the base tangent is re-orthogonalized against the new normal
+ * (Gram-Schmidt) and its change stored as the tangent delta.
+ */
+#include <math.h>
+#include <string.h>
+#include "raw.h"
+
+typedef struct topology {
+    uint32_t group_count;
+    uint32_t *group_of;        /* per vertex */
+    uint32_t *group_vert_first, *group_verts;  /* CSR group -> vertices */
+    uint32_t *group_tri_first, *group_tris;    /* CSR group -> triangles */
+    float *base_normal;        /* per group, unit */
+} topology;
+
+static void face_normal(const float *p0, const float *p1, const float *p2, double out[3])
+{
+    double e1[3] = { p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2] };
+    double e2[3] = { p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2] };
+    out[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    out[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    out[2] = e1[0] * e2[1] - e1[1] * e2[0];
+}
+
+static int same_normal(const float *a, const float *b)
+{
+    return fabsf(a[0] - b[0]) <= 1e-5f && fabsf(a[1] - b[1]) <= 1e-5f && fabsf(a[2] - b[2]) <= 1e-5f;
+}
+
+/* CSR from a key per item: first[key..key+1) lists the items with that key, in item order. */
+static int build_csr(mk_arena *arena, const uint32_t *key, uint32_t items, uint32_t keys, uint32_t **first_out,
+                     uint32_t **list_out)
+{
+    uint32_t *first = mk_arena_array(arena, (size_t)keys + 1, sizeof *first);
+    uint32_t *list = mk_arena_array(arena, items ? items : 1, sizeof *list);
+    if (!first || !list) return 0;
+    for (uint32_t i = 0; i < items; i++) first[key[i] + 1]++;
+    for (uint32_t k = 0; k < keys; k++) first[k + 1] += first[k];
+    uint32_t *fill = mk_arena_array(arena, keys ? keys : 1, sizeof *fill);
+    if (!fill) return 0;
+    memcpy(fill, first, (size_t)keys * sizeof *fill);
+    for (uint32_t i = 0; i < items; i++) list[fill[key[i]]++] = i;
+    mk_arena_release(arena, fill);
+    *first_out = first;
+    *list_out = list;
+    return 1;
+}
+
+/* Normal of group g for positions given by (base + optional sparse delta lookup). */
+static void group_normal(const mk_raw_mesh *m, const topology *topo, uint32_t g, const float *positions,
+                         const int32_t *moved, const float *delta, float out[3])
+{
+    double sum[3] = { 0, 0, 0 };
+    for (uint32_t k = topo->group_tri_first[g]; k < topo->group_tri_first[g + 1]; k++) {
+        const uint32_t *tri = &m->triangles[3u * topo->group_tris[k]];
+        float p[3][3];
+        for (int c = 0; c < 3; c++) {
+            uint32_t v = tri[c];
+            for (int d = 0; d < 3; d++) {
+                p[c][d] = positions[3u * v + (uint32_t)d];
+                if (moved && moved[v] >= 0) p[c][d] += delta[3u * (uint32_t)moved[v] + (uint32_t)d];
+            }
+        }
+        double n[3];
+        face_normal(p[0], p[1], p[2], n);
+        sum[0] += n[0]; sum[1] += n[1]; sum[2] += n[2];
+    }
+    double len = sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+    if (len < 1e-30) { out[0] = out[1] = out[2] = 0.0f; return; }
+    out[0] = (float)(sum[0] / len); out[1] = (float)(sum[1] / len); out[2] = (float)(sum[2] / len);
+}
+
+static int build_topology(mk_arena *arena, const mk_raw_mesh *m, topology *topo)
+{
+    uint32_t n = m->vertex_count;
+    memset(topo, 0, sizeof *topo);
+    topo->group_of = mk_arena_array(arena, n, sizeof(uint32_t));
+    if (!topo->group_of) return 0;
+    if (m->control_points && m->control_point_count) {
+        uint32_t *cp_first, *cp_verts;
+        if (!build_csr(arena, m->control_points, n, m->control_point_count, &cp_first, &cp_verts)) return 0;
+        for (uint32_t cp = 0; cp < m->control_point_count; cp++) {
+            uint32_t start = topo->group_count;
+            for (uint32_t k = cp_first[cp]; k < cp_first[cp + 1]; k++) {
+                uint32_t v = cp_verts[k], g = UINT32_MAX;
+                if (m->normals)
+                    for (uint32_t j = cp_first[cp]; j < k; j++)
+                        if (same_normal(&m->normals[3u * cp_verts[j]], &m->normals[3u * v])) { g = topo->group_of[cp_verts[j]]; break; }
+                if (!m->normals && k > cp_first[cp]) g = start;
+                topo->group_of[v] = g != UINT32_MAX ? g : topo->group_count++;
+            }
+        }
+    } else {
+        for (uint32_t v = 0; v < n; v++) topo->group_of[v] = v;
+        topo->group_count = n;
+    }
+    if (!build_csr(arena, topo->group_of, n, topo->group_count, &topo->group_vert_first, &topo->group_verts)) return 0;
+    /* group -> triangles: each triangle once per distinct corner group. */
+    uint32_t *tri_group = mk_arena_array(arena, 3 * (size_t)m->triangle_count + 1, sizeof(uint32_t));
+    uint32_t *tri_index = mk_arena_array(arena, 3 * (size_t)m->triangle_count + 1, sizeof(uint32_t));
+    if (!tri_group || !tri_index) return 0;
+    uint32_t pairs = 0;
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        uint32_t g0 = topo->group_of[m->triangles[3u * t]], g1 = topo->group_of[m->triangles[3u * t + 1]],
+                 g2 = topo->group_of[m->triangles[3u * t + 2]];
+        tri_group[pairs] = g0; tri_index[pairs++] = t;
+        if (g1 != g0) { tri_group[pairs] = g1; tri_index[pairs++] = t; }
+        if (g2 != g0 && g2 != g1) { tri_group[pairs] = g2; tri_index[pairs++] = t; }
+    }
+    uint32_t *slots;
+    if (!build_csr(arena, tri_group, pairs, topo->group_count, &topo->group_tri_first, &slots)) return 0;
+    for (uint32_t k = 0; k < pairs; k++) slots[k] = tri_index[slots[k]];
+    topo->group_tris = slots;
+    mk_arena_release(arena, tri_group);
+    mk_arena_release(arena, tri_index);
+    topo->base_normal = mk_arena_array(arena, (size_t)topo->group_count * 3, sizeof(float));
+    if (!topo->base_normal) return 0;
+    for (uint32_t g = 0; g < topo->group_count; g++)
+        group_normal(m, topo, g, m->positions, NULL, NULL, &topo->base_normal[3u * g]);
+    return 1;
+}
+
+/* Tangent re-orthogonalized against normal n: normalize(t - n (n.t)); t unchanged if degenerate. */
+static void orthogonal_tangent(const float *t, const float *n, float out[3])
+{
+    float d = t[0] * n[0] + t[1] * n[1] + t[2] * n[2];
+    float v[3] = { t[0] - n[0] * d, t[1] - n[1] * d, t[2] - n[2] * d };
+    float len = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (len < 1e-12f) { out[0] = t[0]; out[1] = t[1]; out[2] = t[2]; return; }
+    out[0] = v[0] / len; out[1] = v[1] / len; out[2] = v[2] / len;
+}
+
+static mk_result compute_target(mk_raw_asset *raw, const mk_raw_mesh *m, const topology *topo, mk_raw_target *t,
+                                int32_t *moved, int32_t *group_slot, uint32_t *group_list, uint8_t *vert_mark,
+                                mk_error *err)
+{
+    mk_arena *arena = &raw->arena;
+    for (uint32_t j = 0; j < t->count; j++) moved[t->indices[j]] = (int32_t)j;
+    /* Groups whose normal can change: every corner group of a triangle touching a moved vertex. */
+    uint32_t affected = 0;
+    for (uint32_t j = 0; j < t->count; j++) {
+        uint32_t g = topo->group_of[t->indices[j]];
+        for (uint32_t k = topo->group_tri_first[g]; k < topo->group_tri_first[g + 1]; k++) {
+            const uint32_t *tri = &m->triangles[3u * topo->group_tris[k]];
+            for (int c = 0; c < 3; c++) {
+                uint32_t gc = topo->group_of[tri[c]];
+                if (group_slot[gc] < 0) { group_slot[gc] = (int32_t)affected; group_list[affected++] = gc; }
+            }
+        }
+    }
+    /* Vertices of the new index set: moved ones plus every vertex of an affected group. */
+    uint32_t total = t->count;
+    for (uint32_t a = 0; a < affected; a++) {
+        uint32_t g = group_list[a];
+        for (uint32_t k = topo->group_vert_first[g]; k < topo->group_vert_first[g + 1]; k++) {
+            uint32_t v = topo->group_verts[k];
+            if (moved[v] < 0 && !vert_mark[v]) { vert_mark[v] = 1; total++; }
+        }
+    }
+    uint32_t *indices = mk_arena_array(arena, total ? total : 1, sizeof(uint32_t));
+    float *positions = mk_arena_array(arena, (size_t)(total ? total : 1) * 3, sizeof(float));
+    float *normals = mk_arena_array(arena, (size_t)(total ? total : 1) * 3, sizeof(float));
+    float *tangents = m->tangents ? mk_arena_array(arena, (size_t)(total ? total : 1) * 3, sizeof(float)) : NULL;
+    float *group_new = mk_arena_array(arena, (size_t)(affected ? affected : 1) * 3, sizeof(float));
+    if (!indices || !positions || !normals || (m->tangents && !tangents) || !group_new)
+        return mk_error_oom(err, "computing target normals");
+    for (uint32_t a = 0; a < affected; a++)
+        group_normal(m, topo, group_list[a], m->positions, moved, t->positions, &group_new[3u * a]);
+    /* Merge: walk vertices in increasing order (sorted output) over moved ∪ marked. */
+    uint32_t out = 0;
+    for (uint32_t v = 0; v < m->vertex_count && out < total; v++) {
+        int is_moved = moved[v] >= 0;
+        if (!is_moved && !vert_mark[v]) continue;
+        indices[out] = v;
+        if (is_moved) memcpy(&positions[3u * out], &t->positions[3u * (uint32_t)moved[v]], 3 * sizeof(float));
+        uint32_t g = topo->group_of[v];
+        const float *nb = &topo->base_normal[3u * g];
+        const float *nt = nb;
+        if (group_slot[g] >= 0) nt = &group_new[3u * (uint32_t)group_slot[g]];
+        for (int d = 0; d < 3; d++) normals[3u * out + (uint32_t)d] = nt[d] - nb[d];
+        if (tangents) {
+            const float *bt = &m->tangents[4u * v];
+            float tb[3], tt[3];
+            orthogonal_tangent(bt, nb, tb);
+            orthogonal_tangent(bt, nt, tt);
+            for (int d = 0; d < 3; d++) tangents[3u * out + (uint32_t)d] = tt[d] - tb[d];
+        }
+        out++;
+    }
+    for (uint32_t j = 0; j < t->count; j++) moved[t->indices[j]] = -1;
+    for (uint32_t a = 0; a < affected; a++) {
+        uint32_t g = group_list[a];
+        group_slot[g] = -1;
+        for (uint32_t k = topo->group_vert_first[g]; k < topo->group_vert_first[g + 1]; k++)
+            vert_mark[topo->group_verts[k]] = 0;
+    }
+    mk_arena_release(arena, group_new);
+    t->indices = indices;
+    t->positions = positions;
+    t->normals = normals;
+    t->tangents = tangents;
+    t->count = out;
+    return MK_OK;
+}
+
+mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int force, mk_error *err)
+{
+    if (mesh >= raw->mesh_count)
+        return mk_error_set(err, MK_ERROR_OUT_OF_RANGE, UINT64_MAX, "compute normals: mesh %u does not exist", mesh);
+    const mk_raw_mesh *m = &raw->meshes[mesh];
+    if (!m->normals || m->triangle_count == 0) return MK_OK;  /* nothing to morph, or no surface */
+    int needed = 0;
+    for (uint32_t c = 0; c < raw->channel_count; c++)
+        if (raw->channels[c].mesh == mesh)
+            for (uint32_t k = 0; k < raw->channels[c].target_count; k++)
+                if (force || !raw->channels[c].targets[k].normals) needed = 1;
+    if (!needed) return MK_OK;
+    mk_arena *arena = &raw->arena;
+    topology topo;
+    int32_t *moved = mk_arena_array(arena, m->vertex_count, sizeof(int32_t));
+    uint8_t *vert_mark = mk_arena_array(arena, m->vertex_count, 1);
+    if (!moved || !vert_mark || !build_topology(arena, m, &topo)) return mk_error_oom(err, "building mesh topology");
+    int32_t *group_slot = mk_arena_array(arena, topo.group_count, sizeof(int32_t));
+    uint32_t *group_list = mk_arena_array(arena, topo.group_count, sizeof(uint32_t));
+    if (!group_slot || !group_list) return mk_error_oom(err, "computing target normals");
+    for (uint32_t g = 0; g < topo.group_count; g++) group_slot[g] = -1;
+    for (uint32_t v = 0; v < m->vertex_count; v++) moved[v] = -1;
+    for (uint32_t c = 0; c < raw->channel_count; c++) {
+        if (raw->channels[c].mesh != mesh) continue;
+        for (uint32_t k = 0; k < raw->channels[c].target_count; k++) {
+            mk_raw_target *t = &raw->channels[c].targets[k];
+            if (!force && t->normals) continue;
+            mk_result r = compute_target(raw, m, &topo, t, moved, group_slot, group_list, vert_mark, err);
+            if (r) return r;
+        }
+    }
+    return MK_OK;
+}

@@ -1,0 +1,143 @@
+/* mk_read_blob: an opened .morph asset back into a raw model (deltas dequantized). Dense
+ * blocks store zeros for vertices a target does not move; those are dropped again so a
+ * read-back target has the sparse vertex set it was written with. */
+#include <stdio.h>
+#include <string.h>
+#include "blob_io.h"
+#include "format.h"
+
+static void *copy(mk_arena *arena, const void *src, size_t n)
+{
+    void *p = mk_arena_alloc(arena, n ? n : 1);
+    if (p && n) memcpy(p, src, n);
+    return p;
+}
+
+/* Decodes component c of value j of an entry's attribute starting at p. */
+static float decode(const uint8_t *p, int quantized, uint32_t m, int c, uint32_t j, float scale)
+{
+    if (quantized) {
+        int16_t q;
+        memcpy(&q, p + ((size_t)c * m + j) * 2, 2);
+        return (float)q * scale;
+    }
+    float f;
+    memcpy(&f, p + ((size_t)c * m + j) * 4, 4);
+    return f;
+}
+
+static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t local, mk_raw_target *t,
+                             mk_arena *arena, mk_error *err)
+{
+    const mk_blob_target *bt = &a->targets[bm->first_target + local];
+    const uint32_t *block_first = (const uint32_t *)(a->data + bm->block_entries);
+    const mk_blob_entry *entries = (const mk_blob_entry *)(a->data + bm->entries);
+    const int q = (bt->flags & MK_TARGET_QUANTIZED) != 0;
+    const int hn = (bt->flags & MK_TARGET_HAS_NORMALS) != 0, ht = (bt->flags & MK_TARGET_HAS_TANGENTS) != 0;
+    uint64_t capacity = 0;
+    for (uint64_t e = 0; e < bm->entry_count; e++)
+        if (entries[e].target == local) capacity += (uint64_t)__builtin_popcountll(entries[e].mask);
+    t->indices = mk_arena_array(arena, capacity + 1, sizeof(uint32_t));
+    t->positions = mk_arena_array(arena, 3 * capacity + 3, sizeof(float));
+    t->normals = hn ? mk_arena_array(arena, 3 * capacity + 3, sizeof(float)) : NULL;
+    t->tangents = ht ? mk_arena_array(arena, 3 * capacity + 3, sizeof(float)) : NULL;
+    if (!t->indices || !t->positions || (hn && !t->normals) || (ht && !t->tangents))
+        return mk_error_oom(err, "reading target deltas");
+    uint32_t n = 0;
+    for (uint32_t b = 0; b < bm->block_count; b++) {
+        for (uint32_t e = block_first[b]; e < block_first[b + 1]; e++) {
+            const mk_blob_entry *en = &entries[e];
+            if (en->target != local) continue;
+            uint32_t m = (uint32_t)__builtin_popcountll(en->mask);
+            size_t attr = (size_t)m * 3 * (q ? 2 : 4);
+            const uint8_t *p = a->data + bm->target_data + (size_t)en->data * MK_ALIGN;
+            uint32_t j = 0;
+            for (uint64_t bits = en->mask; bits; bits &= bits - 1, j++) {
+                float pv[3], nv[3] = { 0, 0, 0 }, tv[3] = { 0, 0, 0 };
+                int nonzero = 0;
+                for (int c = 0; c < 3; c++) {
+                    pv[c] = decode(p, q, m, c, j, bt->position_scale);
+                    if (hn) nv[c] = decode(p + attr, q, m, c, j, bt->normal_scale);
+                    if (ht) tv[c] = decode(p + attr * (hn ? 2 : 1), q, m, c, j, bt->tangent_scale);
+                    nonzero |= pv[c] != 0 || nv[c] != 0 || tv[c] != 0;
+                }
+                if (!nonzero) continue;
+                t->indices[n] = b * MK_BLOCK_SIZE + (uint32_t)__builtin_ctzll(bits);
+                memcpy(&t->positions[3u * n], pv, sizeof pv);
+                if (hn) memcpy(&t->normals[3u * n], nv, sizeof nv);
+                if (ht) memcpy(&t->tangents[3u * n], tv, sizeof tv);
+                n++;
+            }
+        }
+    }
+    t->count = n;
+    return MK_OK;
+}
+
+mk_result mk_read_blob(const mk_asset *a, mk_raw_asset *out, mk_error *err)
+{
+    mk_arena *arena = &out->arena;
+    if (a->mesh_count && !mk_raw_add_meshes(out, a->mesh_count)) return mk_error_oom(err, "reading meshes");
+    for (uint32_t i = 0; i < a->mesh_count; i++) {
+        const mk_blob_mesh *bm = &a->meshes[i];
+        mk_raw_mesh *m = &out->meshes[i];
+        m->name = mk_arena_strdup(arena, a->strings + bm->name);
+        m->vertex_count = bm->vertex_count;
+        m->positions = copy(arena, a->data + bm->positions, 12u * (size_t)bm->vertex_count);
+        if (bm->flags & MK_MESH_HAS_NORMALS) m->normals = copy(arena, a->data + bm->normals, 12u * (size_t)bm->vertex_count);
+        if (bm->flags & MK_MESH_HAS_TANGENTS) m->tangents = copy(arena, a->data + bm->tangents, 16u * (size_t)bm->vertex_count);
+        m->triangle_count = bm->triangle_count;
+        m->triangles = copy(arena, a->data + bm->triangles, 12u * (size_t)bm->triangle_count);
+        m->control_point_count = bm->control_point_count;
+        m->control_points = copy(arena, a->data + bm->control_points, 4u * (size_t)bm->vertex_count);
+        memcpy(m->world, bm->world, sizeof m->world);
+        m->gltf_node = bm->gltf_node;
+        m->gltf_mesh = bm->gltf_mesh;
+        m->gltf_primitive = bm->gltf_primitive;
+        m->stacking = (mk_stacking)bm->stacking;
+        if (!m->name || !m->positions || !m->triangles || !m->control_points
+            || ((bm->flags & MK_MESH_HAS_NORMALS) && !m->normals) || ((bm->flags & MK_MESH_HAS_TANGENTS) && !m->tangents))
+            return mk_error_oom(err, "reading mesh arrays");
+    }
+    if (a->channel_count && !mk_raw_add_channels(out, a->channel_count)) return mk_error_oom(err, "reading channels");
+    for (uint32_t c = 0; c < a->channel_count; c++) {
+        const mk_blob_channel *bc = &a->channels[c];
+        const mk_blob_mesh *bm = &a->meshes[bc->mesh];
+        mk_raw_channel *ch = &out->channels[c];
+        ch->name = mk_arena_strdup(arena, a->strings + bc->name);
+        ch->origin = mk_arena_strdup(arena, a->strings + bc->origin);
+        ch->mesh = bc->mesh;
+        ch->default_weight = bc->default_weight;
+        if (!ch->name || !ch->origin || !mk_raw_add_targets(out, ch, bc->target_count))
+            return mk_error_oom(err, "reading channels");
+        for (uint32_t k = 0; k < bc->target_count; k++) {
+            const mk_blob_target *bt = &a->targets[bc->first_target + k];
+            mk_raw_target *t = &ch->targets[k];
+            t->name = mk_arena_strdup(arena, a->strings + bt->name);
+            t->full_weight = bt->full_weight;
+            if (!t->name) return mk_error_oom(err, "reading target names");
+            mk_result r = read_target(a, bm, bc->first_target + k - bm->first_target, t, arena, err);
+            if (r) return r;
+        }
+    }
+    if (a->clip_count && !mk_raw_add_clips(out, a->clip_count)) return mk_error_oom(err, "reading clips");
+    for (uint32_t i = 0; i < a->clip_count; i++) {
+        const mk_blob_clip *bc = &a->clips[i];
+        mk_raw_clip *clip = &out->clips[i];
+        clip->name = mk_arena_strdup(arena, a->strings + bc->name);
+        clip->start = bc->start;
+        clip->duration = bc->duration;
+        clip->track_count = bc->track_count;
+        clip->tracks = mk_arena_array(arena, bc->track_count + 1u, sizeof(mk_raw_track));
+        if (!clip->name || !clip->tracks) return mk_error_oom(err, "reading clips");
+        for (uint32_t t = 0; t < bc->track_count; t++) {
+            const mk_blob_track *bt = &a->tracks[bc->first_track + t];
+            clip->tracks[t].channel = bt->channel;
+            clip->tracks[t].key_count = bt->key_count;
+            clip->tracks[t].keys = copy(arena, &a->keys[bt->first_key], (size_t)bt->key_count * sizeof(mk_key));
+            if (!clip->tracks[t].keys) return mk_error_oom(err, "reading keys");
+        }
+    }
+    snprintf(out->source_format, sizeof out->source_format, "morph v%u", MK_FORMAT_VERSION);
+    return MK_OK;
+}

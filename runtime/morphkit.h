@@ -1,0 +1,237 @@
+/* morphkit runtime: open a .morph blob in place, sample weight clips, evaluate morphs.
+ *
+ * C11, libc only, never allocates, no global state. Every function is thread-safe for
+ * concurrent calls on the same opened asset as long as their output spans do not overlap.
+ *
+ * Usage (see docs/embedding.md and samples/embed_minimal.c):
+ *   mk_asset asset; mk_error err;
+ *   if (mk_asset_open(blob, blob_size, &asset, &err) != MK_OK) { puts(err.message); ... }
+ *   mk_sample_job s = { .asset = &asset, .clip = 0, .time = t, .weights = w, .weight_count = n };
+ *   mk_sample_run(&s, &err);
+ *   mk_eval_job e = { .asset = &asset, .mesh = 0, .weights = w + first_channel_of_mesh, ... };
+ *   mk_eval_run(&e, &err);
+ *
+ * The blob must stay alive and unmodified while the asset is used: mk_asset only points
+ * into it. The blob must be 16-byte aligned (mmap and malloc both give that).
+ */
+#ifndef MORPHKIT_H
+#define MORPHKIT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define MK_FORMAT_VERSION 1u
+
+/* Result codes. Each comment says what fixes it. */
+typedef enum mk_result {
+    MK_OK = 0,
+    MK_ERROR_INVALID_ARGUMENT,  /* a NULL pointer or zero size where one is required: pass valid arguments */
+    MK_ERROR_TRUNCATED,         /* the blob ends before a structure it declares: pass the whole file */
+    MK_ERROR_BAD_MAGIC,         /* not a .morph blob: check the file you pass */
+    MK_ERROR_BAD_VERSION,       /* written by a newer/older morphkit: re-export with this version's tools */
+    MK_ERROR_BAD_CHECKSUM,      /* bytes changed after writing: the file is corrupt, re-export it */
+    MK_ERROR_BAD_ALIGNMENT,     /* the blob or one of its arrays is not 16-byte aligned: load it into aligned memory */
+    MK_ERROR_CORRUPT,           /* an offset, count, index or value is out of range: the file is corrupt or hostile */
+    MK_ERROR_OUT_OF_RANGE,      /* a job index (mesh, clip, channel, vertex range) exceeds the asset: fix the job */
+    MK_ERROR_BUFFER_TOO_SMALL,  /* an output or scratch span is smaller than the job needs: size it with the queries */
+    MK_ERROR_NOT_FINITE,        /* a NaN or infinite input (weight, time): pass finite values */
+    MK_ERROR_UNSUPPORTED,       /* the job asks for data the asset does not have (e.g. tangents): drop that output */
+    MK_ERROR_IO,                /* offline only: reading or writing a file failed: check the path and disk */
+    MK_ERROR_OUT_OF_MEMORY,     /* offline only: the allocator refused: raise the memory limit */
+    MK_ERROR_PARSE,             /* offline only: an input file (FBX, glTF, JSON) is malformed: see the message */
+    MK_ERROR_LIMIT,             /* offline only: input exceeds a configured limit (size, nesting, count) */
+    MK_RESULT_COUNT
+} mk_result;
+
+/* Errors are data: a code, a message naming what and where, and the element it concerns. */
+typedef struct mk_error {
+    mk_result code;
+    uint64_t offset;      /* byte offset in the input where it went wrong, or UINT64_MAX */
+    char message[256];
+} mk_error;
+
+const char *mk_result_name(mk_result code);
+
+/* Channel stacking on a mesh (DESIGN.md, "Evaluation semantics"). */
+typedef enum mk_stacking {
+    MK_STACKING_ASSET = 0,      /* in a job: use the mesh's setting stored in the blob */
+    MK_STACKING_ADDITIVE = 1,   /* P = B + sum_c D_c(w_c) */
+    MK_STACKING_SEQUENTIAL = 2  /* d_c = (1 - beta_c) d_{c-1} + D_c(w_c) */
+} mk_stacking;
+
+typedef enum mk_normal_mode {
+    MK_NORMALS_NLERP = 0,       /* normalize(B_n + sum of weighted normal deltas) */
+    MK_NORMALS_SLERP = 1        /* per channel, slerp between its span's end normals */
+} mk_normal_mode;
+
+/* Interpolation of the curve segment that starts at a key. */
+typedef enum mk_interp {
+    MK_INTERP_CONSTANT = 0,      /* hold this key's value until the next key */
+    MK_INTERP_CONSTANT_NEXT = 1, /* take the next key's value right after this key (FBX constant-next) */
+    MK_INTERP_LINEAR = 2,        /* straight line to the next key */
+    MK_INTERP_CUBIC = 3,         /* cubic Bezier in (time, value) from the slopes and weights (Hermite when both weights are 1/3) */
+    MK_INTERP_COUNT
+} mk_interp;
+
+/* One key of a weight curve. A segment k -> k+1 uses key k's right tangent and key k+1's
+ * left tangent. Slopes are d(weight)/d(second); weights are fractions of the key interval
+ * (1/3 gives a plain Hermite cubic; FBX weighted tangents set other values). */
+typedef struct mk_key {
+    float time;          /* seconds */
+    float value;         /* normalized weight (1.0 = 100 %) */
+    float right_slope;
+    float right_weight;
+    float left_slope;
+    float left_weight;
+    uint32_t interp;     /* mk_interp of the segment starting here */
+    uint32_t reserved;   /* zero */
+} mk_key;
+
+/* An opened asset: pointers into the blob, filled by mk_asset_open. Treat as opaque; use the
+ * query functions below. */
+typedef struct mk_asset {
+    const uint8_t *data;
+    size_t size;
+    const struct mk_blob_header *header;
+    const struct mk_blob_mesh *meshes;
+    const struct mk_blob_channel *channels;
+    const struct mk_blob_target *targets;
+    const struct mk_blob_clip *clips;
+    const struct mk_blob_track *tracks;
+    const mk_key *keys;
+    const char *strings;
+    uint64_t strings_size;
+    uint32_t mesh_count, channel_count, target_count, clip_count, track_count;
+    uint32_t key_count;
+} mk_asset;
+
+/* Validates the whole blob once (offsets, counts, indices, alignment, sorted data, finite
+ * floats, strictly increasing full weights, checksum, version). After MK_OK the asset is safe
+ * to use with any job; no hot path checks again. On failure *out is zeroed and err (optional)
+ * says what and where. */
+mk_result mk_asset_open(const void *data, size_t size, mk_asset *out, mk_error *err);
+
+/* ---- Queries (valid indices required; out-of-range indices return 0/NULL) ---- */
+
+typedef struct mk_mesh_info {
+    const char *name;             /* source node name (FBX model name, glTF node name) */
+    uint32_t vertex_count;        /* render vertices */
+    uint32_t control_point_count; /* source control points (FBX) or vertices (glTF) */
+    uint32_t triangle_count;
+    uint32_t first_channel;       /* index of the mesh's first channel in the asset */
+    uint32_t channel_count;
+    uint32_t target_count;        /* targets of all the mesh's channels */
+    mk_stacking stacking;         /* stored stacking: additive or sequential */
+    int has_normals, has_tangents;
+    int32_t gltf_node, gltf_mesh, gltf_primitive; /* -1 when not from glTF */
+    const float *world;           /* 4x4 column-major node world transform at rest */
+    const float *positions;       /* base positions, 3 floats per vertex */
+    const float *normals;         /* base normals, 3 floats per vertex, or NULL */
+    const float *tangents;        /* base tangents, 4 floats per vertex (w = handedness), or NULL */
+    const uint32_t *triangles;    /* 3 vertex indices per triangle */
+    const uint32_t *control_points; /* per render vertex: its source control point */
+} mk_mesh_info;
+
+typedef struct mk_channel_info {
+    const char *name;
+    const char *origin;           /* "" for imported channels; baked ones hold their recipe (JSON) */
+    uint32_t mesh;
+    uint32_t target_count;        /* > 1: progressive (in-between) channel */
+    float default_weight;         /* weight when no clip animates the channel */
+} mk_channel_info;
+
+typedef struct mk_target_info {
+    const char *name;
+    float full_weight;            /* normalized (FBX FullWeights / 100) */
+    uint32_t channel;
+    uint32_t moved_vertices;      /* vertices with stored data */
+    int quantized;                /* int16 with per-target scale, else float32 */
+    int has_normals, has_tangents;
+    float position_scale;         /* quantization step of positions (0 for float) */
+} mk_target_info;
+
+typedef struct mk_clip_info {
+    const char *name;
+    float start, duration;        /* seconds */
+    uint32_t track_count;
+} mk_clip_info;
+
+int mk_mesh_get(const mk_asset *asset, uint32_t mesh, mk_mesh_info *out);
+int mk_channel_get(const mk_asset *asset, uint32_t channel, mk_channel_info *out);
+/* Targets of a channel are numbered 0..target_count-1 in increasing full weight. */
+int mk_target_get(const mk_asset *asset, uint32_t channel, uint32_t target, mk_target_info *out);
+int mk_clip_get(const mk_asset *asset, uint32_t clip, mk_clip_info *out);
+/* Track k of a clip: which channel it animates and its keys. */
+int mk_track_get(const mk_asset *asset, uint32_t clip, uint32_t track, uint32_t *channel,
+                 const mk_key **keys, uint32_t *key_count);
+/* Index of the mesh/channel/clip with that name, or -1. */
+int32_t mk_find_mesh(const mk_asset *asset, const char *name);
+int32_t mk_find_channel(const mk_asset *asset, const char *name);
+int32_t mk_find_clip(const mk_asset *asset, const char *name);
+
+/* ---- Evaluation job ---- */
+
+/* Weights in, positions (+ normals, + tangents) out. Output pointers address vertex
+ * `first_vertex` (not vertex 0), so a job system can hand each thread its own range and
+ * buffer slice. A NULL output is skipped. */
+typedef struct mk_eval_job {
+    const mk_asset *asset;
+    uint32_t mesh;
+    uint32_t first_vertex;        /* vertex range [first_vertex, first_vertex + vertex_count) */
+    uint32_t vertex_count;        /* 0 means "to the end of the mesh" */
+    const float *weights;         /* one per channel of the mesh (mesh-local channel order) */
+    uint32_t weight_count;        /* must equal the mesh's channel count */
+    mk_stacking stacking;         /* MK_STACKING_ASSET (0) uses the blob's per-mesh setting */
+    mk_normal_mode normal_mode;   /* default nlerp */
+    void *scratch;                /* caller memory of mk_eval_scratch_size() bytes, 16-byte aligned */
+    size_t scratch_size;
+    float *positions;             /* output, required */
+    size_t positions_stride;      /* bytes between vertices; 0 means 12 */
+    size_t positions_size;        /* bytes available at positions */
+    float *normals;               /* optional output: 3 floats per vertex */
+    size_t normals_stride, normals_size;
+    float *tangents;              /* optional output: 4 floats per vertex (w copied from base) */
+    size_t tangents_stride, tangents_size;
+} mk_eval_job;
+
+/* Scratch bytes an evaluation of this mesh needs (0 for an invalid mesh). */
+size_t mk_eval_scratch_size(const mk_asset *asset, uint32_t mesh);
+mk_result mk_eval_validate(const mk_eval_job *job, mk_error *err);
+mk_result mk_eval_run(const mk_eval_job *job, mk_error *err);
+
+/* ---- Clip sampling job ---- */
+
+/* Time in, one weight per asset channel out. Channels the clip does not animate get their
+ * default weight. `cursors` (optional, one uint32 per track of the clip, zero-initialized by
+ * the caller once) remembers the last key per track so forward playback finds keys in O(1). */
+typedef struct mk_sample_job {
+    const mk_asset *asset;
+    uint32_t clip;
+    float time;                   /* seconds, in the clip's own time line (keys are absolute) */
+    int loop;                     /* nonzero: wrap time into [start, start + duration) */
+    float *weights;               /* output: one per asset channel */
+    uint32_t weight_count;        /* must be >= the asset's channel count */
+    uint32_t *cursors;            /* optional: track_count entries */
+    uint32_t cursor_count;
+} mk_sample_job;
+
+mk_result mk_sample_validate(const mk_sample_job *job, mk_error *err);
+mk_result mk_sample_run(const mk_sample_job *job, mk_error *err);
+
+/* Evaluates one curve at time t (clamped to the first/last key). Exposed for tools and tests. */
+float mk_curve_eval(const mk_key *keys, uint32_t key_count, float time, uint32_t *cursor);
+
+/* The channel displacement coefficients of DESIGN.md for one channel at weight w: the two
+ * targets (indices into the channel's sorted targets, -1 for the implicit zero key) and their
+ * factors, so D(w) = ca * delta[ia] + cb * delta[ib]. Exposed for tools and tests. */
+void mk_channel_span(const float *full_weights, uint32_t count, float w,
+                     int32_t *ia, float *ca, int32_t *ib, float *cb, float *t);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

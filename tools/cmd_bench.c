@@ -1,0 +1,481 @@
+/* morphkit bench [FILE] [--vertices N] [--channels C] [--active A] [--density D] [--threads T]
+ *                [--frames F] [--json]
+ *
+ * Measures evaluation speed against baselines run in the same process:
+ *   bound_ns   the bytes one frame must touch, at the memory-copy bandwidth measured now
+ *   naive_ns   a straightforward dense float loop over all vertices and the active targets
+ * With FILE, plays its first clip at 100 evenly spaced times; without, builds a synthetic mesh
+ * (default 1 000 000 vertices, 100 channels of which 20 % progressive, each target moving
+ * `density` of the vertices in a few spatially coherent regions, `active` channels nonzero).
+ */
+#define _GNU_SOURCE
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include "asset_load.h"
+#include "format.h"
+#include "frame.h"
+
+typedef struct bench_options {
+    uint32_t vertices, channels, active, threads, frames;
+    double density;
+    int json;
+} bench_options;
+
+static double now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
+}
+
+/* ---- synthetic asset ---- */
+
+/* A w x h grid (wavy height) with normals; targets move the vertices inside 3 disks. */
+static mk_result build_synthetic(const bench_options *o, mk_raw_asset *raw, mk_error *err)
+{
+    uint32_t w = (uint32_t)ceil(sqrt((double)o->vertices));
+    uint32_t h = (o->vertices + w - 1) / w;
+    uint32_t n = o->vertices;
+    mk_raw_mesh *m = mk_raw_add_meshes(raw, 1);
+    if (!m) return mk_error_oom(err, "building the synthetic mesh");
+    m->name = mk_arena_strdup(&raw->arena, "synthetic");
+    m->vertex_count = n;
+    m->positions = mk_arena_array(&raw->arena, 3 * (size_t)n, sizeof(float));
+    m->normals = mk_arena_array(&raw->arena, 3 * (size_t)n, sizeof(float));
+    uint32_t quads = (w - 1) * (h - 1);
+    m->triangles = mk_arena_array(&raw->arena, 6 * (size_t)quads, sizeof(uint32_t));
+    if (!m->name || !m->positions || !m->normals || !m->triangles) return mk_error_oom(err, "building the synthetic mesh");
+    for (uint32_t v = 0; v < n; v++) {
+        float x = (float)(v % w) / (float)w, y = (float)(v / w) / (float)h;
+        m->positions[3 * v] = x;
+        m->positions[3 * v + 1] = y;
+        m->positions[3 * v + 2] = 0.02f * sinf(20 * x) * cosf(17 * y);
+        m->normals[3 * v + 2] = 1;
+    }
+    uint32_t t = 0;
+    for (uint32_t y = 0; y + 1 < h; y++)
+        for (uint32_t x = 0; x + 1 < w; x++) {
+            uint32_t a = y * w + x, b = a + 1, c = a + w, d = c + 1;
+            if (d >= n) continue;
+            uint32_t *tri = &m->triangles[6 * (size_t)t++];
+            tri[0] = a; tri[1] = b; tri[2] = d; tri[3] = a; tri[4] = d; tri[5] = c;
+        }
+    m->triangle_count = 2 * t;
+    uint32_t progressive = o->channels / 5;
+    mk_raw_channel *channels = mk_raw_add_channels(raw, o->channels);
+    if (!channels) return mk_error_oom(err, "building channels");
+    uint32_t *scratch = mk_arena_array(&raw->arena, n, sizeof(uint32_t));
+    if (!scratch) return mk_error_oom(err, "building channels");
+    double radius = sqrt(o->density * (double)n / (3.0 * 3.14159265)) ;
+    uint64_t seed = 12345;
+    for (uint32_t c = 0; c < o->channels; c++) {
+        mk_raw_channel *ch = &channels[c];
+        char name[32];
+        snprintf(name, sizeof name, "channel%03u", c);
+        ch->name = mk_arena_strdup(&raw->arena, name);
+        uint32_t targets = c < progressive ? 2 : 1;
+        if (!mk_raw_add_targets(raw, ch, targets)) return mk_error_oom(err, "building targets");
+        /* Three disk centres per channel (an LCG keeps it deterministic). */
+        double cx[3], cy[3];
+        for (int k = 0; k < 3; k++) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            cx[k] = radius + (double)(seed >> 33) / 2147483648.0 * (w - 2 * radius);
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            cy[k] = radius + (double)(seed >> 33) / 2147483648.0 * (h - 2 * radius);
+        }
+        uint32_t count = 0;
+        for (uint32_t v = 0; v < n; v++) {
+            double x = v % w, y = v / w;
+            for (int k = 0; k < 3; k++)
+                if ((x - cx[k]) * (x - cx[k]) + (y - cy[k]) * (y - cy[k]) < radius * radius) { scratch[count++] = v; break; }
+        }
+        for (uint32_t k = 0; k < targets; k++) {
+            mk_raw_target *tg = &ch->targets[k];
+            tg->full_weight = targets == 2 ? (k == 0 ? 0.5f : 1.0f) : 1.0f;
+            tg->name = ch->name;
+            tg->count = count;
+            tg->indices = mk_arena_array(&raw->arena, count + 1u, sizeof(uint32_t));
+            tg->positions = mk_arena_array(&raw->arena, 3 * (size_t)count + 3, sizeof(float));
+            tg->normals = mk_arena_array(&raw->arena, 3 * (size_t)count + 3, sizeof(float));
+            if (!tg->indices || !tg->positions || !tg->normals) return mk_error_oom(err, "building targets");
+            memcpy(tg->indices, scratch, count * sizeof(uint32_t));
+            for (uint32_t j = 0; j < count; j++) {
+                float s = (float)(k + 1) * 0.01f * (float)((j * 2654435761u) % 1000) / 1000.0f;
+                tg->positions[3 * j + 2] = s;
+                tg->positions[3 * j] = 0.3f * s;
+                tg->normals[3 * j] = 0.2f * s;
+                tg->normals[3 * j + 1] = -0.1f * s;
+            }
+        }
+    }
+    return MK_OK;
+}
+
+/* ---- timing harness ---- */
+
+typedef struct bench_ctx {
+    const mk_asset *asset;
+    uint32_t mesh;
+    const float *weights;      /* asset-wide weights of the current frame */
+    mk_stacking stacking;
+    int normals;
+    float *positions, *out_normals;
+    void **scratch;            /* one per thread */
+    uint32_t threads;
+    pthread_barrier_t start, done;
+    int quit;
+} bench_ctx;
+
+typedef struct worker { bench_ctx *ctx; uint32_t index; } worker;
+
+static void run_slice(bench_ctx *c, uint32_t index)
+{
+    mk_mesh_info m;
+    mk_mesh_get(c->asset, c->mesh, &m);
+    /* Split on 64-vertex block boundaries so no two threads share a block. */
+    uint32_t blocks = (m.vertex_count + 63) / 64;
+    uint32_t b0 = (uint32_t)((uint64_t)blocks * index / c->threads), b1 = (uint32_t)((uint64_t)blocks * (index + 1) / c->threads);
+    uint32_t first = b0 * 64, last = b1 * 64 < m.vertex_count ? b1 * 64 : m.vertex_count;
+    if (first >= last) return;
+    mk_eval_job job = {
+        .asset = c->asset, .mesh = c->mesh, .first_vertex = first, .vertex_count = last - first,
+        .weights = c->weights + m.first_channel, .weight_count = m.channel_count, .stacking = c->stacking,
+        .scratch = c->scratch[index], .scratch_size = mk_eval_scratch_size(c->asset, c->mesh),
+        .positions = c->positions + 3 * (size_t)first, .positions_size = 12 * (size_t)(last - first),
+        .normals = c->normals && m.has_normals ? c->out_normals + 3 * (size_t)first : NULL,
+        .normals_size = 12 * (size_t)(last - first),
+    };
+    mk_error err;
+    if (mk_eval_run(&job, &err) != MK_OK) { fprintf(stderr, "bench: eval failed: %s\n", err.message); exit(1); }
+}
+
+static void *worker_main(void *arg)
+{
+    worker *w = arg;
+    for (;;) {
+        pthread_barrier_wait(&w->ctx->start);
+        if (w->ctx->quit) return NULL;
+        run_slice(w->ctx, w->index);
+        pthread_barrier_wait(&w->ctx->done);
+    }
+}
+
+/* Average ns per frame over the weight sets, all meshes, best of 3 passes. */
+static double time_frames(bench_ctx *c, const float *weight_sets, uint32_t frames, mk_stacking stacking, int normals)
+{
+    c->stacking = stacking;
+    c->normals = normals;
+    double best = INFINITY;
+    for (int pass = 0; pass < 3; pass++) {
+        double t0 = now_ns();
+        for (uint32_t f = 0; f < frames; f++) {
+            c->weights = weight_sets + (size_t)f * c->asset->channel_count;
+            for (uint32_t mi = 0; mi < c->asset->mesh_count; mi++) {
+                c->mesh = mi;
+                if (c->threads > 1) pthread_barrier_wait(&c->start);
+                run_slice(c, 0);
+                if (c->threads > 1) pthread_barrier_wait(&c->done);
+            }
+        }
+        double t = (now_ns() - t0) / frames;
+        if (t < best) best = t;
+    }
+    return best;
+}
+
+/* Bytes a frame must touch: block tables and entry headers of the mesh, the data of entries
+ * whose target is active, base positions (+ normals) read and outputs written. */
+static double frame_bytes(const mk_asset *a, const float *weights, int normals)
+{
+    double bytes = 0;
+    for (uint32_t mi = 0; mi < a->mesh_count; mi++) {
+        const mk_blob_mesh *m = &a->meshes[mi];
+        uint8_t *active = calloc(m->target_count + 1u, 1);
+        for (uint32_t c = m->first_channel; c < m->first_channel + m->channel_count; c++) {
+            const mk_blob_channel *ch = &a->channels[c];
+            float full[256];
+            uint32_t n = ch->target_count < 256 ? ch->target_count : 256;
+            for (uint32_t k = 0; k < n; k++) full[k] = a->targets[ch->first_target + k].full_weight;
+            int32_t ia, ib;
+            float ca, cb;
+            if (weights[c] == 0) continue;
+            mk_channel_span(full, n, weights[c], &ia, &ca, &ib, &cb, NULL);
+            if (ia >= 0 && ca != 0) active[ch->first_target - m->first_target + (uint32_t)ia] = 1;
+            if (ib >= 0 && cb != 0) active[ch->first_target - m->first_target + (uint32_t)ib] = 1;
+        }
+        const mk_blob_entry *e = (const mk_blob_entry *)(a->data + m->entries);
+        bytes += 16.0 * (double)m->entry_count + 4.0 * (m->block_count + 1);
+        for (uint64_t k = 0; k < m->entry_count; k++) {
+            if (!active[e[k].target]) continue;
+            uint32_t flags = a->targets[m->first_target + e[k].target].flags;
+            if (!normals) flags &= ~(uint32_t)(MK_TARGET_HAS_NORMALS | MK_TARGET_HAS_TANGENTS);
+            bytes += (double)mk_entry_data_size(flags, (uint32_t)__builtin_popcountll(e[k].mask));
+        }
+        int with_normals = normals && (m->flags & MK_MESH_HAS_NORMALS);
+        bytes += (double)m->vertex_count * 12.0 * 2 * (with_normals ? 2 : 1);
+        free(active);
+    }
+    return bytes;
+}
+
+/* Memory-copy bandwidth in bytes per ns (read + write counted), best of 5 copies of 256 MiB. */
+static double copy_bandwidth(void)
+{
+    size_t size = (size_t)256 << 20;
+    char *a = malloc(size), *b = malloc(size);
+    if (!a || !b) { free(a); free(b); return 0; }
+    memset(a, 1, size);
+    memset(b, 2, size);
+    double best = INFINITY;
+    for (int i = 0; i < 5; i++) {
+        double t0 = now_ns();
+        memcpy(i % 2 ? a : b, i % 2 ? b : a, size);
+        double t = now_ns() - t0;
+        if (t < best) best = t;
+    }
+    volatile char sink = a[size / 2] + b[size / 3];
+    (void)sink;
+    free(a);
+    free(b);
+    return 2.0 * (double)size / best;
+}
+
+/* The naive baseline: dense float deltas for every target, a loop over all vertices for
+ * each active target, then normals normalized. Returns ns per frame; checks its output
+ * against the runtime's (max abs difference into *diff). */
+static double naive_frames(const loaded_asset *l, const float *weight_sets, uint32_t frames, double *diff)
+{
+    const mk_asset *a = &l->asset;
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_error err;
+    if (mk_read_blob(a, &raw, &err)) { fprintf(stderr, "bench: %s\n", err.message); exit(1); }
+    /* Which targets are ever active: only those get dense arrays (memory). */
+    double total = 0;
+    *diff = 0;
+    for (uint32_t mi = 0; mi < raw.mesh_count; mi++) {
+        const mk_raw_mesh *m = &raw.meshes[mi];
+        size_t n = m->vertex_count;
+        float **dense_p = calloc(raw.channel_count * 4u + 1, sizeof(float *));
+        float **dense_n = calloc(raw.channel_count * 4u + 1, sizeof(float *));
+        float *out_p = malloc(12 * n), *out_n = malloc(12 * n);
+        mk_mesh_info info;
+        mk_mesh_get(a, mi, &info);
+        for (uint32_t c = info.first_channel; c < info.first_channel + info.channel_count; c++) {
+            int ever = 0;
+            for (uint32_t f = 0; f < frames; f++) ever |= weight_sets[(size_t)f * a->channel_count + c] != 0;
+            if (!ever) continue;
+            const mk_raw_channel *ch = &raw.channels[c];
+            for (uint32_t k = 0; k < ch->target_count && k < 4; k++) {
+                const mk_raw_target *t = &ch->targets[k];
+                float *dp = calloc(3 * n, sizeof(float)), *dn = calloc(3 * n, sizeof(float));
+                for (uint32_t j = 0; j < t->count; j++)
+                    for (int d = 0; d < 3; d++) {
+                        dp[3 * (size_t)t->indices[j] + (size_t)d] = t->positions[3 * (size_t)j + (size_t)d];
+                        if (t->normals) dn[3 * (size_t)t->indices[j] + (size_t)d] = t->normals[3 * (size_t)j + (size_t)d];
+                    }
+                dense_p[c * 4 + k] = dp;
+                dense_n[c * 4 + k] = dn;
+            }
+        }
+        double best = INFINITY;
+        for (int pass = 0; pass < 3; pass++) {
+            double t0 = now_ns();
+            for (uint32_t f = 0; f < frames; f++) {
+                const float *w = weight_sets + (size_t)f * a->channel_count;
+                memcpy(out_p, m->positions, 12 * n);
+                if (m->normals) memcpy(out_n, m->normals, 12 * n);
+                for (uint32_t c = info.first_channel; c < info.first_channel + info.channel_count; c++) {
+                    if (w[c] == 0) continue;
+                    const mk_raw_channel *ch = &raw.channels[c];
+                    float full[4];
+                    uint32_t count = ch->target_count < 4 ? ch->target_count : 4;
+                    for (uint32_t k = 0; k < count; k++) full[k] = ch->targets[k].full_weight;
+                    int32_t ia, ib;
+                    float ca, cb;
+                    mk_channel_span(full, count, w[c], &ia, &ca, &ib, &cb, NULL);
+                    for (int side = 0; side < 2; side++) {
+                        int32_t k = side ? ib : ia;
+                        float coef = side ? cb : ca;
+                        if (k < 0 || !dense_p[c * 4 + (uint32_t)k]) continue;
+                        const float *dp = dense_p[c * 4 + (uint32_t)k], *dn = dense_n[c * 4 + (uint32_t)k];
+                        for (size_t i = 0; i < 3 * n; i++) out_p[i] += coef * dp[i];
+                        if (m->normals) for (size_t i = 0; i < 3 * n; i++) out_n[i] += coef * dn[i];
+                    }
+                }
+                if (m->normals)
+                    for (size_t v = 0; v < n; v++) {
+                        float *q = &out_n[3 * v];
+                        float len = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+                        if (len > 1e-8f) { q[0] /= len; q[1] /= len; q[2] /= len; }
+                    }
+            }
+            double t = (now_ns() - t0) / frames;
+            if (t < best) best = t;
+        }
+        total += best;
+        /* Check: the last frame against the runtime. */
+        float *rp = malloc(12 * n), *rn = malloc(12 * n);
+        if (frame_eval_mesh(a, mi, weight_sets + (size_t)(frames - 1) * a->channel_count, MK_STACKING_ADDITIVE,
+                            MK_NORMALS_NLERP, rp, m->normals ? rn : NULL, &err) == MK_OK)
+            for (size_t i = 0; i < 3 * n; i++) {
+                double d = fabs((double)rp[i] - out_p[i]);
+                if (d > *diff) *diff = d;
+            }
+        free(rp);
+        free(rn);
+        for (uint32_t k = 0; k < raw.channel_count * 4u; k++) { free(dense_p[k]); free(dense_n[k]); }
+        free(dense_p);
+        free(dense_n);
+        free(out_p);
+        free(out_n);
+    }
+    mk_raw_free(&raw);
+    return total;
+}
+
+static int usage(void)
+{
+    fprintf(stderr, "usage: morphkit bench [FILE] [--vertices N] [--channels C] [--active A] [--density D]\n"
+                    "       [--threads T] [--frames F] [--json]\n");
+    return 2;
+}
+
+int cmd_bench(int argc, char **argv)
+{
+    bench_options o = { 1000000, 100, 30, 1, 100, 0.10, 0 };
+    const char *file = NULL;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--vertices") && v) { o.vertices = (uint32_t)strtoul(v, NULL, 10); i++; }
+        else if (!strcmp(a, "--channels") && v) { o.channels = (uint32_t)strtoul(v, NULL, 10); i++; }
+        else if (!strcmp(a, "--active") && v) { o.active = (uint32_t)strtoul(v, NULL, 10); i++; }
+        else if (!strcmp(a, "--density") && v) { o.density = atof(v); i++; }
+        else if (!strcmp(a, "--threads") && v) { o.threads = (uint32_t)strtoul(v, NULL, 10); i++; }
+        else if (!strcmp(a, "--frames") && v) { o.frames = (uint32_t)strtoul(v, NULL, 10); i++; }
+        else if (!strcmp(a, "--json")) o.json = 1;
+        else if (!strcmp(a, "--help")) { usage(); return 0; }
+        else if (a[0] != '-' && !file) file = a;
+        else { fprintf(stderr, "morphkit bench: unexpected argument '%s'\n", a); return usage(); }
+    }
+    if (o.vertices < 64 || o.channels == 0 || o.active > o.channels || o.threads < 1 || o.threads > 64
+        || o.frames == 0 || !(o.density > 0 && o.density <= 0.3)) {
+        fprintf(stderr, "morphkit bench: need --vertices >= 64, 1 <= --active <= --channels, 1 <= --threads <= 64, "
+                        "0 < --density <= 0.3\n");
+        return 2;
+    }
+    loaded_asset l;
+    mk_error err;
+    memset(&l, 0, sizeof l);
+    mk_result r;
+    double t_build = now_ns();
+    if (file) {
+        r = load_asset(file, NULL, NULL, &l, &err);
+    } else {
+        mk_raw_init(&l.raw, NULL);
+        r = build_synthetic(&o, &l.raw, &err);
+        if (!r) r = mk_write_blob(&l.raw, NULL, &l.raw.arena, &l.blob, &l.blob_size, &l.report, &err);
+        if (!r) r = mk_asset_open(l.blob, l.blob_size, &l.asset, &err);
+    }
+    if (r) { loaded_asset_free(&l); return cli_fail("bench", &err); }
+    t_build = now_ns() - t_build;
+    const mk_asset *a = &l.asset;
+
+    /* Weight sets: a clip sampled at evenly spaced times, or `active` fixed channels with
+     * weights that change every frame (progressive channels cross their in-between). */
+    uint32_t frames = o.frames;
+    float *weights = calloc((size_t)frames * a->channel_count + 1, sizeof(float));
+    if (!weights) return 1;
+    for (uint32_t f = 0; f < frames; f++) {
+        float *w = weights + (size_t)f * a->channel_count;
+        if (file) {
+            mk_clip_info clip;
+            float t = 0;
+            if (mk_clip_get(a, 0, &clip)) t = clip.start + clip.duration * (float)f / (float)(frames > 1 ? frames - 1 : 1);
+            frame_weights(a, a->clip_count ? 0 : -1, t, w, &err);
+        } else {
+            for (uint32_t k = 0; k < o.active; k++) {
+                uint32_t c = (k * 97u) % a->channel_count;
+                w[c] = 0.05f + 0.9f * (float)((f * 7u + k * 13u) % 100u) / 100.0f;
+            }
+        }
+    }
+
+    bench_ctx ctx;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.asset = a;
+    ctx.threads = o.threads;
+    size_t max_vertices = 0, max_scratch = 0;
+    for (uint32_t mi = 0; mi < a->mesh_count; mi++) {
+        mk_mesh_info m;
+        mk_mesh_get(a, mi, &m);
+        if (m.vertex_count > max_vertices) max_vertices = m.vertex_count;
+        if (mk_eval_scratch_size(a, mi) > max_scratch) max_scratch = mk_eval_scratch_size(a, mi);
+    }
+    ctx.positions = malloc(12 * max_vertices);
+    ctx.out_normals = malloc(12 * max_vertices);
+    ctx.scratch = calloc(o.threads, sizeof(void *));
+    for (uint32_t t = 0; t < o.threads; t++) ctx.scratch[t] = aligned_alloc(16, (max_scratch + 15) & ~(size_t)15);
+    pthread_t *threads = calloc(o.threads, sizeof(pthread_t));
+    worker *workers = calloc(o.threads, sizeof(worker));
+    if (o.threads > 1) {
+        pthread_barrier_init(&ctx.start, NULL, o.threads);
+        pthread_barrier_init(&ctx.done, NULL, o.threads);
+        for (uint32_t t = 1; t < o.threads; t++) {
+            workers[t].ctx = &ctx;
+            workers[t].index = t;
+            pthread_create(&threads[t], NULL, worker_main, &workers[t]);
+        }
+    }
+    /* Warm up once, then measure. */
+    time_frames(&ctx, weights, frames < 5 ? frames : 5, MK_STACKING_ADDITIVE, 1);
+    double ns = time_frames(&ctx, weights, frames, MK_STACKING_ADDITIVE, 1);
+    double ns_positions = time_frames(&ctx, weights, frames, MK_STACKING_ADDITIVE, 0);
+    double ns_sequential = time_frames(&ctx, weights, frames, MK_STACKING_SEQUENTIAL, 1);
+    if (o.threads > 1) {
+        ctx.quit = 1;
+        pthread_barrier_wait(&ctx.start);
+        for (uint32_t t = 1; t < o.threads; t++) pthread_join(threads[t], NULL);
+    }
+    double bytes = 0;
+    for (uint32_t f = 0; f < frames; f++) bytes += frame_bytes(a, weights + (size_t)f * a->channel_count, 1);
+    bytes /= frames;
+    double bandwidth = copy_bandwidth();
+    double bound_ns = bandwidth > 0 ? bytes / bandwidth : 0;
+    double diff = 0;
+    double naive_ns = naive_frames(&l, weights, frames < 20 ? frames : 20, &diff);
+
+    if (o.json) {
+        printf("{\"ns_per_frame\": %.0f, \"ns_per_frame_positions\": %.0f, \"bytes_per_frame\": %.0f, "
+               "\"bound_ns\": %.0f, \"ratio_to_bound\": %.3f, \"naive_ns\": %.0f, \"speedup_vs_naive\": %.2f, "
+               "\"sequential_over_additive\": %.3f}\n",
+               ns, ns_positions, bytes, bound_ns, bound_ns / ns, naive_ns, naive_ns / ns, ns_sequential / ns);
+    } else {
+        uint32_t vertices = 0;
+        for (uint32_t mi = 0; mi < a->mesh_count; mi++) vertices += a->meshes[mi].vertex_count;
+        printf("asset: %s, %u meshes, %u vertices, %u channels, %u targets, blob %.1f MB (built in %.1f s)\n",
+               file ? file : "synthetic", a->mesh_count, vertices, a->channel_count, a->target_count,
+               (double)l.blob_size / 1e6, t_build / 1e9);
+        printf("threads: %u, frames: %u\n", o.threads, frames);
+        printf("ns_per_frame             %12.0f  (positions + normals)\n", ns);
+        printf("ns_per_frame_positions   %12.0f\n", ns_positions);
+        printf("bytes_per_frame          %12.0f\n", bytes);
+        printf("bound_ns                 %12.0f  (copy bandwidth %.2f GB/s)\n", bound_ns, bandwidth);
+        printf("ratio_to_bound           %12.3f\n", bound_ns / ns);
+        printf("naive_ns                 %12.0f  (dense float loop; max |difference| %.3g)\n", naive_ns, diff);
+        printf("speedup_vs_naive         %12.2f\n", naive_ns / ns);
+        printf("sequential_over_additive %12.3f\n", ns_sequential / ns);
+    }
+    for (uint32_t t = 0; t < o.threads; t++) free(ctx.scratch[t]);
+    free(ctx.scratch);
+    free(ctx.positions);
+    free(ctx.out_normals);
+    free(threads);
+    free(workers);
+    free(weights);
+    loaded_asset_free(&l);
+    return 0;
+}

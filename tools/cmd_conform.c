@@ -1,0 +1,354 @@
+/* morphkit conform CASES.json [--case SUBSTRING] [--precision float|q16] [--normal-tolerance DEG]
+ *
+ * For each case of a manifest (format: ../shared/corpus/README.md): imports the source in
+ * memory, writes it as a blob with the chosen precision, opens it with the runtime, and for
+ * every reference frame samples the clip (or applies forced weights), evaluates every mesh
+ * and compares with the reference: max position error (world or mesh-local space, matched
+ * per control point or per vertex) and, where the reference has normals, the max angle
+ * between directions. One line per frame, then "N passed, N failed". Exit 0 only if all
+ * frames passed.
+ *
+ * With q16 precision the allowed error is the case tolerance plus the quantization bound the
+ * writer reports, propagated through the frame's channel coefficients and the world scale.
+ */
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "asset_load.h"
+#include "frame.h"
+
+typedef struct conform_options {
+    const char *filter;
+    mk_precision precision;
+    double normal_tolerance_deg;
+} conform_options;
+
+typedef struct counts { int passed, failed; } counts;
+
+static char *read_text(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    if (n < 0) { fclose(f); return NULL; }
+    rewind(f);
+    char *s = malloc((size_t)n + 1);
+    if (s && fread(s, 1, (size_t)n, f) != (size_t)n) { free(s); s = NULL; }
+    fclose(f);
+    if (s) { s[n] = 0; if (size) *size = (size_t)n; }
+    return s;
+}
+
+static cJSON *read_json(const char *path)
+{
+    char *text = read_text(path, NULL);
+    if (!text) return NULL;
+    cJSON *j = cJSON_Parse(text);
+    free(text);
+    return j;
+}
+
+/* Reference mesh positions from an OBJ: every 'v' line, in order (one per control point). */
+static float *read_obj_positions(const char *path, uint32_t *count)
+{
+    char *text = read_text(path, NULL);
+    if (!text) return NULL;
+    size_t cap = 1024, n = 0;
+    float *p = malloc(cap * sizeof(float));
+    for (char *line = strtok(text, "\n"); line && p; line = strtok(NULL, "\n")) {
+        if (line[0] != 'v' || line[1] != ' ') continue;
+        float x, y, z;
+        if (sscanf(line + 2, "%f %f %f", &x, &y, &z) != 3) continue;
+        if (n + 3 > cap) {
+            cap *= 2;
+            float *q = realloc(p, cap * sizeof(float));
+            if (!q) { free(p); p = NULL; break; }
+            p = q;
+        }
+        p[n++] = x; p[n++] = y; p[n++] = z;
+    }
+    free(text);
+    *count = (uint32_t)(n / 3);
+    return p;
+}
+
+static float *json_float_array(const cJSON *array, uint32_t *count)
+{
+    int n = cJSON_GetArraySize(array);
+    if (!cJSON_IsArray(array) || n <= 0) { *count = 0; return NULL; }
+    float *p = malloc((size_t)n * sizeof(float));
+    int i = 0;
+    for (const cJSON *e = array->child; e && p; e = e->next) p[i++] = (float)e->valuedouble;
+    *count = (uint32_t)n;
+    return p;
+}
+
+static double max_column_norm(const float *w)
+{
+    double m = 0;
+    for (int c = 0; c < 3; c++) {
+        double s = sqrt((double)w[4 * c] * w[4 * c] + (double)w[4 * c + 1] * w[4 * c + 1] + (double)w[4 * c + 2] * w[4 * c + 2]);
+        if (s > m) m = s;
+    }
+    return m;
+}
+
+/* Sum over the mesh's channels of |ca| + |cb|: how many quantized deltas a vertex can add. */
+static double coefficient_sum(const mk_asset *a, const mk_mesh_info *m, const float *weights)
+{
+    double sum = 0;
+    for (uint32_t c = m->first_channel; c < m->first_channel + m->channel_count; c++) {
+        mk_channel_info ch;
+        mk_channel_get(a, c, &ch);
+        float full[256];
+        uint32_t n = ch.target_count < 256 ? ch.target_count : 256;
+        for (uint32_t k = 0; k < n; k++) {
+            mk_target_info t;
+            mk_target_get(a, c, k, &t);
+            full[k] = t.full_weight;
+        }
+        int32_t ia, ib;
+        float ca, cb;
+        mk_channel_span(full, n, weights[c], &ia, &ca, &ib, &cb, NULL);
+        sum += (ia >= 0 ? fabs(ca) : 0) + (ib >= 0 ? fabs(cb) : 0);
+    }
+    return sum;
+}
+
+typedef struct frame_result {
+    double position_error, normal_error_deg, allowed;
+    int meshes_compared;
+    char failure[1024];
+} frame_result;
+
+static int find_mesh_for(const mk_asset *a, const cJSON *ref_mesh, int gltf)
+{
+    if (gltf) {
+        const cJSON *node = cJSON_GetObjectItem(ref_mesh, "node"), *mesh = cJSON_GetObjectItem(ref_mesh, "mesh"),
+                    *prim = cJSON_GetObjectItem(ref_mesh, "primitive");
+        for (uint32_t i = 0; i < a->mesh_count; i++) {
+            mk_mesh_info m;
+            mk_mesh_get(a, i, &m);
+            if (cJSON_IsNumber(node) && m.gltf_node == node->valueint && cJSON_IsNumber(mesh) && m.gltf_mesh == mesh->valueint
+                && cJSON_IsNumber(prim) && m.gltf_primitive == prim->valueint)
+                return (int)i;
+        }
+        return -1;
+    }
+    const cJSON *node = cJSON_GetObjectItem(ref_mesh, "node");
+    return cJSON_IsString(node) ? mk_find_mesh(a, node->valuestring) : -1;
+}
+
+/* Compares one mesh; updates result. ref_pos has 3 floats per control point or vertex. */
+static void compare_mesh(const mk_asset *a, uint32_t mi, const float *weights, const float *ref_pos, uint32_t ref_count,
+                         const float *ref_nrm, int world, int by_control_point, double quant_error, frame_result *res)
+{
+    mk_mesh_info m;
+    mk_mesh_get(a, mi, &m);
+    uint32_t expected = by_control_point ? m.control_point_count : m.vertex_count;
+    if (ref_count != expected) {
+        snprintf(res->failure, sizeof res->failure, "mesh '%s': reference has %u %s, import has %u", m.name, ref_count,
+                 by_control_point ? "control points" : "vertices", expected);
+        return;
+    }
+    float *pos = malloc(12u * (size_t)m.vertex_count), *nrm = m.has_normals ? malloc(12u * (size_t)m.vertex_count) : NULL;
+    mk_error err;
+    if (!pos || (m.has_normals && !nrm)) { snprintf(res->failure, sizeof res->failure, "out of memory"); goto done; }
+    if (frame_eval_mesh(a, mi, weights, MK_STACKING_ASSET, MK_NORMALS_NLERP, pos, nrm, &err)) {
+        snprintf(res->failure, sizeof res->failure, "mesh '%.200s': evaluation failed: %.300s", m.name, err.message);
+        goto done;
+    }
+    if (world) frame_to_world(m.world, pos, nrm, m.vertex_count);
+    double scale = world ? max_column_norm(m.world) : 1.0;
+    double allowed_extra = quant_error * scale * coefficient_sum(a, &m, weights);
+    if (allowed_extra > res->allowed) res->allowed = allowed_extra;
+    for (uint32_t v = 0; v < m.vertex_count; v++) {
+        uint32_t r = by_control_point ? m.control_points[v] : v;
+        for (int d = 0; d < 3; d++) {
+            double e = fabs((double)pos[3 * v + (uint32_t)d] - (double)ref_pos[3 * r + (uint32_t)d]);
+            if (!(e <= res->position_error)) res->position_error = e;   /* NaN propagates as failure */
+        }
+        if (ref_nrm && nrm) {
+            const float *rn = &ref_nrm[3 * r], *n = &nrm[3 * v];
+            double rl = sqrt((double)rn[0] * rn[0] + (double)rn[1] * rn[1] + (double)rn[2] * rn[2]);
+            if (rl > 1e-12) {
+                double dot = ((double)n[0] * rn[0] + (double)n[1] * rn[1] + (double)n[2] * rn[2]) / rl;
+                dot = dot > 1 ? 1 : dot < -1 ? -1 : dot;
+                double angle = acos(dot) * 180.0 / 3.14159265358979323846;
+                if (angle > res->normal_error_deg) res->normal_error_deg = angle;
+            }
+        }
+    }
+    res->meshes_compared++;
+done:
+    free(pos);
+    free(nrm);
+}
+
+static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame, const char *base_dir,
+                      frame_result *res)
+{
+    const mk_asset *a = &l->asset;
+    const cJSON *reference = cJSON_GetObjectItem(cs, "reference");
+    const char *kind = cJSON_GetStringValue(cJSON_GetObjectItem(reference, "kind"));
+    const char *space = cJSON_GetStringValue(cJSON_GetObjectItem(reference, "space"));
+    const char *match = cJSON_GetStringValue(cJSON_GetObjectItem(reference, "match"));
+    const char *file = cJSON_GetStringValue(cJSON_GetObjectItem(frame, "file"));
+    int world = space && !strcmp(space, "world"), by_cp = match && !strcmp(match, "control_points");
+    const char *format = cJSON_GetStringValue(cJSON_GetObjectItem(cs, "format"));
+    int gltf = format && !strcmp(format, "gltf");
+    if (!kind || !file) { snprintf(res->failure, sizeof res->failure, "case has no reference kind or frame file"); return; }
+
+    float *weights = calloc(a->channel_count + 1u, sizeof(float));
+    if (!weights) { snprintf(res->failure, sizeof res->failure, "out of memory"); return; }
+    const cJSON *time = cJSON_GetObjectItem(frame, "time"), *clip = cJSON_GetObjectItem(frame, "clip"),
+                *forced = cJSON_GetObjectItem(frame, "weights");
+    int32_t clip_index = cJSON_IsNumber(clip) ? clip->valueint : cJSON_IsNumber(time) ? 0 : -1;
+    mk_error err;
+    if (clip_index >= (int32_t)a->clip_count) {
+        snprintf(res->failure, sizeof res->failure, "frame needs clip %d, import has %u clips", clip_index, a->clip_count);
+        free(weights);
+        return;
+    }
+    if (frame_weights(a, clip_index, cJSON_IsNumber(time) ? (float)time->valuedouble : 0.0f, weights, &err)) {
+        snprintf(res->failure, sizeof res->failure, "sampling failed: %.300s", err.message);
+        free(weights);
+        return;
+    }
+
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s", base_dir, file);
+    if (!strcmp(kind, "obj")) {
+        uint32_t count;
+        float *ref = read_obj_positions(path, &count);
+        if (!ref) { snprintf(res->failure, sizeof res->failure, "cannot read %.900s", path); free(weights); return; }
+        /* An OBJ frame holds the one deformed mesh: the asset's mesh with channels. */
+        for (uint32_t i = 0; i < a->mesh_count; i++) {
+            mk_mesh_info m;
+            mk_mesh_get(a, i, &m);
+            if (m.channel_count) compare_mesh(a, i, weights, ref, count, NULL, world, by_cp, l->report.max_position_error, res);
+        }
+        free(ref);
+        free(weights);
+        return;
+    }
+    cJSON *ref = read_json(path);
+    if (!ref) { snprintf(res->failure, sizeof res->failure, "cannot read or parse %.900s", path); free(weights); return; }
+    const cJSON *meshes = cJSON_GetObjectItem(ref, "meshes");
+    for (const cJSON *rm = meshes ? meshes->child : NULL; rm && !res->failure[0]; rm = rm->next) {
+        const cJSON *chans = cJSON_GetObjectItem(rm, gltf ? "weights" : "channels");
+        int has_morph = cJSON_GetArraySize(chans) > 0;
+        int mi = find_mesh_for(a, rm, gltf);
+        if (mi < 0) {
+            if (has_morph) {
+                const char *label = cJSON_GetStringValue(cJSON_GetObjectItem(rm, gltf ? "label" : "node"));
+                snprintf(res->failure, sizeof res->failure, "reference mesh '%s' with morph channels is not in the import",
+                         label ? label : "?");
+            }
+            continue;
+        }
+        float *local_weights = NULL;
+        const float *use = weights;
+        if (cJSON_IsArray(forced)) {
+            /* Forced weights: per channel of the matched mesh, in its channel order. */
+            local_weights = malloc((a->channel_count + 1u) * sizeof(float));
+            memcpy(local_weights, weights, a->channel_count * sizeof(float));
+            mk_mesh_info m;
+            mk_mesh_get(a, (uint32_t)mi, &m);
+            uint32_t k = 0;
+            for (const cJSON *w = forced->child; w && k < m.channel_count; w = w->next, k++)
+                local_weights[m.first_channel + k] = (float)w->valuedouble;
+            use = local_weights;
+        }
+        uint32_t count, ncount = 0;
+        float *pos = json_float_array(cJSON_GetObjectItem(rm, "positions"), &count);
+        float *nrm = json_float_array(cJSON_GetObjectItem(rm, "normals"), &ncount);
+        if (!pos) snprintf(res->failure, sizeof res->failure, "reference mesh has no positions");
+        else compare_mesh(a, (uint32_t)mi, use, pos, count / 3, ncount == count ? nrm : NULL, world, by_cp,
+                          l->report.max_position_error, res);
+        free(pos);
+        free(nrm);
+        free(local_weights);
+    }
+    if (!res->failure[0] && res->meshes_compared == 0)
+        snprintf(res->failure, sizeof res->failure, "no reference mesh matched the import");
+    cJSON_Delete(ref);
+    free(weights);
+}
+
+static void run_case(const cJSON *cs, const char *base_dir, const conform_options *opt, counts *total)
+{
+    const char *name = cJSON_GetStringValue(cJSON_GetObjectItem(cs, "name"));
+    const char *source = cJSON_GetStringValue(cJSON_GetObjectItem(cs, "source"));
+    const cJSON *frames = cJSON_GetObjectItem(cs, "frames");
+    double tolerance = cJSON_GetNumberValue(cJSON_GetObjectItem(cJSON_GetObjectItem(cs, "reference"), "tolerance"));
+    if (!name || !source || !cJSON_IsArray(frames)) {
+        printf("%-48s FAIL malformed case entry\n", name ? name : "?");
+        total->failed++;
+        return;
+    }
+    if (opt->filter && !strstr(name, opt->filter) && !strstr(source, opt->filter)) return;
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s", base_dir, source);
+    mk_write_options wo = { .precision = opt->precision };
+    loaded_asset l;
+    mk_error err;
+    mk_result r = load_asset(path, NULL, &wo, &l, &err);
+    for (const cJSON *frame = frames->child; frame; frame = frame->next) {
+        const char *file = cJSON_GetStringValue(cJSON_GetObjectItem(frame, "file"));
+        const char *short_name = file ? strrchr(file, '/') : NULL;
+        short_name = short_name ? short_name + 1 : file ? file : "?";
+        if (r != MK_OK) {
+            printf("%-48s %-22s FAIL import: %s\n", name, short_name, err.message);
+            total->failed++;
+            continue;
+        }
+        frame_result res;
+        memset(&res, 0, sizeof res);
+        run_frame(&l, cs, frame, base_dir, &res);
+        double allowed = tolerance + res.allowed;
+        int ok = !res.failure[0] && res.position_error <= allowed && res.normal_error_deg <= opt->normal_tolerance_deg;
+        printf("%-48s %-22s pos %.3g (<= %.3g) normal %.3g deg  %s", name, short_name, res.position_error, allowed,
+               res.normal_error_deg, ok ? "ok" : "FAIL");
+        if (res.failure[0]) printf(" %s", res.failure);
+        printf("\n");
+        if (ok) total->passed++; else total->failed++;
+    }
+    loaded_asset_free(&l);
+}
+
+static int usage(void)
+{
+    fprintf(stderr, "usage: morphkit conform CASES.json [--case SUBSTRING] [--precision float|q16] [--normal-tolerance DEG]\n");
+    return 2;
+}
+
+int cmd_conform(int argc, char **argv)
+{
+    const char *manifest = NULL;
+    conform_options opt = { NULL, MK_PRECISION_Q16, 1.0 };
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--case") && v) { opt.filter = v; i++; }
+        else if (!strcmp(a, "--precision") && v) { int p = cli_parse_precision(v); if (p < 0) return usage(); opt.precision = (mk_precision)p; i++; }
+        else if (!strcmp(a, "--normal-tolerance") && v) { opt.normal_tolerance_deg = atof(v); i++; }
+        else if (!strcmp(a, "--help")) { usage(); return 0; }
+        else if (a[0] != '-' && !manifest) manifest = a;
+        else { fprintf(stderr, "morphkit conform: unexpected argument '%s'\n", a); return usage(); }
+    }
+    if (!manifest) return usage();
+    cJSON *root = read_json(manifest);
+    if (!root) { fprintf(stderr, "morphkit conform: cannot read or parse %s\n", manifest); return 1; }
+    char base_dir[4096];
+    snprintf(base_dir, sizeof base_dir, "%s", manifest);
+    char *slash = strrchr(base_dir, '/');
+    if (slash) *slash = 0; else strcpy(base_dir, ".");
+    counts total = { 0, 0 };
+    const cJSON *cases = cJSON_GetObjectItem(root, "cases");
+    for (const cJSON *cs = cases ? cases->child : NULL; cs; cs = cs->next) run_case(cs, base_dir, &opt, &total);
+    cJSON_Delete(root);
+    printf("%d passed, %d failed\n", total.passed, total.failed);
+    return total.failed || total.passed == 0 ? 1 : 0;
+}

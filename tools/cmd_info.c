@@ -1,0 +1,178 @@
+/* morphkit info FILE [--json]: meshes, channels with in-betweens and full weights, clips,
+ * sizes, precision and the quantization error bound. Any input works; non-.morph inputs are
+ * imported and written in memory with the default options first. */
+#include <string.h>
+#include "asset_load.h"
+#include "format.h"
+#include "json_write.h"
+
+static void precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *floats, double *max_error_bound)
+{
+    *quantized = *floats = 0;
+    *max_error_bound = 0;
+    for (uint32_t c = 0; c < a->channel_count; c++) {
+        mk_channel_info ch;
+        mk_channel_get(a, c, &ch);
+        for (uint32_t k = 0; k < ch.target_count; k++) {
+            mk_target_info t;
+            mk_target_get(a, c, k, &t);
+            if (t.quantized) {
+                (*quantized)++;
+                /* Rounding to the nearest step: the error is at most half a step. */
+                if (t.position_scale * 0.5 > *max_error_bound) *max_error_bound = t.position_scale * 0.5;
+            } else {
+                (*floats)++;
+            }
+        }
+    }
+}
+
+static void print_text(const loaded_asset *l, const char *path)
+{
+    const mk_asset *a = &l->asset;
+    uint32_t nq, nf;
+    double bound;
+    precision_of(a, &nq, &nf, &bound);
+    printf("%s: %zu bytes, format v%u\n", path, l->blob_size, MK_FORMAT_VERSION);
+    if (l->imported) {
+        printf("source: %s%s%s\n", l->raw.source_format[0] ? l->raw.source_format : "?",
+               l->raw.source_creator[0] ? ", creator " : "", l->raw.source_creator);
+        if (l->raw.unit_scale > 0) printf("unit scale: %g cm per unit\n", (double)l->raw.unit_scale);
+        if (l->raw.up_axis >= 0) printf("up axis: %c\n", "XYZ"[l->raw.up_axis % 3]);
+        printf("import warnings: %u\n", l->raw.warning_count);
+    }
+    printf("precision: %u quantized (int16) targets, %u float targets; max quantization error <= %.3g\n", nq, nf, bound);
+    for (uint32_t i = 0; i < a->mesh_count; i++) {
+        mk_mesh_info m;
+        mk_mesh_get(a, i, &m);
+        printf("mesh %u '%s': %u vertices (%u control points), %u triangles, %s%s%s stacking",
+               i, m.name, m.vertex_count, m.control_point_count, m.triangle_count,
+               m.has_normals ? "normals, " : "", m.has_tangents ? "tangents, " : "",
+               m.stacking == MK_STACKING_SEQUENTIAL ? "sequential" : "additive");
+        if (m.gltf_node >= 0) printf(", glTF node %d mesh %d primitive %d", m.gltf_node, m.gltf_mesh, m.gltf_primitive);
+        printf("\n  target data: %llu bytes in %llu block entries\n",
+               (unsigned long long)a->meshes[i].target_data_size, (unsigned long long)a->meshes[i].entry_count);
+        for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
+            mk_channel_info ch;
+            mk_channel_get(a, c, &ch);
+            printf("  channel %u '%s': default %g, %u target%s%s\n", c, ch.name, (double)ch.default_weight,
+                   ch.target_count, ch.target_count == 1 ? "" : "s", ch.target_count > 1 ? " (progressive)" : "");
+            for (uint32_t k = 0; k < ch.target_count; k++) {
+                mk_target_info t;
+                mk_target_get(a, c, k, &t);
+                printf("    target '%s': full weight %g, %u vertices, %s%s%s\n", t.name, (double)t.full_weight,
+                       t.moved_vertices, t.quantized ? "int16" : "float", t.has_normals ? ", normals" : "",
+                       t.has_tangents ? ", tangents" : "");
+            }
+            if (ch.origin[0]) printf("    baked from recipe: %s\n", ch.origin);
+        }
+    }
+    for (uint32_t i = 0; i < a->clip_count; i++) {
+        mk_clip_info c;
+        mk_clip_get(a, i, &c);
+        printf("clip %u '%s': start %g s, duration %g s, %u tracks\n", i, c.name, (double)c.start, (double)c.duration,
+               c.track_count);
+    }
+}
+
+static void print_json(const loaded_asset *l, const char *path)
+{
+    const mk_asset *a = &l->asset;
+    uint32_t nq, nf;
+    double bound;
+    precision_of(a, &nq, &nf, &bound);
+    json_writer w;
+    json_begin(&w, stdout, 1);
+    json_object(&w, NULL);
+    json_string(&w, "file", path);
+    json_int(&w, "bytes", (long long)l->blob_size);
+    json_int(&w, "format_version", MK_FORMAT_VERSION);
+    if (l->imported) {
+        json_string(&w, "source_format", l->raw.source_format);
+        json_string(&w, "source_creator", l->raw.source_creator);
+        json_number(&w, "unit_scale", l->raw.unit_scale);
+        json_int(&w, "up_axis", l->raw.up_axis);
+        json_int(&w, "warnings", l->raw.warning_count);
+    }
+    json_int(&w, "quantized_targets", nq);
+    json_int(&w, "float_targets", nf);
+    json_number(&w, "max_quantization_error", bound);
+    json_array(&w, "meshes");
+    for (uint32_t i = 0; i < a->mesh_count; i++) {
+        mk_mesh_info m;
+        mk_mesh_get(a, i, &m);
+        json_object(&w, NULL);
+        json_string(&w, "name", m.name);
+        json_int(&w, "vertices", m.vertex_count);
+        json_int(&w, "control_points", m.control_point_count);
+        json_int(&w, "triangles", m.triangle_count);
+        json_bool(&w, "normals", m.has_normals);
+        json_bool(&w, "tangents", m.has_tangents);
+        json_string(&w, "stacking", m.stacking == MK_STACKING_SEQUENTIAL ? "sequential" : "additive");
+        json_int(&w, "gltf_node", m.gltf_node);
+        json_int(&w, "gltf_mesh", m.gltf_mesh);
+        json_int(&w, "gltf_primitive", m.gltf_primitive);
+        json_floats(&w, "world", m.world, 16);
+        json_int(&w, "target_bytes", (long long)a->meshes[i].target_data_size);
+        json_array(&w, "channels");
+        for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
+            mk_channel_info ch;
+            mk_channel_get(a, c, &ch);
+            json_object(&w, NULL);
+            json_int(&w, "index", c);
+            json_string(&w, "name", ch.name);
+            json_number(&w, "default_weight", ch.default_weight);
+            if (ch.origin[0]) json_string(&w, "origin", ch.origin);
+            json_array(&w, "targets");
+            for (uint32_t k = 0; k < ch.target_count; k++) {
+                mk_target_info t;
+                mk_target_get(a, c, k, &t);
+                json_object(&w, NULL);
+                json_string(&w, "name", t.name);
+                json_number(&w, "full_weight", t.full_weight);
+                json_int(&w, "vertices", t.moved_vertices);
+                json_string(&w, "precision", t.quantized ? "q16" : "float");
+                json_bool(&w, "normals", t.has_normals);
+                json_bool(&w, "tangents", t.has_tangents);
+                json_end_object(&w);
+            }
+            json_end_array(&w);
+            json_end_object(&w);
+        }
+        json_end_array(&w);
+        json_end_object(&w);
+    }
+    json_end_array(&w);
+    json_array(&w, "clips");
+    for (uint32_t i = 0; i < a->clip_count; i++) {
+        mk_clip_info c;
+        mk_clip_get(a, i, &c);
+        json_object(&w, NULL);
+        json_string(&w, "name", c.name);
+        json_number(&w, "start", c.start);
+        json_number(&w, "duration", c.duration);
+        json_int(&w, "tracks", c.track_count);
+        json_end_object(&w);
+    }
+    json_end_array(&w);
+    json_end_object(&w);
+}
+
+int cmd_info(int argc, char **argv)
+{
+    const char *path = NULL;
+    int as_json = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--json")) as_json = 1;
+        else if (!strcmp(argv[i], "--help")) { printf("usage: morphkit info FILE [--json]\n"); return 0; }
+        else if (argv[i][0] == '-' || path) { fprintf(stderr, "morphkit info: unexpected argument '%s'\n", argv[i]); return 2; }
+        else path = argv[i];
+    }
+    if (!path) { fprintf(stderr, "usage: morphkit info FILE [--json]\n"); return 2; }
+    loaded_asset l;
+    mk_error err;
+    if (load_asset(path, NULL, NULL, &l, &err)) { loaded_asset_free(&l); return cli_fail("info", &err); }
+    if (as_json) print_json(&l, path); else print_text(&l, path);
+    loaded_asset_free(&l);
+    return 0;
+}

@@ -1,0 +1,65 @@
+#include <math.h>
+#include <stdlib.h>
+#include "frame.h"
+
+mk_result frame_weights(const mk_asset *asset, int32_t clip, float time, float *weights, mk_error *err)
+{
+    for (uint32_t c = 0; c < asset->channel_count; c++) {
+        mk_channel_info info;
+        mk_channel_get(asset, c, &info);
+        weights[c] = info.default_weight;
+    }
+    if (clip < 0) return MK_OK;
+    mk_sample_job job = { .asset = asset, .clip = (uint32_t)clip, .time = time, .weights = weights,
+                          .weight_count = asset->channel_count };
+    return mk_sample_run(&job, err);
+}
+
+mk_result frame_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
+                          mk_normal_mode normals_mode, float *positions, float *normals, mk_error *err)
+{
+    mk_mesh_info m;
+    if (!mk_mesh_get(asset, mesh, &m)) {
+        err->code = MK_ERROR_OUT_OF_RANGE;
+        return MK_ERROR_OUT_OF_RANGE;
+    }
+    size_t scratch_size = mk_eval_scratch_size(asset, mesh);
+    void *scratch = aligned_alloc(16, (scratch_size + 15) & ~(size_t)15);
+    if (!scratch) return MK_ERROR_OUT_OF_MEMORY;
+    mk_eval_job job = {
+        .asset = asset, .mesh = mesh, .weights = weights + m.first_channel, .weight_count = m.channel_count,
+        .stacking = stacking, .normal_mode = normals_mode, .scratch = scratch, .scratch_size = scratch_size,
+        .positions = positions, .positions_size = (size_t)m.vertex_count * 12,
+        .normals = m.has_normals ? normals : NULL, .normals_size = (size_t)m.vertex_count * 12,
+    };
+    mk_result r = mk_eval_run(&job, err);
+    free(scratch);
+    return r;
+}
+
+void frame_to_world(const float w[16], float *positions, float *normals, uint32_t count)
+{
+    /* Column-major: x' = w[0] x + w[4] y + w[8] z + w[12]. */
+    double a = w[0], b = w[4], c = w[8], d = w[1], e = w[5], f = w[9], g = w[2], h = w[6], i = w[10];
+    double det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
+    /* Cofactor matrix = det * (M^-1)^T: normals only need its direction. */
+    double cof[9] = { e * i - f * h, -(d * i - f * g), d * h - e * g,
+                      -(b * i - c * h), a * i - c * g, -(a * h - b * g),
+                      b * f - c * e, -(a * f - c * d), a * e - b * d };
+    double sign = det < 0 ? -1.0 : 1.0;
+    for (uint32_t v = 0; v < count; v++) {
+        float *p = &positions[3u * v];
+        double x = p[0], y = p[1], z = p[2];
+        p[0] = (float)(w[0] * x + w[4] * y + w[8] * z + w[12]);
+        p[1] = (float)(w[1] * x + w[5] * y + w[9] * z + w[13]);
+        p[2] = (float)(w[2] * x + w[6] * y + w[10] * z + w[14]);
+        if (!normals) continue;
+        float *n = &normals[3u * v];
+        double nx = n[0], ny = n[1], nz = n[2];
+        double ox = sign * (cof[0] * nx + cof[1] * ny + cof[2] * nz);
+        double oy = sign * (cof[3] * nx + cof[4] * ny + cof[5] * nz);
+        double oz = sign * (cof[6] * nx + cof[7] * ny + cof[8] * nz);
+        double len = sqrt(ox * ox + oy * oy + oz * oz);
+        if (len > 0) { n[0] = (float)(ox / len); n[1] = (float)(oy / len); n[2] = (float)(oz / len); }
+    }
+}

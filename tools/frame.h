@@ -1,0 +1,18 @@
+/* One evaluated frame of an asset, shared by play, conform and bench. */
+#ifndef MK_FRAME_H
+#define MK_FRAME_H
+
+#include "morphkit.h"
+
+/* weights (asset channel count) = channel defaults, then the clip sampled at time if clip >= 0. */
+mk_result frame_weights(const mk_asset *asset, int32_t clip, float time, float *weights, mk_error *err);
+
+/* Evaluates mesh positions (and normals if non-NULL and the mesh has them) for asset-wide
+ * weights. stacking 0 = the blob's. Scratch is allocated here (tools may allocate). */
+mk_result frame_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
+                          mk_normal_mode normals_mode, float *positions, float *normals, mk_error *err);
+
+/* In place: p = W p (points), n = normalize((W^-1)^T n). */
+void frame_to_world(const float world[16], float *positions, float *normals, uint32_t count);
+
+#endif
