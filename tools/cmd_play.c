@@ -197,7 +197,8 @@ int cmd_play(int argc, char **argv)
         free(text);
         if (r) { status = cli_fail("play", &err); goto done; }
     }
-    printf("%s: %s%s frame with %u meshes written to %s\n", in, clip >= 0 ? "clip " : "rest pose", "", a->mesh_count, out);
+    printf("%s: %s frame of %u mesh%s written to %s\n", in, clip >= 0 ? "animated" : "rest-pose", a->mesh_count,
+           a->mesh_count == 1 ? "" : "es", out);
     if (clip >= 0) {
         mk_clip_info ci;
         mk_clip_get(a, (uint32_t)clip, &ci);

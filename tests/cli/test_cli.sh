@@ -1,0 +1,53 @@
+#!/bin/sh
+# The CLI end to end on the generated example: info (text and JSON), play (JSON, OBJ,
+# weights, stacking, normals, spaces), import errors, usage errors, atomic outputs.
+# usage: test_cli.sh MORPHKIT MAKE_EXAMPLE
+mk="$1"; make_example="$2"
+dir=$(mktemp -d); trap 'rm -rf "$dir"' EXIT
+passed=0; failed=0
+ok() { passed=$((passed+1)); echo "ok   $1"; }
+bad() { failed=$((failed+1)); echo "FAIL $1"; }
+check() { name="$1"; shift; if "$@" >"$dir/out" 2>&1; then ok "$name"; else bad "$name"; cat "$dir/out"; fi; }
+check_fails() { name="$1"; code="$2"; shift 2; "$@" >"$dir/out" 2>&1; rc=$?
+  if [ "$rc" -eq "$code" ]; then ok "$name"; else bad "$name (exit $rc, expected $code)"; cat "$dir/out"; fi; }
+
+check "make example" "$make_example" "$dir/ex.morph"
+check "info text" sh -c "'$mk' info '$dir/ex.morph' | grep -q \"channel 1 'bend': default 0, 4 targets (progressive)\""
+check "info json parses" sh -c "'$mk' info '$dir/ex.morph' --json | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d[\"meshes\"][0][\"channels\"][1][\"targets\"][3][\"full_weight\"] == 1'"
+check "play json" "$mk" play "$dir/ex.morph" --clip wave --time 1 -o "$dir/f.json"
+check "play json shape" python3 -c "
+import json; d = json.load(open('$dir/f.json'))
+m = d['meshes'][0]
+assert m['name'] == 'tube' and len(m['positions']) == 3 * 800 and len(m['normals']) == 3 * 800
+assert abs(m['channels'][0]['weight'] - 1) < 1e-6 and abs(m['channels'][1]['weight'] - 0.5) < 1e-6"
+check "play obj" sh -c "'$mk' play '$dir/ex.morph' --time 0.5 -o '$dir/f.obj' && grep -c '^v ' '$dir/f.obj' | grep -qx 800 && grep -c '^f ' '$dir/f.obj' | grep -qx 1536"
+check "play weights by name" "$mk" play "$dir/ex.morph" --weights bend=1,bulge=0.25 --stacking sequential --normals slerp --space local -o "$dir/w.json"
+check "weights applied" python3 -c "
+import json; d = json.load(open('$dir/w.json'))
+w = {c['name']: c['weight'] for c in d['meshes'][0]['channels']}
+assert w == {'bulge': 0.25, 'bend': 1.0}, w"
+check "rest pose equals base" python3 -c "
+import json, subprocess
+subprocess.run(['$mk', 'play', '$dir/ex.morph', '--weights', 'bend=0,bulge=0', '--space', 'local', '-o', '$dir/r.json'], check=True)
+p = json.load(open('$dir/r.json'))['meshes'][0]['positions']
+assert abs(p[0] - 0.5) < 1e-6 and abs(p[1]) < 1e-6"
+check_fails "unknown verb" 2 "$mk" frobnicate
+check_fails "play without output" 2 "$mk" play "$dir/ex.morph"
+check_fails "unknown channel" 2 "$mk" play "$dir/ex.morph" --weights nope=1 -o "$dir/x.json"
+check_fails "unknown clip" 2 "$mk" play "$dir/ex.morph" --clip nope -o "$dir/x.json"
+check "no output file after a failure" test ! -e "$dir/x.json"
+printf 'not a morph file at all' > "$dir/junk.morph"
+check_fails "info on junk" 1 "$mk" info "$dir/junk.morph"
+head -c 200 "$dir/ex.morph" > "$dir/trunc.morph"
+check_fails "info on truncated blob" 1 "$mk" info "$dir/trunc.morph"
+cp "$dir/out" "$dir/trunc.out"
+check "truncation message names it" grep -q "shorter than the header's file size" "$dir/trunc.out"
+check_fails "import of a missing file" 1 "$mk" import "$dir/missing.fbx" -o "$dir/y.morph"
+check "no output after failed import" test ! -e "$dir/y.morph"
+check "import of a .morph rewrites it" "$mk" import "$dir/ex.morph" -o "$dir/re.morph" --precision float
+check "rewritten file opens" "$mk" info "$dir/re.morph"
+check "no temporary files left" sh -c "! ls '$dir' | grep -q '\.tmp\.'"
+check "bench runs (small)" sh -c "'$mk' bench --vertices 5000 --channels 10 --active 3 --frames 5 --json | python3 -c 'import json,sys; d=json.load(sys.stdin); assert set(d) == {\"ns_per_frame\",\"ns_per_frame_positions\",\"bytes_per_frame\",\"bound_ns\",\"ratio_to_bound\",\"naive_ns\",\"speedup_vs_naive\",\"sequential_over_additive\"}'"
+check "bench on a file" "$mk" bench "$dir/ex.morph" --frames 10
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]

@@ -1,0 +1,147 @@
+/* Target normals computed from target positions: they equal normals computed from scratch
+ * on the deformed mesh (property), UV-seam duplicates smooth together, hard edges stay hard,
+ * and tangents stay orthogonal to the new normals. */
+#include <stdlib.h>
+#include "check.h"
+#include "fixtures.h"
+
+/* Brute force: per control point, normalized sum of area-weighted normals of every
+ * triangle touching it (positions given per render vertex). */
+static void reference_normal(const mk_raw_mesh *m, const float *pos, uint32_t cp, float out[3])
+{
+    double s[3] = { 0, 0, 0 };
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *tri = &m->triangles[3 * t];
+        int touches = 0;
+        for (int c = 0; c < 3; c++) touches |= m->control_points[tri[c]] == cp;
+        if (!touches) continue;
+        const float *a = &pos[3 * tri[0]], *b = &pos[3 * tri[1]], *c = &pos[3 * tri[2]];
+        double e1[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] }, e2[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+        s[0] += e1[1] * e2[2] - e1[2] * e2[1];
+        s[1] += e1[2] * e2[0] - e1[0] * e2[2];
+        s[2] += e1[0] * e2[1] - e1[1] * e2[0];
+    }
+    double l = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    for (int d = 0; d < 3; d++) out[d] = (float)(s[d] / l);
+}
+
+/* A flat 5x5 grid (normals +z, tangents +x) whose centre control point is duplicated for a
+ * UV seam: vertex 25 is control point 12 and the triangles right of the centre use it. */
+static void grid_with_seam(mk_raw_asset *raw)
+{
+    mk_raw_mesh *m = mk_raw_add_meshes(raw, 1);
+    m->name = "grid";
+    m->vertex_count = 26;
+    m->control_point_count = 25;
+    m->positions = mk_arena_array(&raw->arena, 78, sizeof(float));
+    m->normals = mk_arena_array(&raw->arena, 78, sizeof(float));
+    m->tangents = mk_arena_array(&raw->arena, 104, sizeof(float));
+    m->control_points = mk_arena_array(&raw->arena, 26, sizeof(uint32_t));
+    m->triangles = mk_arena_array(&raw->arena, 32 * 3, sizeof(uint32_t));
+    for (uint32_t v = 0; v < 26; v++) {
+        uint32_t cp = v < 25 ? v : 12;
+        m->control_points[v] = cp;
+        m->positions[3 * v] = (float)(cp % 5);
+        m->positions[3 * v + 1] = (float)(cp / 5);
+        m->normals[3 * v + 2] = 1;
+        m->tangents[4 * v] = 1;
+        m->tangents[4 * v + 3] = 1;
+    }
+    uint32_t t = 0;
+    for (uint32_t y = 0; y < 4; y++)
+        for (uint32_t x = 0; x < 4; x++) {
+            uint32_t q[4] = { y * 5 + x, y * 5 + x + 1, (y + 1) * 5 + x, (y + 1) * 5 + x + 1 };
+            if (x >= 2) for (int k = 0; k < 4; k++) if (q[k] == 12) q[k] = 25;
+            uint32_t *tri = &m->triangles[6 * t++];
+            tri[0] = q[0]; tri[1] = q[1]; tri[2] = q[3]; tri[3] = q[0]; tri[4] = q[3]; tri[5] = q[2];
+        }
+    m->triangle_count = 32;
+    mk_raw_channel *ch = mk_raw_add_channels(raw, 1);
+    ch->name = "bump";
+    mk_raw_target *tg = mk_raw_add_targets(raw, ch, 1);
+    tg->name = "bump";
+    tg->count = 3;
+    tg->indices = mk_arena_array(&raw->arena, 3, sizeof(uint32_t));
+    tg->positions = mk_arena_array(&raw->arena, 9, sizeof(float));
+    tg->indices[0] = 7; tg->indices[1] = 12; tg->indices[2] = 25;  /* both seam copies move together */
+    tg->positions[2] = 0.3f; tg->positions[5] = 0.8f; tg->positions[8] = 0.8f;
+}
+
+static void test_matches_recomputed_normals(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    grid_with_seam(&raw);
+    mk_error err;
+    CHECK(mk_raw_compute_target_normals(&raw, 0, 0, &err) == MK_OK);
+    const mk_raw_mesh *m = &raw.meshes[0];
+    const mk_raw_target *t = &raw.channels[0].targets[0];
+    CHECK(t->normals != NULL && t->tangents != NULL);
+    CHECK(t->count > 3);                         /* neighbours joined the index set */
+    float deformed[78];
+    memcpy(deformed, m->positions, sizeof deformed);
+    for (uint32_t j = 0; j < t->count; j++)
+        for (int d = 0; d < 3; d++) deformed[3 * t->indices[j] + (uint32_t)d] += t->positions[3 * j + (uint32_t)d];
+    double worst = 0, ortho = 0;
+    for (uint32_t j = 0; j < t->count; j++) {
+        uint32_t v = t->indices[j];
+        float n[3], ref[3];
+        for (int d = 0; d < 3; d++) n[d] = m->normals[3 * v + (uint32_t)d] + t->normals[3 * j + (uint32_t)d];
+        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        reference_normal(m, deformed, m->control_points[v], ref);
+        for (int d = 0; d < 3; d++) worst = fmax(worst, fabs(n[d] / l - ref[d]));
+        float tn[3];
+        for (int d = 0; d < 3; d++) tn[d] = m->tangents[4 * v + (uint32_t)d] + t->tangents[3 * j + (uint32_t)d];
+        ortho = fmax(ortho, fabs(tn[0] * ref[0] + tn[1] * ref[1] + tn[2] * ref[2]));
+    }
+    CHECK_MSG(worst < 1e-6, "normal differs from the recomputed one by %g", worst);
+    CHECK_MSG(ortho < 1e-6, "tangent not orthogonal to the new normal (%g)", ortho);
+    /* The seam copies (vertices 12 and 25) got the same normal delta. */
+    const float *d12 = NULL, *d25 = NULL;
+    for (uint32_t j = 0; j < t->count; j++) {
+        if (t->indices[j] == 12) d12 = &t->normals[3 * j];
+        if (t->indices[j] == 25) d25 = &t->normals[3 * j];
+    }
+    CHECK(d12 && d25 && !memcmp(d12, d25, 12));
+    mk_raw_free(&raw);
+}
+
+/* An L of two quads meeting at a right angle with a hard edge: the shared edge's control
+ * points have one vertex per face (different normals). Moving a far vertex of the floor
+ * must not change the wall's normals. */
+static void test_hard_edge_stays_hard(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_raw_mesh *m = mk_raw_add_meshes(&raw, 1);
+    static float pos[] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0,    /* floor (z = 0), v2 v3 on the edge */
+                           0, 1, 0, 1, 1, 0, 0, 1, 1, 1, 1, 1 };  /* wall (y = 1), v4 v5 on the edge */
+    static float nrm[] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, -1, 0, 0, -1, 0, 0, -1, 0, 0, -1, 0 };
+    static uint32_t cps[] = { 0, 1, 2, 3, 2, 3, 4, 5 };
+    static uint32_t tris[] = { 0, 1, 3, 0, 3, 2, 4, 5, 7, 4, 7, 6 };
+    m->name = "L";
+    m->vertex_count = 8;
+    m->control_point_count = 6;
+    m->positions = pos;
+    m->normals = nrm;
+    m->control_points = cps;
+    m->triangles = tris;
+    m->triangle_count = 4;
+    mk_raw_channel *ch = mk_raw_add_channels(&raw, 1);
+    ch->name = "lift";
+    mk_raw_target *t = mk_raw_add_targets(&raw, ch, 1);
+    static uint32_t idx[] = { 0 };
+    static float d[] = { 0, 0, 0.5f };
+    t->name = "lift"; t->count = 1; t->indices = idx; t->positions = d;
+    mk_error err;
+    CHECK(mk_raw_compute_target_normals(&raw, 0, 0, &err) == MK_OK);
+    t = &raw.channels[0].targets[0];
+    for (uint32_t j = 0; j < t->count; j++) {
+        double len = fabs(t->normals[3 * j]) + fabs(t->normals[3 * j + 1]) + fabs(t->normals[3 * j + 2]);
+        if (t->indices[j] >= 4) CHECK_MSG(len == 0, "wall vertex %u changed normal", t->indices[j]);
+        if (t->indices[j] == 2 || t->indices[j] == 3) CHECK_MSG(len > 0.01, "floor edge vertex %u did not change", t->indices[j]);
+    }
+    mk_raw_free(&raw);
+}
+
+CHECK_MAIN(CASE(test_matches_recomputed_normals), CASE(test_hard_edge_stays_hard))

@@ -1,0 +1,204 @@
+/* Offline core: deterministic writer, raw -> blob -> raw round trip, quantization within the
+ * tolerance (with float fallback), raw validation errors, failing allocation K for every K,
+ * atomic file writes. */
+
+#include <stdlib.h>
+#include <unistd.h>
+#include "check.h"
+#include "fixtures.h"
+
+static void test_deterministic(void)
+{
+    for (int p = 0; p < 2; p++) {
+        mk_raw_asset a, b;
+        mk_raw_init(&a, NULL);
+        mk_raw_init(&b, NULL);
+        fixture_line(&a, 700, 9, 2);
+        fixture_line(&b, 700, 9, 2);
+        size_t sa, sb;
+        void *ba = fixture_blob(&a, (mk_precision)p, &a.arena, &sa);
+        void *bb = fixture_blob(&b, (mk_precision)p, &b.arena, &sb);
+        CHECK(sa == sb && memcmp(ba, bb, sa) == 0);
+        mk_raw_free(&a);
+        mk_raw_free(&b);
+    }
+}
+
+static void test_round_trip_float(void)
+{
+    mk_raw_asset raw, back;
+    mk_raw_init(&raw, NULL);
+    mk_raw_init(&back, NULL);
+    fixture_basic(&raw);
+    size_t size, size2;
+    void *blob = fixture_blob(&raw, MK_PRECISION_FLOAT, &raw.arena, &size);
+    mk_asset a;
+    mk_error err;
+    CHECK(mk_asset_open(blob, size, &a, &err) == MK_OK);
+    CHECK(mk_read_blob(&a, &back, &err) == MK_OK);
+    CHECK_EQ_INT(back.mesh_count, 2);
+    CHECK_EQ_INT(back.channel_count, 5);
+    CHECK(!strcmp(back.channels[1].name, "negative"));
+    CHECK_NEAR(back.channels[1].targets[0].full_weight, -1, 0);
+    CHECK_EQ_INT(back.channels[4].targets[0].count, 3);
+    CHECK_EQ_INT(back.clips[0].tracks[0].key_count, 2);
+    /* Writing the read-back model again gives the same bytes. */
+    void *blob2 = fixture_blob(&back, MK_PRECISION_FLOAT, &back.arena, &size2);
+    CHECK(size == size2 && memcmp(blob, blob2, size) == 0);
+    mk_raw_free(&raw);
+    mk_raw_free(&back);
+}
+
+static void test_quantization_tolerance(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_line(&raw, 300, 4, 1);
+    /* One target with a huge range next to tiny deltas: int16 error = range / 65534. */
+    raw.channels[3].targets[0].positions[1] = 1000.0f;
+    mk_write_options o = { .precision = MK_PRECISION_Q16, .tolerance = 0.001f };
+    void *blob;
+    size_t size;
+    mk_write_report rep;
+    mk_error err;
+    CHECK(mk_write_blob(&raw, &o, &raw.arena, &blob, &size, &rep, &err) == MK_OK);
+    CHECK_EQ_INT(rep.float_targets, 1);        /* 1000 / 65534 > 0.001: stored as float */
+    CHECK_EQ_INT(rep.quantized_targets, 3);
+    CHECK(rep.max_position_error <= 0.001);
+    /* Read back: every delta within the reported error. */
+    mk_asset a;
+    mk_raw_asset back;
+    mk_raw_init(&back, NULL);
+    CHECK(mk_asset_open(blob, size, &a, &err) == MK_OK);
+    CHECK(mk_read_blob(&a, &back, &err) == MK_OK);
+    double worst = 0;
+    for (uint32_t c = 0; c < raw.channel_count; c++) {
+        const mk_raw_target *t = &raw.channels[c].targets[0], *u = &back.channels[c].targets[0];
+        /* Read-back drops vertices whose quantized delta is all zero; match by index. */
+        uint32_t k = 0;
+        for (uint32_t j = 0; j < t->count; j++) {
+            while (k < u->count && u->indices[k] < t->indices[j]) k++;
+            for (int d = 0; d < 3; d++) {
+                double got = (k < u->count && u->indices[k] == t->indices[j]) ? u->positions[3 * k + (uint32_t)d] : 0;
+                double e = fabs(got - t->positions[3 * j + (uint32_t)d]);
+                worst = e > worst ? e : worst;
+            }
+        }
+    }
+    CHECK_MSG(worst <= rep.max_position_error + 1e-9, "worst %g > reported %g", worst, rep.max_position_error);
+    mk_raw_free(&back);
+    mk_raw_free(&raw);
+}
+
+static void test_validation_names_the_element(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_basic(&raw);
+    mk_error err;
+    CHECK(mk_raw_validate(&raw, &err) == MK_OK);
+    raw.channels[0].targets[1].full_weight = 0.5f;          /* equal to the in-between */
+    CHECK(mk_raw_validate(&raw, &err) == MK_ERROR_CORRUPT);
+    CHECK(strstr(err.message, "channel 0 'progressive' target 1") != NULL);
+    raw.channels[0].targets[1].full_weight = 1.0f;
+    raw.channels[4].targets[0].indices[2] = 7;
+    CHECK(mk_raw_validate(&raw, &err) == MK_ERROR_CORRUPT);
+    CHECK(strstr(err.message, "index 7") != NULL);
+    raw.channels[4].targets[0].indices[2] = 2;
+    raw.meshes[0].positions[5] = NAN;
+    CHECK(mk_raw_validate(&raw, &err) == MK_ERROR_NOT_FINITE);
+    raw.meshes[0].positions[5] = 0;
+    raw.clips[0].tracks[0].keys[1].time = 0;
+    CHECK(mk_raw_validate(&raw, &err) == MK_ERROR_CORRUPT);
+    CHECK(strstr(err.message, "clip 0 track 0 key 1") != NULL);
+    /* The writer refuses what validation refuses, and writes nothing. */
+    void *blob = NULL;
+    size_t size = 0;
+    CHECK(mk_write_blob(&raw, NULL, &raw.arena, &blob, &size, NULL, &err) == MK_ERROR_CORRUPT);
+    CHECK(blob == NULL);
+    mk_raw_free(&raw);
+}
+
+static void test_group_channels(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_basic(&raw);
+    /* Swap channel 0 (mesh 0) and 4 (mesh 1): the track of channel 4 must follow it. */
+    mk_raw_channel tmp = raw.channels[0];
+    raw.channels[0] = raw.channels[4];
+    raw.channels[4] = tmp;
+    raw.clips[0].tracks[0].channel = 4;
+    raw.clips[0].tracks[1].channel = 0;
+    mk_error err;
+    CHECK(mk_raw_group_channels(&raw, &err) == MK_OK);
+    CHECK(!strcmp(raw.channels[4].name, "lift"));
+    CHECK(!strcmp(raw.channels[3].name, "progressive"));
+    CHECK_EQ_INT(raw.clips[0].tracks[0].channel, 3);
+    CHECK_EQ_INT(raw.clips[0].tracks[1].channel, 4);
+    CHECK(mk_raw_validate(&raw, &err) == MK_OK);
+    mk_raw_free(&raw);
+}
+
+/* Fail allocation K for every K: each failure is a clean MK_ERROR_OUT_OF_MEMORY, and all
+ * memory is returned (the arena counts live bytes; LeakSanitizer checks under ASan). */
+static void test_fail_allocation_k(void)
+{
+    mk_raw_asset src;
+    mk_raw_init(&src, NULL);
+    fixture_basic(&src);
+    size_t size;
+    void *blob = fixture_blob(&src, MK_PRECISION_Q16, &src.arena, &size);
+    mk_asset a;
+    mk_error err;
+    CHECK(mk_asset_open(blob, size, &a, &err) == MK_OK);
+    int succeeded = 0, failures = 0;
+    for (uint64_t k = 1; k < 10000 && !succeeded; k++) {
+        mk_allocator al = { .fail_after = k };
+        mk_raw_asset raw;
+        mk_raw_init(&raw, &al);
+        mk_result r = mk_read_blob(&a, &raw, &err);
+        void *out = NULL;
+        size_t out_size;
+        if (r == MK_OK) r = mk_raw_compute_target_normals(&raw, 0, 1, &err);
+        if (r == MK_OK) r = mk_write_blob(&raw, NULL, &raw.arena, &out, &out_size, NULL, &err);
+        if (r == MK_OK) succeeded = 1;
+        else {
+            failures++;
+            CHECK_MSG(r == MK_ERROR_OUT_OF_MEMORY, "K=%llu: %s", (unsigned long long)k, err.message);
+        }
+        mk_raw_free(&raw);
+        CHECK_EQ_INT(raw.arena.bytes_live, 0);
+    }
+    CHECK(succeeded);
+    printf("  %d allocation failures injected, all clean\n", failures);
+    mk_raw_free(&src);
+}
+
+static void test_atomic_write(void)
+{
+    char dir[] = "/tmp/mk_atomic_XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char path[256], bad[256];
+    snprintf(path, sizeof path, "%s/out.morph", dir);
+    snprintf(bad, sizeof bad, "%s/missing/out.morph", dir);
+    mk_error err;
+    CHECK(mk_write_file_atomic(path, "abc", 3, &err) == MK_OK);
+    CHECK(mk_write_file_atomic(path, "defg", 4, &err) == MK_OK);
+    size_t n;
+    unsigned char *got = check_read_file(path, &n);
+    CHECK(got && n == 4 && !memcmp(got, "defg", 4));
+    free(got);
+    CHECK(mk_write_file_atomic(bad, "x", 1, &err) == MK_ERROR_IO);
+    CHECK(strstr(err.message, "missing") != NULL);
+    /* No temporary file left behind. */
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, "test $(ls -A %s | wc -l) -eq 1", dir);
+    CHECK(system(cmd) == 0);
+    remove(path);
+    rmdir(dir);
+}
+
+CHECK_MAIN(CASE(test_deterministic), CASE(test_round_trip_float), CASE(test_quantization_tolerance),
+           CASE(test_validation_names_the_element), CASE(test_group_channels), CASE(test_fail_allocation_k),
+           CASE(test_atomic_write))
