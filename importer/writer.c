@@ -187,8 +187,15 @@ static mk_result write_mesh_data(const mk_raw_asset *raw, uint32_t mi, uint32_t 
     uint32_t *cursor = mk_arena_array(arena, target_count + 1, sizeof *cursor);
     uint32_t blocks = (m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
     uint32_t *block_first = mk_arena_array(arena, (size_t)blocks + 1, sizeof *block_first);
-    bytes entries = { arena, NULL, 0, 0, 0 }, deltas = { arena, NULL, 0, 0, 0 };
-    if (!targets || !cursor || !block_first) return mk_error_oom(err, "planning blocks");
+    /* Delta data is laid out target-major (all blocks of target 0, then target 1, ...) while
+     * the entries stay block-major: a frame then reads each active target as one sequential
+     * stream, which the hardware prefetcher and the TLB handle well, and never touches the
+     * pages of inactive targets. Each target's data goes to its own buffer first; entry data
+     * offsets are rebased once the buffers are concatenated. */
+    bytes *per_target = mk_arena_array(arena, target_count + 1, sizeof *per_target);
+    bytes entries = { arena, NULL, 0, 0, 0 }, offsets = { arena, NULL, 0, 0, 0 }; /* offsets: per entry, in its target's buffer */
+    if (!targets || !cursor || !block_first || !per_target) return mk_error_oom(err, "planning blocks");
+    for (uint32_t t = 0; t < target_count; t++) per_target[t].arena = arena;
     uint32_t k = 0;
     for (uint32_t c = first_channel; c < first_channel + channel_count; c++)
         for (uint32_t j = 0; j < raw->channels[c].target_count; j++) targets[k++] = &raw->channels[c].targets[j];
@@ -212,34 +219,55 @@ static mk_result write_mesh_data(const mk_raw_asset *raw, uint32_t mi, uint32_t 
             const target_plan *p = &plans[t];
             int q = (p->flags & MK_TARGET_QUANTIZED) != 0;
             size_t size = (size_t)mk_entry_data_size(p->flags, count);
-            size_t at = bytes_put(&deltas, NULL, size);
-            if (deltas.failed) return mk_error_oom(err, "writing target data");
-            if (at / MK_ALIGN > UINT32_MAX)
-                return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: target data exceeds 64 GiB", mi);
+            bytes *dst_buf = &per_target[t];
+            size_t at = bytes_put(dst_buf, NULL, size);
+            if (dst_buf->failed) return mk_error_oom(err, "writing target data");
             size_t attr = size / (1u + (tg->normals ? 1u : 0u) + (tg->tangents ? 1u : 0u));
-            uint8_t *dst = deltas.data + at;
+            uint8_t *dst = dst_buf->data + at;
             put_component_arrays(dst, tg, tg->positions, first, mask, b, count, q, p->position_scale);
             if (tg->normals) put_component_arrays(dst += attr, tg, tg->normals, first, mask, b, count, q, p->normal_scale);
             if (tg->tangents) put_component_arrays(dst + attr, tg, tg->tangents, first, mask, b, count, q, p->tangent_scale);
-            mk_blob_entry e = { t, (uint32_t)(at / MK_ALIGN), mask };
+            /* data is filled in once the target buffers are concatenated (below). */
+            mk_blob_entry e = { t, 0, mask };
             size_t e_at = entries.size;
-            if (!bytes_reserve(&entries, sizeof e)) return mk_error_oom(err, "writing entries");
+            uint64_t local = at;
+            if (!bytes_reserve(&entries, sizeof e) || !bytes_reserve(&offsets, sizeof local))
+                return mk_error_oom(err, "writing entries");
             memcpy(entries.data + e_at, &e, sizeof e);
             entries.size += sizeof e;
+            memcpy(offsets.data + offsets.size, &local, sizeof local);
+            offsets.size += sizeof local;
             if (++entry_count > UINT32_MAX)
                 return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: more than 2^32 block entries", mi);
         }
     }
     block_first[blocks] = (uint32_t)entry_count;
+    /* Concatenate the per-target buffers and rebase the entries. */
+    uint64_t *base = mk_arena_array(arena, target_count + 1, sizeof *base);
+    if (!base) return mk_error_oom(err, "writing target data");
+    uint64_t total = 0;
+    for (uint32_t t = 0; t < target_count; t++) { base[t] = total; total += pad16(per_target[t].size); }
+    if (total / MK_ALIGN > UINT32_MAX)
+        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: target data exceeds 64 GiB", mi);
+    mk_blob_entry *all_entries = (mk_blob_entry *)(void *)entries.data;
+    const uint64_t *local_offsets = (const uint64_t *)(void *)offsets.data;
+    for (uint64_t e = 0; e < entry_count; e++)
+        all_entries[e].data = (uint32_t)((base[all_entries[e].target] + local_offsets[e]) / MK_ALIGN);
     out->block_entries = bytes_put(data, block_first, 4u * ((size_t)blocks + 1));
     out->entries = bytes_put(data, entries.data, entries.size);
     out->entry_count = entry_count;
-    out->target_data = bytes_put(data, deltas.data, deltas.size);
-    out->target_data_size = deltas.size;
+    out->target_data = bytes_put(data, NULL, (size_t)total);
+    out->target_data_size = total;
     if (data->failed) return mk_error_oom(err, "writing block data");
-    report->target_bytes += entries.size + deltas.size;
+    for (uint32_t t = 0; t < target_count; t++) {
+        if (per_target[t].size) memcpy(data->data + out->target_data + base[t], per_target[t].data, per_target[t].size);
+        mk_arena_release(arena, per_target[t].data);
+    }
+    report->target_bytes += entries.size + total;
     mk_arena_release(arena, entries.data);
-    mk_arena_release(arena, deltas.data);
+    mk_arena_release(arena, offsets.data);
+    mk_arena_release(arena, per_target);
+    mk_arena_release(arena, base);
     mk_arena_release(arena, targets);
     mk_arena_release(arena, cursor);
     mk_arena_release(arena, block_first);

@@ -20,6 +20,7 @@
 
 typedef struct bench_options {
     uint32_t vertices, channels, active, threads, frames;
+    uint32_t profile;          /* --profile N: only N evaluation frames (for perf/callgrind) */
     double density;
     int json;
 } bench_options;
@@ -346,7 +347,7 @@ static int usage(void)
 
 int cmd_bench(int argc, char **argv)
 {
-    bench_options o = { 1000000, 100, 30, 1, 100, 0.10, 0 };
+    bench_options o = { 1000000, 100, 30, 1, 100, 0, 0.10, 0 };
     const char *file = NULL;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -356,6 +357,7 @@ int cmd_bench(int argc, char **argv)
         else if (!strcmp(a, "--density") && v) { o.density = atof(v); i++; }
         else if (!strcmp(a, "--threads") && v) { o.threads = (uint32_t)strtoul(v, NULL, 10); i++; }
         else if (!strcmp(a, "--frames") && v) { o.frames = (uint32_t)strtoul(v, NULL, 10); i++; }
+        else if (!strcmp(a, "--profile") && v) { o.profile = (uint32_t)strtoul(v, NULL, 10); i++; }
         else if (!strcmp(a, "--json")) o.json = 1;
         else if (!strcmp(a, "--help")) { usage(); return 0; }
         else if (a[0] != '-' && !file) file = a;
@@ -429,6 +431,12 @@ int cmd_bench(int argc, char **argv)
             workers[t].index = t;
             pthread_create(&threads[t], NULL, worker_main, &workers[t]);
         }
+    }
+    if (o.profile) {
+        /* Profiling mode: nothing but evaluation (positions + normals), for perf/callgrind. */
+        for (uint32_t k = 0; k < o.profile; k++) time_frames(&ctx, weights, frames, MK_STACKING_ADDITIVE, 1);
+        printf("profiled %u x %u frames\n", o.profile, frames);
+        return 0;
     }
     /* Warm up once, then measure. */
     time_frames(&ctx, weights, frames < 5 ? frames : 5, MK_STACKING_ADDITIVE, 1);
