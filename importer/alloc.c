@@ -37,8 +37,8 @@ static void raw_free(mk_arena *arena, void *ptr)
 void *mk_arena_alloc(mk_arena *arena, size_t size)
 {
     if (size > SIZE_MAX - sizeof(mk_arena_block) - 16) { arena->failed = 1; return NULL; }
-    if (arena->allocator.memory_limit && size > arena->allocator.memory_limit - arena->bytes_live
-        && arena->bytes_live <= arena->allocator.memory_limit) {
+    /* bytes_live never exceeds the limit, so the subtraction cannot wrap. */
+    if (arena->allocator.memory_limit && size > arena->allocator.memory_limit - arena->bytes_live) {
         arena->failed = 1;
         return NULL;
     }

@@ -175,6 +175,30 @@ static void test_fail_allocation_k(void)
     mk_raw_free(&src);
 }
 
+/* The memory limit of the allocator is honoured: a writer that would need more than the
+ * limit fails with out-of-memory, and a generous limit succeeds. */
+static void test_memory_limit(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_line(&raw, 5000, 8, 1);
+    mk_allocator tight = { .memory_limit = 64 * 1024 };
+    mk_arena arena;
+    mk_arena_init(&arena, &tight);
+    void *blob;
+    size_t size;
+    mk_error err;
+    CHECK(mk_write_blob(&raw, NULL, &arena, &blob, &size, NULL, &err) == MK_ERROR_OUT_OF_MEMORY);
+    CHECK(arena.bytes_peak <= tight.memory_limit);
+    mk_arena_free_all(&arena);
+    mk_allocator roomy = { .memory_limit = 64 * 1024 * 1024 };
+    mk_arena_init(&arena, &roomy);
+    CHECK(mk_write_blob(&raw, NULL, &arena, &blob, &size, NULL, &err) == MK_OK);
+    printf("  peak %zu bytes for a %zu-byte blob\n", arena.bytes_peak, size);
+    mk_arena_free_all(&arena);
+    mk_raw_free(&raw);
+}
+
 static void test_atomic_write(void)
 {
     char dir[] = "/tmp/mk_atomic_XXXXXX";
@@ -201,4 +225,4 @@ static void test_atomic_write(void)
 
 CHECK_MAIN(CASE(test_deterministic), CASE(test_round_trip_float), CASE(test_quantization_tolerance),
            CASE(test_validation_names_the_element), CASE(test_group_channels), CASE(test_fail_allocation_k),
-           CASE(test_atomic_write))
+           CASE(test_memory_limit), CASE(test_atomic_write))
