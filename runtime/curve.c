@@ -43,10 +43,10 @@ static double solve_bezier_parameter(double a, double b, double s)
     return u;
 }
 
-static float segment_value(const mk_key *k0, const mk_key *k1, float time)
+static float segment_value(const mk_key *k0, const mk_key *k1, double time)
 {
     double dt = (double)k1->time - (double)k0->time;
-    double s = ((double)time - (double)k0->time) / dt;
+    double s = (time - (double)k0->time) / dt;
     switch (k0->interp) {
     case MK_INTERP_CONSTANT: return k0->value;
     case MK_INTERP_CONSTANT_NEXT: return s > 0 ? k1->value : k0->value;
@@ -63,7 +63,7 @@ static float segment_value(const mk_key *k0, const mk_key *k1, float time)
 }
 
 /* Index k of the segment with keys[k].time <= time < keys[k+1].time (count >= 2, time inside). */
-static uint32_t find_segment(const mk_key *keys, uint32_t count, float time, uint32_t *cursor)
+static uint32_t find_segment(const mk_key *keys, uint32_t count, double time, uint32_t *cursor)
 {
     if (cursor && *cursor + 1 < count) {
         uint32_t c = *cursor;
@@ -79,7 +79,7 @@ static uint32_t find_segment(const mk_key *keys, uint32_t count, float time, uin
     return lo;
 }
 
-float mk_curve_eval(const mk_key *keys, uint32_t count, float time, uint32_t *cursor)
+float mk_curve_eval(const mk_key *keys, uint32_t count, double time, uint32_t *cursor)
 {
     if (!keys || count == 0) return 0.0f;
     if (!(time > keys[0].time)) return keys[0].value;  /* also NaN-safe */
@@ -122,11 +122,11 @@ mk_result mk_sample_run(const mk_sample_job *job, mk_error *err)
     if (r != MK_OK) return r;
     const mk_asset *a = job->asset;
     const mk_blob_clip *clip = &a->clips[job->clip];
-    float time = job->time;
+    double time = job->time;
     if (job->loop && clip->duration > 0) {
-        double local = fmod((double)time - clip->start, clip->duration);
+        double local = fmod(time - clip->start, clip->duration);
         if (local < 0) local += clip->duration;
-        time = (float)(clip->start + local);
+        time = clip->start + local;
     }
     for (uint32_t c = 0; c < a->channel_count; c++) job->weights[c] = a->channels[c].default_weight;
     for (uint32_t k = 0; k < clip->track_count; k++) {

@@ -211,7 +211,8 @@ mk_result mk_eval_run(const mk_eval_job *job, mk_error *err);
 typedef struct mk_sample_job {
     const mk_asset *asset;
     uint32_t clip;
-    float time;                   /* seconds, in the clip's own time line (keys are absolute) */
+    double time;                  /* seconds on the clip's time line (keys are absolute times); double so
+                                   * long-running clocks and times just before a key stay exact */
     int loop;                     /* nonzero: wrap time into [start, start + duration) */
     float *weights;               /* output: one per asset channel */
     uint32_t weight_count;        /* must be >= the asset's channel count */
@@ -223,7 +224,7 @@ mk_result mk_sample_validate(const mk_sample_job *job, mk_error *err);
 mk_result mk_sample_run(const mk_sample_job *job, mk_error *err);
 
 /* Evaluates one curve at time t (clamped to the first/last key). Exposed for tools and tests. */
-float mk_curve_eval(const mk_key *keys, uint32_t key_count, float time, uint32_t *cursor);
+float mk_curve_eval(const mk_key *keys, uint32_t key_count, double time, uint32_t *cursor);
 
 /* The channel displacement coefficients of DESIGN.md for one channel at weight w: the two
  * targets (indices into the channel's sorted targets, -1 for the implicit zero key) and their

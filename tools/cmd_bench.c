@@ -395,7 +395,7 @@ int cmd_bench(int argc, char **argv)
         float *w = weights + (size_t)f * a->channel_count;
         if (file) {
             mk_clip_info clip;
-            float t = 0;
+            double t = 0;
             if (mk_clip_get(a, 0, &clip)) t = clip.start + clip.duration * (float)f / (float)(frames > 1 ? frames - 1 : 1);
             frame_weights(a, a->clip_count ? 0 : -1, t, w, &err);
         } else {

@@ -205,14 +205,16 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
     if (!weights) { snprintf(res->failure, sizeof res->failure, "out of memory"); return; }
     const cJSON *time = cJSON_GetObjectItem(frame, "time"), *clip = cJSON_GetObjectItem(frame, "clip"),
                 *forced = cJSON_GetObjectItem(frame, "weights");
-    int32_t clip_index = cJSON_IsNumber(clip) ? clip->valueint : cJSON_IsNumber(time) ? 0 : -1;
+    /* glTF frames name their animation ("clip"); without one they show the default weights.
+     * FBX frames with a time are in the file's first animation stack. */
+    int32_t clip_index = cJSON_IsNumber(clip) ? clip->valueint : (!gltf && cJSON_IsNumber(time)) ? 0 : -1;
     mk_error err;
     if (clip_index >= (int32_t)a->clip_count) {
         snprintf(res->failure, sizeof res->failure, "frame needs clip %d, import has %u clips", clip_index, a->clip_count);
         free(weights);
         return;
     }
-    if (frame_weights(a, clip_index, cJSON_IsNumber(time) ? (float)time->valuedouble : 0.0f, weights, &err)) {
+    if (frame_weights(a, clip_index, cJSON_IsNumber(time) ? time->valuedouble : 0.0, weights, &err)) {
         snprintf(res->failure, sizeof res->failure, "sampling failed: %.300s", err.message);
         free(weights);
         return;

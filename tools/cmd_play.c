@@ -48,7 +48,7 @@ static int apply_weights(const mk_asset *a, const char *spec, float *weights)
     return 1;
 }
 
-static void write_json(FILE *f, const mk_asset *a, float **pos, float **nrm, const char *space, float time, int32_t clip,
+static void write_json(FILE *f, const mk_asset *a, float **pos, float **nrm, const char *space, double time, int32_t clip,
                        const float *weights)
 {
     json_writer w;
@@ -116,7 +116,7 @@ static void write_obj(FILE *f, const mk_asset *a, float **pos, float **nrm)
 int cmd_play(int argc, char **argv)
 {
     const char *in = NULL, *out = NULL, *clip_arg = NULL, *weights_arg = NULL, *space = "world";
-    float time = 0;
+    double time = 0;
     int have_time = 0;
     mk_stacking stacking = MK_STACKING_ASSET;
     mk_normal_mode nmode = MK_NORMALS_NLERP;
@@ -126,7 +126,7 @@ int cmd_play(int argc, char **argv)
         else if (!strcmp(a, "--clip") && v) { clip_arg = v; i++; }
         else if (!strcmp(a, "--time") && v) {
             char *end;
-            time = strtof(v, &end);
+            time = strtod(v, &end);
             if (*end) return usage();
             have_time = 1;
             i++;
@@ -202,7 +202,7 @@ int cmd_play(int argc, char **argv)
     if (clip >= 0) {
         mk_clip_info ci;
         mk_clip_get(a, (uint32_t)clip, &ci);
-        printf("clip '%s' at %g s\n", ci.name, (double)time);
+        printf("clip '%s' at %g s\n", ci.name, time);
     }
     for (uint32_t c = 0; c < a->channel_count; c++) {
         mk_channel_info ch;

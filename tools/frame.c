@@ -2,7 +2,7 @@
 #include <stdlib.h>
 #include "frame.h"
 
-mk_result frame_weights(const mk_asset *asset, int32_t clip, float time, float *weights, mk_error *err)
+mk_result frame_weights(const mk_asset *asset, int32_t clip, double time, float *weights, mk_error *err)
 {
     for (uint32_t c = 0; c < asset->channel_count; c++) {
         mk_channel_info info;

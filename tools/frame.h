@@ -5,7 +5,7 @@
 #include "morphkit.h"
 
 /* weights (asset channel count) = channel defaults, then the clip sampled at time if clip >= 0. */
-mk_result frame_weights(const mk_asset *asset, int32_t clip, float time, float *weights, mk_error *err);
+mk_result frame_weights(const mk_asset *asset, int32_t clip, double time, float *weights, mk_error *err);
 
 /* Evaluates mesh positions (and normals if non-NULL and the mesh has them) for asset-wide
  * weights. stacking 0 = the blob's. Scratch is allocated here (tools may allocate). */

@@ -84,6 +84,10 @@ static void test_cursor_matches_search(void)
         same &= mk_curve_eval(k, 50, t, &cursor) == mk_curve_eval(k, 50, t, NULL);
     }
     cursor = 12345;                               /* a garbage cursor is ignored */
+    /* Time is double: an instant just before a step key still gets the previous value. */
+    mk_key st[2] = { key(0, 1, MK_INTERP_CONSTANT), key(3.9f, 2, MK_INTERP_CONSTANT) };
+    CHECK_NEAR(mk_curve_eval(st, 2, (double)3.9f - 1e-7, NULL), 1, 0);
+    CHECK_NEAR(mk_curve_eval(st, 2, (double)3.9f, NULL), 2, 0);
     same &= mk_curve_eval(k, 50, 2.05f, &cursor) == mk_curve_eval(k, 50, 2.05f, NULL);
     CHECK(same);
 }
