@@ -43,6 +43,10 @@ typedef struct mk_bake_options {
     /* Called once per baked channel; may be NULL. */
     void (*channel_done)(void *user, const mk_bake_channel_report *channel);
     void *user;
+    /* Nonzero for recipes from untrusted sources (fuzzing, services): cage OBJ paths are
+     * refused and work is capped (samples <= 200, lattice dims <= 8, ARAP iterations <= 50,
+     * in-betweens <= 32), so a hostile recipe cannot read files or run for hours. */
+    int untrusted;
 } mk_bake_options;
 
 /* Applies a JSON recipe (docs/baking.md) to raw. progress(user, fraction) may be NULL.

@@ -1,0 +1,819 @@
+/* JSON bake recipes (docs/baking.md): parse, validate every field, then bake channel by channel.
+ *
+ * All or nothing: the whole recipe is parsed and checked before any baking starts, and if a
+ * channel fails while baking, the channels added so far are dropped again (raw->channel_count
+ * is restored), so `morphkit bake` writes nothing on any error. Errors name the field by its
+ * JSON path, e.g. "channels[1].handles[0].radius: must be > 0".
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cjson/cJSON.h>
+#include "bake.h"
+#include "bake_util.h"
+#include "barr.h"
+#include "cage_mvc.h"
+#include "ffd.h"
+#include "inbetween.h"
+#include "laplacian.h"
+
+#define PI 3.14159265358979323846
+
+typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP } op_kind;
+
+static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap" };
+
+/* Fields accepted by every op, and per op. */
+static const char *const common_fields[] = { "name", "op", "mesh", "inbetweens", "tolerance",
+                                             "samples", "max_targets", "default_weight", NULL };
+static const char *const op_fields[][12] = {
+    [OP_FFD] = { "dims", "basis", "origin", "axes", "padding", "moves", NULL },
+    [OP_TAPER] = { "axis", "center", "range", "scale", NULL },
+    [OP_TWIST] = { "axis", "center", "range", "angle", NULL },
+    [OP_BEND] = { "axis", "center", "range", "angle", "direction", NULL },
+    [OP_CAGE] = { "cage", "deformed_cage", NULL },
+    [OP_LAPLACIAN] = { "weights", "constraints", "soft_weight", "anchors", "handles", NULL },
+    [OP_ARAP] = { "weights", "constraints", "soft_weight", "anchors", "handles", "iterations", NULL },
+};
+
+/* Everything parsed for one channel before baking. */
+typedef struct channel_plan {
+    op_kind op;
+    char name[128];
+    uint32_t mesh;
+    char *origin;                 /* recipe JSON of the channel (scratch arena) */
+    mk_inbetween_options inbetween;
+    float default_weight;
+    mk_barr barr;
+    mk_ffd_lattice ffd;
+    double *ffd_displacements;
+    mk_cage cage;
+    mk_edit_params edit;
+    mk_edit_handle *handles;
+} channel_plan;
+
+typedef struct recipe_ctx {
+    mk_raw_asset *raw;
+    mk_arena *scratch;
+    const mk_bake_options *options;
+    mk_error *err;
+} recipe_ctx;
+
+static int untrusted(const recipe_ctx *ctx)
+{
+    return ctx->options && ctx->options->untrusted;
+}
+
+/* ---- small JSON helpers that name the field on error ---- */
+
+static mk_result field_error(recipe_ctx *ctx, const char *path, const char *field, const char *fmt,
+                             const char *detail)
+{
+    char what[200];
+    snprintf(what, sizeof what, fmt, detail ? detail : "");
+    return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s%s%s: %s", path,
+                        field && *field ? "." : "", field ? field : "", what);
+}
+
+static mk_result get_number(recipe_ctx *ctx, const cJSON *obj, const char *path, const char *field,
+                            double *out, int required)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, field);
+    if (!item) return required ? field_error(ctx, path, field, "missing%s", NULL) : MK_OK;
+    if (!cJSON_IsNumber(item)) return field_error(ctx, path, field, "must be a number%s", NULL);
+    if (!isfinite(item->valuedouble)) return field_error(ctx, path, field, "is not a finite number%s", NULL);
+    *out = item->valuedouble;
+    return MK_OK;
+}
+
+static mk_result get_uint(recipe_ctx *ctx, const cJSON *obj, const char *path, const char *field,
+                          uint32_t *out, uint32_t min, uint32_t max)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, field);
+    if (!item) return MK_OK;
+    double v = item->valuedouble;
+    if (!cJSON_IsNumber(item) || !isfinite(v) || v != floor(v) || v < min || v > max) {
+        char range[64];
+        snprintf(range, sizeof range, "%u..%u", min, max);
+        return field_error(ctx, path, field, "must be an integer in %s", range);
+    }
+    *out = (uint32_t)v;
+    return MK_OK;
+}
+
+static mk_result parse_vec3_item(recipe_ctx *ctx, const cJSON *item, const char *path,
+                                 const char *field, double out[3])
+{
+    if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != 3)
+        return field_error(ctx, path, field, "must be an array of 3 numbers%s", NULL);
+    for (int c = 0; c < 3; c++) {
+        const cJSON *e = cJSON_GetArrayItem(item, c);
+        if (!cJSON_IsNumber(e)) return field_error(ctx, path, field, "must be an array of 3 numbers%s", NULL);
+        if (!isfinite(e->valuedouble)) return field_error(ctx, path, field, "holds a value that is not finite%s", NULL);
+        out[c] = e->valuedouble;
+    }
+    return MK_OK;
+}
+
+/* Returns 1 when present (and parsed), 0 when absent, -1 on error. */
+static int get_vec3(recipe_ctx *ctx, const cJSON *obj, const char *path, const char *field, double out[3])
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, field);
+    if (!item) return 0;
+    return parse_vec3_item(ctx, item, path, field, out) == MK_OK ? 1 : -1;
+}
+
+static mk_result check_fields(recipe_ctx *ctx, const cJSON *obj, const char *path,
+                              const char *const *a, const char *const *b)
+{
+    for (const cJSON *it = obj->child; it; it = it->next) {
+        int known = 0;
+        for (int i = 0; a && a[i] && !known; i++) known = strcmp(a[i], it->string) == 0;
+        for (int i = 0; b && b[i] && !known; i++) known = strcmp(b[i], it->string) == 0;
+        if (!known) return field_error(ctx, path, it->string, "unknown field%s (see docs/baking.md)", NULL);
+    }
+    return MK_OK;
+}
+
+/* ---- vertex selections ---- */
+
+/* Selection object: {"indices": [...]} | {"center": [x,y,z], "radius": r} |
+ * {"min": [..], "max": [..]}. Appends matching vertices to *list (deduplicated by a mark). */
+static mk_result parse_selection(recipe_ctx *ctx, const mk_raw_mesh *mesh, const cJSON *sel,
+                                 const char *path, unsigned char *mark, uint32_t **list,
+                                 uint32_t *count, uint32_t *capacity, int allow_extra)
+{
+    static const char *const sel_fields[] = { "indices", "center", "radius", "min", "max", NULL };
+    static const char *const handle_fields[] = { "translate", "rotate", NULL };
+    if (!cJSON_IsObject(sel)) return field_error(ctx, path, "", "must be an object (indices, center+radius or min+max)%s", NULL);
+    mk_result r = check_fields(ctx, sel, path, sel_fields, allow_extra ? handle_fields : NULL);
+    if (r != MK_OK) return r;
+    const cJSON *indices = cJSON_GetObjectItemCaseSensitive(sel, "indices");
+    int has_sphere = cJSON_HasObjectItem(sel, "center") || cJSON_HasObjectItem(sel, "radius");
+    int has_box = cJSON_HasObjectItem(sel, "min") || cJSON_HasObjectItem(sel, "max");
+    if ((indices != NULL) + has_sphere + has_box != 1)
+        return field_error(ctx, path, "", "give exactly one of indices, center+radius or min+max%s", NULL);
+    uint32_t before = *count;
+    size_t n = mesh->vertex_count;
+#define PUSH(v) do { if (!mark[v]) { \
+        if (*count == *capacity) { \
+            uint32_t ncap = *capacity ? 2 * *capacity : 64; \
+            uint32_t *nl = mk_arena_realloc(ctx->scratch, *list, (size_t)*capacity * 4, (size_t)ncap * 4); \
+            if (!nl) return mk_error_oom(ctx->err, "selection"); \
+            *list = nl; *capacity = ncap; } \
+        mark[v] = 1; (*list)[(*count)++] = (uint32_t)(v); } } while (0)
+    if (indices) {
+        if (!cJSON_IsArray(indices)) return field_error(ctx, path, "indices", "must be an array of vertex indices%s", NULL);
+        int k = 0;
+        for (const cJSON *e = indices->child; e; e = e->next, k++) {
+            double v = e->valuedouble;
+            if (!cJSON_IsNumber(e) || !isfinite(v) || v != floor(v) || v < 0 || v >= (double)n) {
+                char msg[96];
+                snprintf(msg, sizeof msg, "entry %d is not a vertex index in 0..%zu", k, n ? n - 1 : 0);
+                return field_error(ctx, path, "indices", "%s", msg);
+            }
+            PUSH((size_t)v);
+        }
+    } else if (has_sphere) {
+        double c[3], radius = 0;
+        int got = get_vec3(ctx, sel, path, "center", c);
+        if (got < 0) return ctx->err->code;
+        if (got == 0) return field_error(ctx, path, "center", "missing (a sphere needs center and radius)%s", NULL);
+        if ((r = get_number(ctx, sel, path, "radius", &radius, 1)) != MK_OK) return r;
+        if (!(radius > 0)) return field_error(ctx, path, "radius", "must be > 0%s", NULL);
+        for (size_t v = 0; v < n; v++) {
+            const float *p = mesh->positions + 3 * v;
+            double d[3] = { p[0] - c[0], p[1] - c[1], p[2] - c[2] };
+            if (mk_dot3(d, d) <= radius * radius) PUSH(v);
+        }
+    } else {
+        double lo[3], hi[3];
+        int g1 = get_vec3(ctx, sel, path, "min", lo), g2 = get_vec3(ctx, sel, path, "max", hi);
+        if (g1 < 0 || g2 < 0) return ctx->err->code;
+        if (!g1 || !g2) return field_error(ctx, path, g1 ? "max" : "min", "missing (a box needs min and max)%s", NULL);
+        for (size_t v = 0; v < n; v++) {
+            const float *p = mesh->positions + 3 * v;
+            if (p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] &&
+                p[2] >= lo[2] && p[2] <= hi[2]) PUSH(v);
+        }
+    }
+#undef PUSH
+    if (*count == before)
+        return field_error(ctx, path, "", "selection is empty (no vertex matches, or all were taken by anchors/earlier handles)%s", NULL);
+    return MK_OK;
+}
+
+/* Rotation object {"axis": [..], "degrees": d, "pivot": [..]}; pivot defaults to def_pivot. */
+static mk_result parse_rotate(recipe_ctx *ctx, const cJSON *obj, const char *path, double axis[3],
+                              double *angle, double pivot[3], const double def_pivot[3])
+{
+    static const char *const rot_fields[] = { "axis", "degrees", "pivot", NULL };
+    const cJSON *rot = cJSON_GetObjectItemCaseSensitive(obj, "rotate");
+    *angle = 0;
+    axis[0] = 0; axis[1] = 0; axis[2] = 1;
+    for (int c = 0; c < 3; c++) pivot[c] = def_pivot[c];
+    if (!rot) return MK_OK;
+    char rpath[256];
+    snprintf(rpath, sizeof rpath, "%s.rotate", path);
+    if (!cJSON_IsObject(rot)) return field_error(ctx, rpath, "", "must be an object {axis, degrees, pivot}%s", NULL);
+    mk_result r = check_fields(ctx, rot, rpath, rot_fields, NULL);
+    if (r != MK_OK) return r;
+    int got = get_vec3(ctx, rot, rpath, "axis", axis);
+    if (got < 0) return ctx->err->code;
+    if (got == 0) return field_error(ctx, rpath, "axis", "missing%s", NULL);
+    if (!(mk_normalize3(axis) > 0)) return field_error(ctx, rpath, "axis", "is a zero vector%s", NULL);
+    double deg = 0;
+    if ((r = get_number(ctx, rot, rpath, "degrees", &deg, 1)) != MK_OK) return r;
+    *angle = deg * PI / 180;
+    if (get_vec3(ctx, rot, rpath, "pivot", pivot) < 0) return ctx->err->code;
+    return MK_OK;
+}
+
+static mk_result parse_axis(recipe_ctx *ctx, const cJSON *obj, const char *path, double axis[3])
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, "axis");
+    axis[0] = 0; axis[1] = 1; axis[2] = 0;
+    if (!item) return MK_OK;
+    if (cJSON_IsString(item)) {
+        const char *s = item->valuestring;
+        double sign = 1;
+        if (*s == '-') { sign = -1; s++; } else if (*s == '+') s++;
+        int k = !strcmp(s, "x") ? 0 : !strcmp(s, "y") ? 1 : !strcmp(s, "z") ? 2 : -1;
+        if (k < 0) return field_error(ctx, path, "axis", "\"%s\" is not x, y, z, -x, -y, -z or [x, y, z]", item->valuestring);
+        axis[0] = axis[1] = axis[2] = 0;
+        axis[k] = sign;
+        return MK_OK;
+    }
+    if (parse_vec3_item(ctx, item, path, "axis", axis) != MK_OK) return ctx->err->code;
+    if (!(mk_len3(axis) > 0)) return field_error(ctx, path, "axis", "is a zero vector%s", NULL);
+    return MK_OK;
+}
+
+/* ---- per-op parsing ---- */
+
+static mk_result parse_barr(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    const mk_raw_mesh *mesh = &ctx->raw->meshes[plan->mesh];
+    mk_barr *b = &plan->barr;
+    memset(b, 0, sizeof *b);
+    b->op = plan->op == OP_TAPER ? MK_BARR_TAPER : plan->op == OP_TWIST ? MK_BARR_TWIST : MK_BARR_BEND;
+    mk_result r = parse_axis(ctx, ch, path, b->axis);
+    if (r != MK_OK) return r;
+    double bmin[3], bmax[3], diag;
+    mk_bake_bounds(mesh, bmin, bmax, &diag);
+    for (int c = 0; c < 3; c++) b->center[c] = 0.5 * (bmin[c] + bmax[c]);
+    if (get_vec3(ctx, ch, path, "center", b->center) < 0) return ctx->err->code;
+    double axis_unit[3] = { b->axis[0], b->axis[1], b->axis[2] };
+    mk_normalize3(axis_unit);
+    const cJSON *range = cJSON_GetObjectItemCaseSensitive(ch, "range");
+    if (range) {
+        if (!cJSON_IsArray(range) || cJSON_GetArraySize(range) != 2 ||
+            !cJSON_IsNumber(range->child) || !cJSON_IsNumber(range->child->next))
+            return field_error(ctx, path, "range", "must be [min, max] along the axis%s", NULL);
+        b->range[0] = range->child->valuedouble;
+        b->range[1] = range->child->next->valuedouble;
+        if (!isfinite(b->range[0]) || !isfinite(b->range[1]))
+            return field_error(ctx, path, "range", "holds a value that is not finite%s", NULL);
+        if (!(b->range[1] > b->range[0]))
+            return field_error(ctx, path, "range", "must have min < max%s", NULL);
+    } else {
+        for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+            const float *p = mesh->positions + 3 * (size_t)v;
+            double pd[3] = { p[0], p[1], p[2] }, a = mk_dot3(pd, axis_unit);
+            if (v == 0 || a < b->range[0]) b->range[0] = a;
+            if (v == 0 || a > b->range[1]) b->range[1] = a;
+        }
+        if (!(b->range[1] > b->range[0]))
+            return field_error(ctx, path, "range", "the mesh has no extent along the axis: give range%s", NULL);
+    }
+    if (plan->op == OP_TAPER) {
+        if ((r = get_number(ctx, ch, path, "scale", &b->scale, 1)) != MK_OK) return r;
+    } else {
+        double deg = 0;
+        if ((r = get_number(ctx, ch, path, "angle", &deg, 1)) != MK_OK) return r;
+        b->angle = deg * PI / 180;
+    }
+    if (plan->op == OP_BEND) {
+        /* Default bend direction: the coordinate axis after the axis' dominant one. */
+        int k = 0;
+        for (int c = 1; c < 3; c++) if (fabs(axis_unit[c]) > fabs(axis_unit[k])) k = c;
+        b->direction[(k + 1) % 3] = 1;
+        if (get_vec3(ctx, ch, path, "direction", b->direction) < 0) return ctx->err->code;
+    }
+    mk_error inner;
+    if (mk_barr_prepare(b, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
+    return MK_OK;
+}
+
+static mk_result parse_index_range(recipe_ctx *ctx, const cJSON *mv, const char *path, const char *field,
+                                   uint32_t dim, uint32_t *lo, uint32_t *hi)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(mv, field);
+    *lo = 0; *hi = dim - 1;
+    if (!item) return MK_OK;
+    double a, b;
+    if (cJSON_IsNumber(item)) a = b = item->valuedouble;
+    else if (cJSON_IsArray(item) && cJSON_GetArraySize(item) == 2 && cJSON_IsNumber(item->child) &&
+             cJSON_IsNumber(item->child->next)) {
+        a = item->child->valuedouble; b = item->child->next->valuedouble;
+    } else return field_error(ctx, path, field, "must be an index or [first, last]%s", NULL);
+    if (!isfinite(a) || !isfinite(b) || a != floor(a) || b != floor(b) || a < 0 || b < a || b >= dim) {
+        char msg[64];
+        snprintf(msg, sizeof msg, "must lie in 0..%u with first <= last", dim - 1);
+        return field_error(ctx, path, field, "%s", msg);
+    }
+    *lo = (uint32_t)a; *hi = (uint32_t)b;
+    return MK_OK;
+}
+
+static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    const mk_raw_mesh *mesh = &ctx->raw->meshes[plan->mesh];
+    mk_ffd_lattice *f = &plan->ffd;
+    memset(f, 0, sizeof *f);
+    f->dims[0] = f->dims[1] = f->dims[2] = 4;
+    const cJSON *dims = cJSON_GetObjectItemCaseSensitive(ch, "dims");
+    if (dims) {
+        if (!cJSON_IsArray(dims) || cJSON_GetArraySize(dims) != 3)
+            return field_error(ctx, path, "dims", "must be [l, m, n] control points per axis%s", NULL);
+        int a = 0;
+        for (const cJSON *e = dims->child; e; e = e->next, a++) {
+            double v = e->valuedouble;
+            if (!cJSON_IsNumber(e) || !isfinite(v) || v != floor(v) || v < 2 || v > (untrusted(ctx) ? 8 : 64))
+                return field_error(ctx, path, "dims", "each entry must be an integer in 2..64 (8 when untrusted)%s", NULL);
+            f->dims[a] = (uint32_t)v;
+        }
+    }
+    const cJSON *basis = cJSON_GetObjectItemCaseSensitive(ch, "basis");
+    if (basis) {
+        if (cJSON_IsString(basis) && !strcmp(basis->valuestring, "bernstein")) f->basis = MK_FFD_BERNSTEIN;
+        else if (cJSON_IsString(basis) && !strcmp(basis->valuestring, "bspline")) f->basis = MK_FFD_BSPLINE;
+        else return field_error(ctx, path, "basis", "must be \"bernstein\" or \"bspline\"%s", NULL);
+    }
+    const cJSON *axes = cJSON_GetObjectItemCaseSensitive(ch, "axes");
+    int has_origin = cJSON_HasObjectItem(ch, "origin");
+    if ((axes != NULL) != has_origin)
+        return field_error(ctx, path, axes ? "origin" : "axes", "missing (origin and axes go together)%s", NULL);
+    if (axes) {
+        if (get_vec3(ctx, ch, path, "origin", f->origin) < 0) return ctx->err->code;
+        if (!cJSON_IsArray(axes) || cJSON_GetArraySize(axes) != 3)
+            return field_error(ctx, path, "axes", "must be [S, T, U], three vectors%s", NULL);
+        int a = 0;
+        for (const cJSON *e = axes->child; e; e = e->next, a++)
+            if (parse_vec3_item(ctx, e, path, "axes", f->axes[a]) != MK_OK) return ctx->err->code;
+    } else {
+        double padding = 0.01, bmin[3], bmax[3], diag;
+        mk_result r = get_number(ctx, ch, path, "padding", &padding, 0);
+        if (r != MK_OK) return r;
+        if (padding < 0) return field_error(ctx, path, "padding", "must be >= 0%s", NULL);
+        mk_bake_bounds(mesh, bmin, bmax, &diag);
+        double pad = padding * diag;
+        for (int a = 0; a < 3; a++) {
+            f->origin[a] = bmin[a] - pad;
+            for (int c = 0; c < 3; c++) f->axes[a][c] = 0;
+            f->axes[a][a] = bmax[a] - bmin[a] + 2 * pad;
+        }
+    }
+    size_t count = (size_t)f->dims[0] * f->dims[1] * f->dims[2];
+    plan->ffd_displacements = mk_arena_array(ctx->scratch, 3 * count, sizeof(double));
+    double *current = mk_arena_array(ctx->scratch, 3 * count, sizeof(double));
+    if (!plan->ffd_displacements || !current) return mk_error_oom(ctx->err, "lattice");
+    for (uint32_t k = 0; k < f->dims[2]; k++)
+        for (uint32_t j = 0; j < f->dims[1]; j++)
+            for (uint32_t i = 0; i < f->dims[0]; i++)
+                mk_ffd_control_point(f, i, j, k, current + 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k)));
+    mk_error inner;
+    if (mk_ffd_prepare(f, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
+    const cJSON *moves = cJSON_GetObjectItemCaseSensitive(ch, "moves");
+    if (moves && !cJSON_IsArray(moves))
+        return field_error(ctx, path, "moves", "must be an array of moves%s", NULL);
+    int m = 0;
+    for (const cJSON *mv = moves ? moves->child : NULL; mv; mv = mv->next, m++) {
+        static const char *const move_fields[] = { "i", "j", "k", "translate", "rotate", "scale", "pivot", NULL };
+        char mpath[256];
+        snprintf(mpath, sizeof mpath, "%s.moves[%d]", path, m);
+        if (!cJSON_IsObject(mv)) return field_error(ctx, mpath, "", "must be an object%s", NULL);
+        mk_result r = check_fields(ctx, mv, mpath, move_fields, NULL);
+        if (r != MK_OK) return r;
+        uint32_t lo[3], hi[3];
+        static const char *const ijk[3] = { "i", "j", "k" };
+        for (int a = 0; a < 3; a++)
+            if ((r = parse_index_range(ctx, mv, mpath, ijk[a], f->dims[a], &lo[a], &hi[a])) != MK_OK) return r;
+        /* Default pivot: centroid of the selected control points (current positions). */
+        double centroid[3] = { 0, 0, 0 };
+        size_t sel = 0;
+        for (uint32_t k = lo[2]; k <= hi[2]; k++)
+            for (uint32_t j = lo[1]; j <= hi[1]; j++)
+                for (uint32_t i = lo[0]; i <= hi[0]; i++, sel++)
+                    for (int c = 0; c < 3; c++)
+                        centroid[c] += current[3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k)) + c];
+        for (int c = 0; c < 3; c++) centroid[c] /= (double)sel;
+        double pivot[3] = { centroid[0], centroid[1], centroid[2] };
+        if (get_vec3(ctx, mv, mpath, "pivot", pivot) < 0) return ctx->err->code;
+        double scale[3] = { 1, 1, 1 }, translate[3] = { 0, 0, 0 }, axis[3], angle, rpivot[3];
+        const cJSON *sc = cJSON_GetObjectItemCaseSensitive(mv, "scale");
+        if (sc && cJSON_IsNumber(sc)) {
+            if (!isfinite(sc->valuedouble)) return field_error(ctx, mpath, "scale", "is not finite%s", NULL);
+            scale[0] = scale[1] = scale[2] = sc->valuedouble;
+        } else if (sc && get_vec3(ctx, mv, mpath, "scale", scale) < 0) return ctx->err->code;
+        if (get_vec3(ctx, mv, mpath, "translate", translate) < 0) return ctx->err->code;
+        if ((r = parse_rotate(ctx, mv, mpath, axis, &angle, rpivot, pivot)) != MK_OK) return r;
+        double R[9];
+        mk_mat3_rotation(R, axis, angle);
+        /* P <- rotate(scale(P about pivot)) about rotate.pivot, then translate. */
+        for (uint32_t k = lo[2]; k <= hi[2]; k++)
+            for (uint32_t j = lo[1]; j <= hi[1]; j++)
+                for (uint32_t i = lo[0]; i <= hi[0]; i++) {
+                    double *p = current + 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k));
+                    double q[3], o[3];
+                    for (int c = 0; c < 3; c++) q[c] = pivot[c] + scale[c] * (p[c] - pivot[c]) - rpivot[c];
+                    mk_mat3_mul_vec(o, R, q);
+                    for (int c = 0; c < 3; c++) p[c] = rpivot[c] + o[c] + translate[c];
+                }
+    }
+    for (uint32_t k = 0; k < f->dims[2]; k++)
+        for (uint32_t j = 0; j < f->dims[1]; j++)
+            for (uint32_t i = 0; i < f->dims[0]; i++) {
+                size_t q = 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k));
+                double rest[3];
+                mk_ffd_control_point(f, i, j, k, rest);
+                for (int c = 0; c < 3; c++) plan->ffd_displacements[q + c] = current[q + c] - rest[c];
+            }
+    f->displacements = plan->ffd_displacements;
+    if (mk_ffd_prepare(f, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
+    return MK_OK;
+}
+
+static mk_result load_cage_file(recipe_ctx *ctx, const cJSON *ch, const char *path, const char *field,
+                                double **verts, uint32_t *nv, uint32_t **tris, uint32_t *nt)
+{
+    if (untrusted(ctx)) return field_error(ctx, path, field, "files are not read for untrusted recipes%s", NULL);
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(ch, field);
+    if (!item) return field_error(ctx, path, field, "missing (path of an OBJ file)%s", NULL);
+    if (!cJSON_IsString(item) || !*item->valuestring)
+        return field_error(ctx, path, field, "must be the path of an OBJ file%s", NULL);
+    const char *name = item->valuestring;
+    char full[4096];
+    const char *dir = ctx->options && ctx->options->base_dir ? ctx->options->base_dir : "";
+    if (name[0] == '/' || !*dir) snprintf(full, sizeof full, "%s", name);
+    else snprintf(full, sizeof full, "%s/%s", dir, name);
+    mk_error inner;
+    if (mk_read_obj(full, ctx->scratch, verts, nv, tris, nt, &inner) != MK_OK)
+        return mk_error_set(ctx->err, inner.code, inner.offset, "%s.%s: %s", path, field, inner.message);
+    return MK_OK;
+}
+
+static mk_result parse_cage(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    double *rest, *def;
+    uint32_t nv, nt, nv2, nt2, *tris, *tris2;
+    mk_result r = load_cage_file(ctx, ch, path, "cage", &rest, &nv, &tris, &nt);
+    if (r == MK_OK) r = load_cage_file(ctx, ch, path, "deformed_cage", &def, &nv2, &tris2, &nt2);
+    if (r != MK_OK) return r;
+    if (nv2 != nv)
+        return field_error(ctx, path, "deformed_cage", "has a different vertex count than cage%s", NULL);
+    plan->cage.vertex_count = nv;
+    plan->cage.rest = rest;
+    plan->cage.deformed = def;
+    plan->cage.triangle_count = nt;
+    plan->cage.triangles = tris;
+    mk_error inner;
+    if (mk_cage_validate(&plan->cage, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.cage: %s", path, inner.message);
+    return MK_OK;
+}
+
+static mk_result parse_edit(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    const mk_raw_mesh *mesh = &ctx->raw->meshes[plan->mesh];
+    mk_edit_params *e = &plan->edit;
+    memset(e, 0, sizeof *e);
+    e->method = plan->op == OP_ARAP ? MK_EDIT_ARAP : MK_EDIT_LAPLACIAN;
+    const cJSON *w = cJSON_GetObjectItemCaseSensitive(ch, "weights");
+    if (w) {
+        if (cJSON_IsString(w) && !strcmp(w->valuestring, "cotangent")) e->weights = MK_WEIGHTS_COTANGENT;
+        else if (cJSON_IsString(w) && !strcmp(w->valuestring, "uniform")) e->weights = MK_WEIGHTS_UNIFORM;
+        else return field_error(ctx, path, "weights", "must be \"cotangent\" or \"uniform\"%s", NULL);
+    }
+    const cJSON *cons = cJSON_GetObjectItemCaseSensitive(ch, "constraints");
+    if (cons) {
+        if (cJSON_IsString(cons) && !strcmp(cons->valuestring, "hard")) e->soft = 0;
+        else if (cJSON_IsString(cons) && !strcmp(cons->valuestring, "soft")) e->soft = 1;
+        else return field_error(ctx, path, "constraints", "must be \"hard\" or \"soft\"%s", NULL);
+    }
+    e->soft_weight = 100;
+    mk_result r = get_number(ctx, ch, path, "soft_weight", &e->soft_weight, 0);
+    if (r != MK_OK) return r;
+    if (!(e->soft_weight > 0)) return field_error(ctx, path, "soft_weight", "must be > 0%s", NULL);
+    e->iterations = 10;
+    if ((r = get_uint(ctx, ch, path, "iterations", &e->iterations, 1, untrusted(ctx) ? 50 : 10000)) != MK_OK) return r;
+
+    unsigned char *mark = mk_arena_array(ctx->scratch, mesh->vertex_count ? mesh->vertex_count : 1, 1);
+    if (!mark) return mk_error_oom(ctx->err, "selection");
+    /* Anchors: one selection or an array of them. */
+    const cJSON *anchors = cJSON_GetObjectItemCaseSensitive(ch, "anchors");
+    uint32_t *alist = NULL, acount = 0, acap = 0;
+    char spath[256];
+    if (anchors && cJSON_IsArray(anchors)) {
+        int k = 0;
+        for (const cJSON *s = anchors->child; s; s = s->next, k++) {
+            snprintf(spath, sizeof spath, "%s.anchors[%d]", path, k);
+            if ((r = parse_selection(ctx, mesh, s, spath, mark, &alist, &acount, &acap, 0)) != MK_OK) return r;
+        }
+    } else if (anchors) {
+        snprintf(spath, sizeof spath, "%s.anchors", path);
+        if ((r = parse_selection(ctx, mesh, anchors, spath, mark, &alist, &acount, &acap, 0)) != MK_OK) return r;
+    }
+    e->anchor_count = acount;
+    e->anchors = alist;
+    /* Handles: array of selection + translate/rotate. A vertex belongs to the first handle
+     * (or anchor) that selects it. */
+    const cJSON *handles = cJSON_GetObjectItemCaseSensitive(ch, "handles");
+    if (!handles) return field_error(ctx, path, "handles", "missing (at least one handle moves the mesh)%s", NULL);
+    if (cJSON_IsObject(handles)) {
+        /* allow a single handle object */
+    } else if (!cJSON_IsArray(handles) || cJSON_GetArraySize(handles) == 0)
+        return field_error(ctx, path, "handles", "must be a non-empty array of handles%s", NULL);
+    int hcount = cJSON_IsObject(handles) ? 1 : cJSON_GetArraySize(handles);
+    plan->handles = mk_arena_array(ctx->scratch, (size_t)hcount, sizeof *plan->handles);
+    if (!plan->handles) return mk_error_oom(ctx->err, "handles");
+    for (int h = 0; h < hcount; h++) {
+        const cJSON *hd = cJSON_IsObject(handles) ? handles : cJSON_GetArrayItem(handles, h);
+        if (cJSON_IsObject(handles)) snprintf(spath, sizeof spath, "%s.handles", path);
+        else snprintf(spath, sizeof spath, "%s.handles[%d]", path, h);
+        uint32_t *list = NULL, count = 0, cap = 0;
+        if ((r = parse_selection(ctx, mesh, hd, spath, mark, &list, &count, &cap, 1)) != MK_OK) return r;
+        mk_edit_handle *eh = &plan->handles[h];
+        eh->count = count;
+        eh->vertices = list;
+        double centroid[3] = { 0, 0, 0 };
+        for (uint32_t i = 0; i < count; i++)
+            for (int c = 0; c < 3; c++) centroid[c] += mesh->positions[3 * (size_t)list[i] + c];
+        for (int c = 0; c < 3; c++) centroid[c] /= count;
+        if (get_vec3(ctx, hd, spath, "translate", eh->translate) < 0) return ctx->err->code;
+        if ((r = parse_rotate(ctx, hd, spath, eh->axis, &eh->angle, eh->pivot, centroid)) != MK_OK) return r;
+    }
+    e->handles = plan->handles;
+    e->handle_count = (uint32_t)hcount;
+    return MK_OK;
+}
+
+/* ---- recipe ---- */
+
+static mk_result resolve_mesh(recipe_ctx *ctx, const cJSON *item, const char *path, uint32_t *mesh)
+{
+    if (!item) return field_error(ctx, path, "mesh", "missing (a mesh name or index)%s", NULL);
+    if (cJSON_IsNumber(item)) {
+        double v = item->valuedouble;
+        if (!isfinite(v) || v != floor(v) || v < 0 || v >= ctx->raw->mesh_count) {
+            char msg[96];
+            snprintf(msg, sizeof msg, "index %g is not a mesh (the asset has %u)", v, ctx->raw->mesh_count);
+            return field_error(ctx, path, "mesh", "%s", msg);
+        }
+        *mesh = (uint32_t)v;
+        return MK_OK;
+    }
+    if (!cJSON_IsString(item)) return field_error(ctx, path, "mesh", "must be a mesh name or index%s", NULL);
+    for (uint32_t m = 0; m < ctx->raw->mesh_count; m++)
+        if (ctx->raw->meshes[m].name && !strcmp(ctx->raw->meshes[m].name, item->valuestring)) {
+            *mesh = m;
+            return MK_OK;
+        }
+    return field_error(ctx, path, "mesh", "no mesh named \"%s\"", item->valuestring);
+}
+
+static mk_result check_mesh(recipe_ctx *ctx, uint32_t m, const char *path)
+{
+    const mk_raw_mesh *mesh = &ctx->raw->meshes[m];
+    if (mesh->vertex_count == 0)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.mesh: mesh %u has no vertices", path, m);
+    for (size_t i = 0; i < 3 * (size_t)mesh->vertex_count; i++)
+        if (!isfinite(mesh->positions[i]))
+            return mk_error_set(ctx->err, MK_ERROR_NOT_FINITE, UINT64_MAX,
+                                "mesh %u vertex %zu: position is not finite", m, i / 3);
+    for (size_t i = 0; i < 3 * (size_t)mesh->triangle_count; i++)
+        if (mesh->triangles[i] >= mesh->vertex_count)
+            return mk_error_set(ctx->err, MK_ERROR_CORRUPT, UINT64_MAX,
+                                "mesh %u triangle %zu: vertex index out of range", m, i / 3);
+    return MK_OK;
+}
+
+static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int has_top_mesh,
+                               uint32_t top_mesh, channel_plan *plan)
+{
+    char path[64];
+    snprintf(path, sizeof path, "channels[%d]", index);
+    if (!cJSON_IsObject(ch)) return field_error(ctx, path, "", "must be an object%s", NULL);
+    const cJSON *op = cJSON_GetObjectItemCaseSensitive(ch, "op");
+    if (!op) return field_error(ctx, path, "op", "missing (ffd, taper, twist, bend, cage, laplacian or arap)%s", NULL);
+    if (!cJSON_IsString(op)) return field_error(ctx, path, "op", "must be a string%s", NULL);
+    int k = -1;
+    for (int i = 0; i < (int)(sizeof op_names / sizeof op_names[0]); i++)
+        if (!strcmp(op_names[i], op->valuestring)) k = i;
+    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, taper, twist, bend, cage, laplacian or arap)", op->valuestring);
+    plan->op = (op_kind)k;
+    mk_result r = check_fields(ctx, ch, path, common_fields, op_fields[k]);
+    if (r != MK_OK) return r;
+
+    const cJSON *mesh_item = cJSON_GetObjectItemCaseSensitive(ch, "mesh");
+    if (mesh_item) {
+        if ((r = resolve_mesh(ctx, mesh_item, path, &plan->mesh)) != MK_OK) return r;
+    } else if (has_top_mesh) plan->mesh = top_mesh;
+    else return field_error(ctx, "mesh", "", "missing (a mesh name or index, at the top or per channel)%s", NULL);
+    if ((r = check_mesh(ctx, plan->mesh, path)) != MK_OK) return r;
+
+    const cJSON *name = cJSON_GetObjectItemCaseSensitive(ch, "name");
+    if (name && (!cJSON_IsString(name) || !*name->valuestring || strlen(name->valuestring) >= sizeof plan->name))
+        return field_error(ctx, path, "name", "must be a non-empty string under 128 bytes%s", NULL);
+    if (name) snprintf(plan->name, sizeof plan->name, "%s", name->valuestring);
+    else snprintf(plan->name, sizeof plan->name, "%s%d", op_names[k], index);
+
+    /* Twist, bend, Laplacian (with rotations) and ARAP are nonlinear in the amplitude: they
+     * default to adaptive in-betweens; FFD, taper and cage are linear: one target is exact. */
+    int nonlinear = plan->op == OP_TWIST || plan->op == OP_BEND || plan->op == OP_LAPLACIAN || plan->op == OP_ARAP;
+    plan->inbetween.count = nonlinear ? 0 : 1;
+    const cJSON *ib = cJSON_GetObjectItemCaseSensitive(ch, "inbetweens");
+    if (ib) {
+        if (cJSON_IsString(ib) && !strcmp(ib->valuestring, "auto")) plan->inbetween.count = 0;
+        else if (cJSON_IsNumber(ib) && isfinite(ib->valuedouble) && ib->valuedouble == floor(ib->valuedouble) &&
+                 ib->valuedouble >= 1 && ib->valuedouble <= (untrusted(ctx) ? 32 : 256))
+            plan->inbetween.count = (uint32_t)ib->valuedouble;
+        else return field_error(ctx, path, "inbetweens", "must be \"auto\" or an integer in 1..256%s", NULL);
+    }
+    plan->inbetween.tolerance = 0.001;
+    if ((r = get_number(ctx, ch, path, "tolerance", &plan->inbetween.tolerance, 0)) != MK_OK) return r;
+    if (!(plan->inbetween.tolerance > 0)) return field_error(ctx, path, "tolerance", "must be > 0%s", NULL);
+    plan->inbetween.samples = 100;
+    if ((r = get_uint(ctx, ch, path, "samples", &plan->inbetween.samples, 2, untrusted(ctx) ? 200 : 100000)) != MK_OK) return r;
+    plan->inbetween.max_targets = untrusted(ctx) ? 32 : 64;
+    if ((r = get_uint(ctx, ch, path, "max_targets", &plan->inbetween.max_targets, 1, untrusted(ctx) ? 32 : 256)) != MK_OK) return r;
+    double dw = 0;
+    if ((r = get_number(ctx, ch, path, "default_weight", &dw, 0)) != MK_OK) return r;
+    plan->default_weight = (float)dw;
+
+    switch (plan->op) {
+    case OP_TAPER: case OP_TWIST: case OP_BEND: r = parse_barr(ctx, plan, ch, path); break;
+    case OP_FFD: r = parse_ffd(ctx, plan, ch, path); break;
+    case OP_CAGE: r = parse_cage(ctx, plan, ch, path); break;
+    case OP_LAPLACIAN: case OP_ARAP: r = parse_edit(ctx, plan, ch, path); break;
+    }
+    if (r != MK_OK) return r;
+    char *json = cJSON_PrintUnformatted(ch);
+    if (!json) return mk_error_oom(ctx->err, "recipe origin");
+    plan->origin = mk_arena_strdup(ctx->scratch, json);
+    cJSON_free(json);
+    if (!plan->origin) return mk_error_oom(ctx->err, "recipe origin");
+    return MK_OK;
+}
+
+static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_bake_report *report)
+{
+    mk_raw_asset *raw = ctx->raw;
+    const mk_raw_mesh *mesh = &raw->meshes[plan->mesh];
+    const mk_bake_options *o = ctx->options;
+    double t0 = mk_bake_now();
+    mk_deformer deformer;
+    memset(&deformer, 0, sizeof deformer);
+    mk_pointwise pw = { mesh, NULL, NULL, ctx->scratch };
+    mk_cage_binding *binding = NULL;
+    mk_surface_edit *edit = NULL;
+    mk_result r = MK_OK;
+    mk_error inner;
+    char path[64];
+    snprintf(path, sizeof path, "channels[%d]", index);
+    switch (plan->op) {
+    case OP_TAPER: case OP_TWIST: case OP_BEND:
+        pw.map = mk_barr_map; pw.user = &plan->barr;
+        deformer.eval = mk_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
+        break;
+    case OP_FFD:
+        pw.map = mk_ffd_map; pw.user = &plan->ffd;
+        deformer.eval = mk_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
+        break;
+    case OP_CAGE:
+        if (o && o->progress) o->progress(o->user, "binding cage", 0);
+        r = mk_cage_bind(mesh, &plan->cage, &raw->arena.allocator, &binding, &inner);
+        deformer.eval = mk_cage_eval; deformer.user = binding;
+        break;
+    case OP_LAPLACIAN: case OP_ARAP:
+        if (o && o->progress) o->progress(o->user, "factoring", 0);
+        r = mk_surface_edit_create(mesh, &plan->edit, &raw->arena.allocator, &edit, &inner);
+        deformer.eval = mk_surface_edit_eval; deformer.user = edit; deformer.expensive = 1;
+        break;
+    }
+    if (r != MK_OK) return mk_error_set(ctx->err, inner.code, inner.offset, "%s (%s): %s", path, op_names[plan->op], inner.message);
+    mk_inbetween_result res;
+    memset(&res, 0, sizeof res);
+    r = mk_bake_channel(raw, plan->mesh, plan->name, plan->origin, &deformer, &plan->inbetween,
+                        o ? o->progress : NULL, o ? o->user : NULL, &res, &inner);
+    mk_bake_channel_report cr;
+    memset(&cr, 0, sizeof cr);
+    if (edit) {
+        mk_solver_stats st;
+        mk_surface_edit_stats(edit, &st);
+        cr.factorizations = st.factorizations;
+        cr.factor_seconds = st.factor_seconds;
+        cr.solve_seconds = st.solve_seconds;
+        cr.solves = st.solves;
+        mk_surface_edit_destroy(edit);
+    }
+    if (binding) mk_cage_unbind(binding);
+    if (r != MK_OK) return mk_error_set(ctx->err, inner.code, inner.offset, "%s (%s): %s", path, op_names[plan->op], inner.message);
+    raw->channels[raw->channel_count - 1].default_weight = plan->default_weight;
+    if (res.inverted_vertices)
+        mk_raw_warn(raw, "channel \"%s\": %u vertices where the deformation folds (det J <= 0); "
+                    "their normals come from the deformed surface", plan->name, res.inverted_vertices);
+    cr.name = plan->name;
+    cr.op = op_names[plan->op];
+    cr.mesh = plan->mesh;
+    cr.targets = res.targets;
+    cr.evaluations = res.evaluations;
+    cr.max_error = res.max_error;
+    cr.error_measured_on_grid = res.error_on_grid;
+    cr.moved_vertices = res.moved_vertices;
+    cr.inverted_vertices = res.inverted_vertices;
+    cr.seconds = mk_bake_now() - t0;
+    if (o && o->channel_done) o->channel_done(o->user, &cr);
+    report->channels_added++;
+    report->targets_added += res.targets;
+    if (res.max_error > report->max_error) report->max_error = res.max_error;
+    return MK_OK;
+}
+
+static mk_result run_recipe(recipe_ctx *ctx, const char *json, size_t size, mk_bake_report *report)
+{
+    const char *end = NULL;
+    cJSON *root = cJSON_ParseWithLengthOpts(json, size, &end, 0);
+    if (!root) {
+        uint64_t off = end && end >= json ? (uint64_t)(end - json) : UINT64_MAX;
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, off, "recipe: JSON syntax error at byte %llu",
+                            (unsigned long long)off);
+    }
+    mk_result r = MK_OK;
+    channel_plan *plans = NULL;
+    int count = 0;
+    static const char *const top_fields[] = { "mesh", "channels", NULL };
+    if (!cJSON_IsObject(root)) { r = field_error(ctx, "recipe", "", "must be a JSON object%s", NULL); goto done; }
+    if ((r = check_fields(ctx, root, "recipe", top_fields, NULL)) != MK_OK) goto done;
+    const cJSON *mesh_item = cJSON_GetObjectItemCaseSensitive(root, "mesh");
+    uint32_t top_mesh = 0;
+    if (mesh_item && (r = resolve_mesh(ctx, mesh_item, "recipe", &top_mesh)) != MK_OK) goto done;
+    const cJSON *channels = cJSON_GetObjectItemCaseSensitive(root, "channels");
+    if (!channels) { r = field_error(ctx, "channels", "", "missing (an array of channel recipes)%s", NULL); goto done; }
+    if (!cJSON_IsArray(channels) || cJSON_GetArraySize(channels) == 0) {
+        r = field_error(ctx, "channels", "", "must be a non-empty array%s", NULL);
+        goto done;
+    }
+    count = cJSON_GetArraySize(channels);
+    plans = mk_arena_array(ctx->scratch, (size_t)count, sizeof *plans);
+    if (!plans) { r = mk_error_oom(ctx->err, "recipe"); goto done; }
+    int i = 0;
+    for (const cJSON *ch = channels->child; ch; ch = ch->next, i++)
+        if ((r = parse_channel(ctx, ch, i, mesh_item != NULL, top_mesh, &plans[i])) != MK_OK) goto done;
+    for (i = 0; i < count; i++)
+        if ((r = bake_plan(ctx, &plans[i], i, report)) != MK_OK) goto done;
+done:
+    cJSON_Delete(root);
+    return r;
+}
+
+mk_result mk_bake_recipe_ex(mk_raw_asset *raw, const char *recipe_json, size_t recipe_size,
+                            const mk_bake_options *options, mk_bake_report *report, mk_error *err)
+{
+    mk_bake_report local;
+    if (!report) report = &local;
+    memset(report, 0, sizeof *report);
+    if (!raw || !recipe_json)
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "mk_bake_recipe: raw and recipe are required");
+    mk_arena scratch;
+    mk_arena_init(&scratch, &raw->arena.allocator);
+    recipe_ctx ctx = { raw, &scratch, options, err };
+    mk_error local_err;
+    if (!err) ctx.err = &local_err;
+    uint32_t old_channels = raw->channel_count;
+    uint32_t old_warnings = raw->warning_count;
+    mk_result r = run_recipe(&ctx, recipe_json, recipe_size, report);
+    if (r == MK_OK) r = mk_raw_group_channels(raw, ctx.err);
+    if (r != MK_OK) {
+        raw->channel_count = old_channels;
+        raw->warning_count = old_warnings;  /* drop warnings of the abandoned bake */
+        memset(report, 0, sizeof *report);
+    }
+    mk_arena_free_all(&scratch);
+    return r;
+}
+
+mk_result mk_bake_recipe(mk_raw_asset *raw, const char *recipe_json, size_t recipe_size,
+                         void (*progress)(void *user, const char *stage, double fraction),
+                         void *user, mk_bake_report *report, mk_error *err)
+{
+    mk_bake_options o;
+    memset(&o, 0, sizeof o);
+    o.progress = progress;
+    o.user = user;
+    return mk_bake_recipe_ex(raw, recipe_json, recipe_size, &o, report, err);
+}

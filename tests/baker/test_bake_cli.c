@@ -1,0 +1,82 @@
+/* `morphkit bake` end to end: bake a sample recipe onto samples/make_example's tube, open the
+ * result with the runtime, and check that a bad recipe fails without writing anything.
+ * usage (from meson): test_bake_cli MORPHKIT MAKE_EXAMPLE RECIPES_DIR WORK_DIR */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "blob_io.h"
+#include "check.h"
+
+static const char *morphkit, *make_example, *recipes, *work;
+
+static int run(const char *fmt, const char *a, const char *b, const char *c, const char *d)
+{
+    char cmd[8192];  /* 4 paths of < 1024 bytes + the format */
+    snprintf(cmd, sizeof cmd, fmt, a, b, c, d);
+    return system(cmd);
+}
+
+static int exists(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (f) fclose(f);
+    return f != NULL;
+}
+
+static void bake_sample_and_open_it(void)
+{
+    char in[1024], out[1024], recipe[1024];
+    snprintf(in, sizeof in, "%s/cli_tube.morph", work);
+    snprintf(out, sizeof out, "%s/cli_tube_baked.morph", work);
+    snprintf(recipe, sizeof recipe, "%s/barr.json", recipes);
+    remove(out);
+    CHECK(run("\"%s\" \"%s\" > /dev/null%s%s", make_example, in, "", "") == 0);
+    CHECK(run("\"%s\" bake \"%s\" --recipe \"%s\" -o \"%s\" --quiet > /dev/null", morphkit, in, recipe, out) == 0);
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    void *data = NULL;
+    size_t size = 0;
+    mk_error err;
+    mk_asset asset;
+    mk_result r = mk_read_file(&arena, out, 1 << 28, &data, &size, &err);
+    if (r == MK_OK) r = mk_asset_open(data, size, &asset, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    if (r == MK_OK) {
+        /* the example's 2 channels untouched + 3 baked ones, baked ones carry their recipe */
+        CHECK_EQ_INT(asset.channel_count, 5);
+        int32_t c = mk_find_channel(&asset, "bend_forward");
+        mk_channel_info ci;
+        CHECK(c >= 0 && mk_channel_get(&asset, (uint32_t)c, &ci));
+        CHECK(c >= 0 && strstr(ci.origin, "\"op\":\"bend\"") != NULL);
+        CHECK(c >= 0 && ci.target_count > 1);
+        int32_t b = mk_find_channel(&asset, "bulge");
+        CHECK(b >= 0 && mk_channel_get(&asset, (uint32_t)b, &ci) && ci.origin[0] == 0);
+    }
+    mk_arena_free_all(&arena);
+}
+
+static void bad_recipe_writes_nothing(void)
+{
+    char in[1024], out[1024], recipe[1024];
+    snprintf(in, sizeof in, "%s/cli_tube2.morph", work);
+    snprintf(out, sizeof out, "%s/cli_tube_bad.morph", work);
+    snprintf(recipe, sizeof recipe, "%s/cli_bad_recipe.json", work);
+    remove(out);
+    FILE *f = fopen(recipe, "w");
+    CHECK(f != NULL);
+    if (!f) return;
+    fputs("{\"mesh\": \"tube\", \"channels\": [{\"op\": \"twist\", \"angle\": 90},"
+          " {\"op\": \"arap\", \"handles\": [{\"center\": [9, 9, 9], \"radius\": 0.1}]}]}", f);
+    fclose(f);
+    CHECK(run("\"%s\" \"%s\" > /dev/null%s%s", make_example, in, "", "") == 0);
+    CHECK(run("\"%s\" bake \"%s\" --recipe \"%s\" -o \"%s\" 2> /dev/null > /dev/null", morphkit, in, recipe, out) != 0);
+    CHECK(!exists(out));
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 5) { fprintf(stderr, "usage: test_bake_cli MORPHKIT MAKE_EXAMPLE RECIPES_DIR WORK_DIR\n"); return 2; }
+    morphkit = argv[1]; make_example = argv[2]; recipes = argv[3]; work = argv[4];
+    static const check_case cases[] = { CASE(bake_sample_and_open_it), CASE(bad_recipe_writes_nothing) };
+    return check_run(cases, 2, 1, argv);
+}
