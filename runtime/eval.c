@@ -207,9 +207,9 @@ static void compute_coefficients(frame *f, const mk_eval_job *job, mk_stacking s
 
 /* The block loop is compiled twice where the compiler and platform allow it: for the
  * baseline ISA and for Haswell-class x86-64 (AVX2, FMA, POPCNT), picked once at load time
- * (GCC/Clang target_clones through an ifunc). The helpers it calls are force-inlined so each
+ * (GCC/Clang target_clones through a glibc ifunc). The helpers it calls are force-inlined so each
  * clone gets its own vector code. Define MK_NO_TARGET_CLONES to build one baseline copy. */
-#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__linux__) && \
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__GLIBC__) && \
     !defined(MK_NO_TARGET_CLONES) && !defined(__SANITIZE_ADDRESS__)
 #define MK_CLONES __attribute__((target_clones("arch=haswell", "default")))
 #else
