@@ -221,30 +221,21 @@ static void compute_coefficients(frame *f, const mk_eval_job *job, mk_stacking s
 #define MK_INLINE static inline
 #endif
 
-#if defined(__GNUC__) || defined(__clang__)
-#define PREFETCH(p) __builtin_prefetch((p), 0, 0)
+/* The block loop is compiled twice where the compiler and platform allow it: for the
+ * baseline ISA and for Haswell-class x86-64 (AVX2, FMA, POPCNT), picked once at load time
+ * (GCC/Clang target_clones through a glibc ifunc). The helpers it calls are force-inlined so each
+ * clone gets its own vector code. Define MK_NO_TARGET_CLONES to build one baseline copy. */
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__GLIBC__) && \
+    !defined(MK_NO_TARGET_CLONES) && !defined(__SANITIZE_ADDRESS__)
+#define MK_CLONES __attribute__((target_clones("arch=haswell", "default")))
 #else
-#define PREFETCH(p) ((void)(p))
+#define MK_CLONES
 #endif
-
-/* Blocks ahead whose active entries are prefetched. Each entry is a short stream (a few
- * cache lines) at its own address, which the hardware prefetcher does not pick up in time;
- * measured with `morphkit bench` (docs/performance.md). */
-#define PREFETCH_BLOCKS 2
-
-MK_INLINE void prefetch_block(const mk_blob_entry *entries, const uint32_t *block_first, uint32_t block,
-                           const float *coef, const mk_blob_target *targets, const uint8_t *data, int with_normals)
-{
-    for (uint32_t e = block_first[block]; e < block_first[block + 1]; e++) {
-        const mk_blob_entry *en = &entries[e];
-        if (coef[en->target] == 0.0f) continue;
-        uint32_t flags = targets[en->target].flags;
-        if (!with_normals) flags &= ~(uint32_t)(MK_TARGET_HAS_NORMALS | MK_TARGET_HAS_TANGENTS);
-        uint64_t bytes = mk_entry_data_size(flags, (uint32_t)__builtin_popcountll(en->mask));
-        const uint8_t *p = data + (size_t)en->data * MK_ALIGN;
-        for (uint64_t off = 0; off < bytes; off += 64) PREFETCH(p + off);
-    }
-}
+#if defined(__GNUC__) || defined(__clang__)
+#define MK_INLINE static inline __attribute__((always_inline))
+#else
+#define MK_INLINE static inline
+#endif
 
 enum { PX, PY, PZ, NX, NY, NZ, TX, TY, TZ, ACC_ROWS };
 typedef float block_acc[ACC_ROWS][MK_BLOCK_SIZE];
@@ -461,14 +452,8 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
     block_acc acc;
     float slerp_a[3][MK_BLOCK_SIZE], slerp_b[3][MK_BLOCK_SIZE];
     const uint32_t block_end = (end + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
-    for (uint32_t b = first / MK_BLOCK_SIZE; b < block_end && b < first / MK_BLOCK_SIZE + PREFETCH_BLOCKS; b++)
-        prefetch_block(entries, block_first, b + 1 < block_end ? b + 1 : b, f.coef, f.targets, data,
-                       want_normals || want_tangents);
     for (uint32_t b = first / MK_BLOCK_SIZE; b < block_end; b++) {
         const uint32_t block_start = b * MK_BLOCK_SIZE;
-        if (b + PREFETCH_BLOCKS < block_end)
-            prefetch_block(entries, block_first, b + PREFETCH_BLOCKS, f.coef, f.targets, data,
-                           want_normals || want_tangents);
         const int rows = want_tangents ? ACC_ROWS : want_normals ? TX : NX;
         memset(acc, 0, sizeof(float) * MK_BLOCK_SIZE * (size_t)rows);
         int32_t open_channel = -1;          /* slerp channel whose deltas are being gathered */
