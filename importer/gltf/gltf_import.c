@@ -500,6 +500,17 @@ static mk_result import_doc(importer *im, mk_error *err)
     }
     if (im->instance_count == 0) mk_raw_warn(im->out, "glTF has no mesh with morph targets");
     if ((r = mk_gltf_import_animations(&im->reader, im->instances, im->instance_count, im->out, err)) != MK_OK) return r;
+    if (im->sidecar && im->sidecar->clip_count) {
+        /* glTF has no clip range: the sidecar keeps the original start and duration. */
+        if (im->sidecar->clip_count != im->out->clip_count)
+            mk_raw_warn(im->out, "sidecar: %u clips listed, the glTF has %u animations; clip ranges ignored",
+                        im->sidecar->clip_count, im->out->clip_count);
+        else
+            for (uint32_t c = 0; c < im->out->clip_count; c++) {
+                im->out->clips[c].start = im->sidecar->clips[c].start;
+                im->out->clips[c].duration = im->sidecar->clips[c].duration;
+            }
+    }
     mk_raw_sort_targets(im->out);
     if ((r = mk_raw_group_channels(im->out, err)) != MK_OK) return r;
     return mk_raw_validate(im->out, err);
