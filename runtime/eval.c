@@ -206,12 +206,13 @@ static void compute_coefficients(frame *f, const mk_eval_job *job, mk_stacking s
 /* ---- block accumulation ---- */
 
 /* The block loop is compiled twice where the compiler and platform allow it: for the
- * baseline ISA and for Haswell-class x86-64 (AVX2, FMA, POPCNT), picked once at load time
+ * baseline ISA and for x86-64-v3 (AVX2, FMA, BMI, POPCNT), picked once at load time by feature
+ * level, not CPU model ("arch=haswell" would check the model and never match an AMD CPU),
  * (GCC/Clang target_clones through a glibc ifunc). The helpers it calls are force-inlined so each
  * clone gets its own vector code. Define MK_NO_TARGET_CLONES to build one baseline copy. */
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__GLIBC__) && \
     !defined(MK_NO_TARGET_CLONES) && !defined(__SANITIZE_ADDRESS__)
-#define MK_CLONES __attribute__((target_clones("arch=haswell", "default")))
+#define MK_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
 #define MK_CLONES
 #endif
@@ -222,12 +223,13 @@ static void compute_coefficients(frame *f, const mk_eval_job *job, mk_stacking s
 #endif
 
 /* The block loop is compiled twice where the compiler and platform allow it: for the
- * baseline ISA and for Haswell-class x86-64 (AVX2, FMA, POPCNT), picked once at load time
+ * baseline ISA and for x86-64-v3 (AVX2, FMA, BMI, POPCNT), picked once at load time by feature
+ * level, not CPU model ("arch=haswell" would check the model and never match an AMD CPU),
  * (GCC/Clang target_clones through a glibc ifunc). The helpers it calls are force-inlined so each
  * clone gets its own vector code. Define MK_NO_TARGET_CLONES to build one baseline copy. */
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__GLIBC__) && \
     !defined(MK_NO_TARGET_CLONES) && !defined(__SANITIZE_ADDRESS__)
-#define MK_CLONES __attribute__((target_clones("arch=haswell", "default")))
+#define MK_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
 #define MK_CLONES
 #endif
