@@ -206,8 +206,11 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
     const cJSON *time = cJSON_GetObjectItem(frame, "time"), *clip = cJSON_GetObjectItem(frame, "clip"),
                 *forced = cJSON_GetObjectItem(frame, "weights");
     /* glTF frames name their animation ("clip"); without one they show the default weights.
-     * FBX frames with a time are in the file's first animation stack. */
-    int32_t clip_index = cJSON_IsNumber(clip) ? clip->valueint : (!gltf && cJSON_IsNumber(time)) ? 0 : -1;
+     * FBX frames are in the file's first animation stack; a frame with time null was made by
+     * ufbx_evaluate_scene with the scene's default animation (the first stack) at t = 0, so an
+     * animated weight there overrides the static DeformPercent (blender_279_*_7400_binary:
+     * its positions show the animated weight 0 although its "channels" list the static 1). */
+    int32_t clip_index = cJSON_IsNumber(clip) ? clip->valueint : !gltf && a->clip_count ? 0 : -1;
     mk_error err;
     if (clip_index >= (int32_t)a->clip_count) {
         snprintf(res->failure, sizeof res->failure, "frame needs clip %d, import has %u clips", clip_index, a->clip_count);

@@ -33,10 +33,13 @@ mk_result mk_import_fbx(const void *data, size_t size, const mk_import_options *
     doc.err = err;
     doc.binary = fbx_is_binary(data, size);
     mk_result r = doc.binary ? fbx_parse_binary(&doc) : fbx_parse_ascii(&doc);
+    if (r == MK_OK && doc.root.child_count == 0)
+        r = mk_error_set(err, MK_ERROR_PARSE, 0, "not an FBX file: no nodes found (%zu bytes)", size);
     if (r == MK_OK) {
         fbx_link_parents(&doc.root);
         r = fbx_convert(&doc, options, out);
     }
+    fbx_doc_free(&doc);
     mk_arena_free_all(&scratch);
     return r;
 }

@@ -1,0 +1,388 @@
+/* Accessors over the FBX document tree: child lookup, scalar values, properties and lazy array
+ * decoding (zlib via libdeflate for binary arrays, text for ASCII arrays, scalar runs for
+ * FBX 5.x/6.x binary).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <libdeflate.h>
+#include "fbx_internal.h"
+
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "the FBX array decoder copies little-endian payloads directly; add byte swapping for this host"
+#endif
+
+void *fbx_grow(mk_arena *arena, void *ptr, size_t old_size, size_t new_size)
+{
+    if (!ptr) return mk_arena_alloc(arena, new_size);
+    return mk_arena_realloc(arena, ptr, old_size, new_size);
+}
+
+void fbx_release(mk_arena *arena, void *ptr)
+{
+    if (ptr) mk_arena_release(arena, ptr);
+}
+
+void fbx_doc_free(fbx_doc *doc)
+{
+    if (doc->inflater) libdeflate_free_decompressor(doc->inflater);
+    doc->inflater = NULL;
+}
+
+void fbx_link_parents(fbx_node *node)
+{
+    for (uint32_t i = 0; i < node->child_count; i++) {
+        node->children[i].parent = node;
+        fbx_link_parents(&node->children[i]);
+    }
+}
+
+int fbx_name_is(const fbx_node *node, const char *name)
+{
+    size_t length = strlen(name);
+    return node->name_length == length && memcmp(node->name, name, length) == 0;
+}
+
+const fbx_node *fbx_next_child(const fbx_node *node, const fbx_node *prev, const char *name)
+{
+    if (!node) return NULL;
+    uint32_t start = prev ? (uint32_t)(prev - node->children) + 1 : 0;
+    for (uint32_t i = start; i < node->child_count; i++)
+        if (fbx_name_is(&node->children[i], name)) return &node->children[i];
+    return NULL;
+}
+
+const fbx_node *fbx_child(const fbx_node *node, const char *name)
+{
+    return fbx_next_child(node, NULL, name);
+}
+
+int fbx_value_int(const fbx_value *v, int64_t *out)
+{
+    if (v->kind == FBX_INT || v->kind == FBX_CHAR) { *out = v->u.i; return 1; }
+    if (v->kind == FBX_FLOAT && v->u.f >= -9.2e18 && v->u.f <= 9.2e18) { *out = (int64_t)v->u.f; return 1; }
+    return 0;
+}
+
+int fbx_value_float(const fbx_value *v, double *out)
+{
+    if (v->kind == FBX_FLOAT) { *out = v->u.f; return 1; }
+    if (v->kind == FBX_INT || v->kind == FBX_CHAR) { *out = (double)v->u.i; return 1; }
+    return 0;
+}
+
+int fbx_value_string(const fbx_value *v, const char **data, uint32_t *length)
+{
+    if (v->kind != FBX_STRING) return 0;
+    *data = v->u.s.data;
+    *length = v->u.s.length;
+    return 1;
+}
+
+int fbx_child_int(const fbx_node *node, const char *name, int64_t *out)
+{
+    const fbx_node *c = fbx_child(node, name);
+    return c && c->value_count > 0 && fbx_value_int(&c->values[0], out);
+}
+
+int fbx_child_float(const fbx_node *node, const char *name, double *out)
+{
+    const fbx_node *c = fbx_child(node, name);
+    return c && c->value_count > 0 && fbx_value_float(&c->values[0], out);
+}
+
+int fbx_child_string(const fbx_node *node, const char *name, const char **data, uint32_t *length)
+{
+    const fbx_node *c = fbx_child(node, name);
+    return c && c->value_count > 0 && fbx_value_string(&c->values[0], data, length);
+}
+
+void fbx_node_path(const fbx_node *node, char *buffer, size_t size)
+{
+    const fbx_node *chain[FBX_MAX_DEPTH + 2];
+    int n = 0;
+    for (const fbx_node *it = node; it && it->name_length && n < FBX_MAX_DEPTH + 1; it = it->parent)
+        chain[n++] = it;
+    size_t used = 0;
+    if (size) buffer[0] = 0;
+    for (int i = n - 1; i >= 0 && used + 1 < size; i--) {
+        int w = snprintf(buffer + used, size - used, "%s%.*s", used ? "/" : "",
+                         (int)chain[i]->name_length, chain[i]->name);
+        if (w < 0) break;
+        used += (size_t)w;
+        if (used >= size) { used = size - 1; break; }
+    }
+}
+
+/* ---- Array decoding ---- */
+
+static size_t elem_size(fbx_elem elem)
+{
+    return (elem == FBX_ELEM_F64 || elem == FBX_ELEM_I64) ? 8 : 4;
+}
+
+static mk_result array_error(fbx_doc *doc, const fbx_node *node, uint64_t offset, mk_result code,
+                             const char *what)
+{
+    char path[160];
+    fbx_node_path(node, path, sizeof path);
+    return mk_error_set(doc->err, code, offset, "FBX %s: %s", path, what);
+}
+
+/* Stores a double into the output element; fails on integers out of range or NaN. */
+static int store_f64(void *out, size_t i, fbx_elem elem, double x)
+{
+    switch (elem) {
+    case FBX_ELEM_F64: ((double *)out)[i] = x; return 1;
+    case FBX_ELEM_F32: case FBX_ELEM_F32_BITS: ((float *)out)[i] = (float)x; return 1;
+    case FBX_ELEM_I32:
+        if (!(x >= -2147483648.0 && x <= 2147483647.0)) return 0;
+        ((int32_t *)out)[i] = (int32_t)x;
+        return 1;
+    case FBX_ELEM_I64:
+        if (!(x >= -9.2e18 && x <= 9.2e18)) return 0;
+        ((int64_t *)out)[i] = (int64_t)x;
+        return 1;
+    }
+    return 0;
+}
+
+static int store_i64(void *out, size_t i, fbx_elem elem, int64_t x)
+{
+    switch (elem) {
+    case FBX_ELEM_F64: ((double *)out)[i] = (double)x; return 1;
+    case FBX_ELEM_F32: ((float *)out)[i] = (float)x; return 1;
+    case FBX_ELEM_F32_BITS: {
+        /* ASCII >= 7200 writes KeyAttrDataFloat as the int32 bit patterns of the floats. */
+        uint32_t bits = (uint32_t)x;
+        float f;
+        memcpy(&f, &bits, 4);
+        ((float *)out)[i] = f;
+        return 1;
+    }
+    case FBX_ELEM_I32:
+        if (x < INT32_MIN || x > INT32_MAX) return 0;
+        ((int32_t *)out)[i] = (int32_t)x;
+        return 1;
+    case FBX_ELEM_I64: ((int64_t *)out)[i] = x; return 1;
+    }
+    return 0;
+}
+
+static mk_result decode_binary(fbx_doc *doc, const fbx_node *node, const fbx_value *v, fbx_elem elem,
+                               void *out)
+{
+    size_t src_size = (v->type == 'd' || v->type == 'l') ? 8 : (v->type == 'f' || v->type == 'i') ? 4 : 1;
+    size_t bytes = (size_t)v->count * src_size;
+    const uint8_t *src = v->u.a.data;
+    void *inflated = NULL;
+    int same = (v->type == 'd' && elem == FBX_ELEM_F64) || (v->type == 'l' && elem == FBX_ELEM_I64) ||
+               (v->type == 'i' && elem == FBX_ELEM_I32) ||
+               (v->type == 'f' && (elem == FBX_ELEM_F32 || elem == FBX_ELEM_F32_BITS));
+    if (v->encoding == 1) {
+        void *target = same ? out : (inflated = mk_arena_alloc(doc->arena, bytes ? bytes : 1));
+        if (!target) return mk_error_oom(doc->err, "FBX array");
+        if (!doc->inflater) doc->inflater = libdeflate_alloc_decompressor();
+        struct libdeflate_decompressor *d = doc->inflater;
+        if (!d) { fbx_release(doc->arena, inflated); return mk_error_oom(doc->err, "zlib decoder"); }
+        size_t actual = 0;
+        enum libdeflate_result lr = libdeflate_zlib_decompress(d, src, (size_t)v->u.a.size, target, bytes, &actual);
+        if (lr != LIBDEFLATE_SUCCESS || actual != bytes) {
+            fbx_release(doc->arena, inflated);
+            /* The output buffer is exactly the declared size, so a stream that would inflate
+             * beyond it stops with INSUFFICIENT_SPACE instead of writing more. */
+            return array_error(doc, node, v->offset, MK_ERROR_PARSE,
+                               lr == LIBDEFLATE_INSUFFICIENT_SPACE ? "compressed array inflates beyond its declared size"
+                               : lr == LIBDEFLATE_SHORT_OUTPUT || (lr == LIBDEFLATE_SUCCESS && actual != bytes)
+                                   ? "compressed array inflates to fewer bytes than declared"
+                                   : "corrupt zlib stream in array");
+        }
+        if (same) return MK_OK;
+        src = inflated;
+    } else if (same) {
+        if (bytes) memcpy(out, src, bytes);
+        return MK_OK;
+    }
+    int ok = 1;
+    for (size_t i = 0; i < v->count && ok; i++) {
+        const uint8_t *p = src + i * src_size;
+        switch (v->type) {
+        case 'd': { double x; memcpy(&x, p, 8); ok = store_f64(out, i, elem, x); break; }
+        case 'f': { float x; memcpy(&x, p, 4); ok = store_f64(out, i, elem, x); break; }
+        case 'l': { int64_t x; memcpy(&x, p, 8); ok = store_i64(out, i, elem, x); break; }
+        case 'i': { int32_t x; memcpy(&x, p, 4); ok = store_i64(out, i, elem, x); break; }
+        default: ok = store_i64(out, i, elem, p[0]); break;
+        }
+    }
+    fbx_release(doc->arena, inflated);
+    if (!ok) return array_error(doc, node, v->offset, MK_ERROR_PARSE, "array value out of range for its use");
+    return MK_OK;
+}
+
+static int is_digit(char c) { return c >= '0' && c <= '9'; }
+
+static mk_result decode_ascii(fbx_doc *doc, const fbx_node *node, const fbx_value *v, fbx_elem elem, void *out)
+{
+    const char *s = (const char *)v->u.a.data;
+    size_t size = (size_t)v->u.a.size, pos = 0, n = 0;
+    for (;;) {
+        while (pos < size && (s[pos] == ' ' || s[pos] == '\t' || s[pos] == '\n' || s[pos] == '\r' || s[pos] == ','))
+            pos++;
+        if (pos >= size) break;
+        size_t start = pos;
+        while (pos < size && s[pos] != ',' && s[pos] != ' ' && s[pos] != '\t' && s[pos] != '\n' && s[pos] != '\r')
+            pos++;
+        if (n >= v->count)
+            return array_error(doc, node, v->offset + start, MK_ERROR_PARSE, "array has more values than its *N count");
+        size_t length = pos - start;
+        /* Integer fast path (indices, KTime, bit patterns). */
+        size_t k = (s[start] == '-' || s[start] == '+') ? 1 : 0;
+        int integer = length > k && length - k <= 18;
+        for (size_t j = k; j < length && integer; j++) integer = is_digit(s[start + j]);
+        int ok;
+        if (integer) {
+            int64_t x = 0;
+            for (size_t j = k; j < length; j++) x = x * 10 + (s[start + j] - '0');
+            ok = store_i64(out, n, elem, s[start] == '-' ? -x : x);
+        } else {
+            char buffer[96];
+            if (length >= sizeof buffer)
+                return array_error(doc, node, v->offset + start, MK_ERROR_PARSE, "number token too long");
+            memcpy(buffer, s + start, length);
+            buffer[length] = 0;
+            char *stop;
+            double x = strtod(buffer, &stop);
+            if (stop == buffer || *stop)
+                return array_error(doc, node, v->offset + start, MK_ERROR_PARSE, "malformed number in array");
+            ok = store_f64(out, n, elem, x);
+        }
+        if (!ok) return array_error(doc, node, v->offset + start, MK_ERROR_PARSE, "array value out of range for its use");
+        n++;
+    }
+    if (n != v->count)
+        return array_error(doc, node, v->offset, MK_ERROR_PARSE, "array has fewer values than its *N count");
+    return MK_OK;
+}
+
+mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void **out, size_t *count)
+{
+    *out = NULL;
+    *count = 0;
+    size_t esize = elem_size(elem);
+    if (node->value_count == 1 && node->values[0].kind == FBX_ARRAY) {
+        const fbx_value *v = &node->values[0];
+        if ((uint64_t)v->count * esize > FBX_MAX_ARRAY_BYTES)
+            return array_error(doc, node, v->offset, MK_ERROR_LIMIT, "array too large");
+        void *data = mk_arena_alloc(doc->arena, (size_t)v->count * esize);
+        if (!data) return mk_error_oom(doc->err, "FBX array");
+        mk_result r = v->type == 'a' ? decode_ascii(doc, node, v, elem, data) : decode_binary(doc, node, v, elem, data);
+        if (r != MK_OK) { fbx_release(doc->arena, data); return r; }
+        *out = data;
+        *count = v->count;
+        return MK_OK;
+    }
+    /* FBX 5.x/6.x: a run of scalar values. */
+    void *data = mk_arena_array(doc->arena, node->value_count, esize);
+    if (!data) return mk_error_oom(doc->err, "FBX array");
+    for (uint32_t i = 0; i < node->value_count; i++) {
+        const fbx_value *v = &node->values[i];
+        int ok;
+        if (v->kind == FBX_FLOAT) ok = store_f64(data, i, elem == FBX_ELEM_F32_BITS ? FBX_ELEM_F32 : elem, v->u.f);
+        else if (v->kind == FBX_INT || v->kind == FBX_CHAR) ok = store_i64(data, i, elem == FBX_ELEM_F32_BITS ? FBX_ELEM_F32 : elem, v->u.i);
+        else ok = 0;
+        if (!ok) {
+            fbx_release(doc->arena, data);
+            return array_error(doc, node, v->offset, MK_ERROR_PARSE, "expected a number in the value list");
+        }
+    }
+    *out = data;
+    *count = node->value_count;
+    return MK_OK;
+}
+
+mk_result fbx_child_array(fbx_doc *doc, const fbx_node *node, const char *name, fbx_elem elem,
+                          void **out, size_t *count)
+{
+    *out = NULL;
+    *count = 0;
+    const fbx_node *c = fbx_child(node, name);
+    if (!c) return MK_OK;
+    return fbx_node_array(doc, c, elem, out, count);
+}
+
+/* ---- Properties ---- */
+
+fbx_props fbx_props_of(const fbx_node *object)
+{
+    fbx_props props = { NULL, 0 };
+    if (!object) return props;
+    props.block = fbx_child(object, "Properties70");
+    if (!props.block) {
+        props.block = fbx_child(object, "Properties60");
+        props.legacy = props.block != NULL;
+    }
+    return props;
+}
+
+uint32_t fbx_prop_payload(fbx_props props)
+{
+    return props.legacy ? 3u : 4u;
+}
+
+const fbx_node *fbx_prop_find(fbx_props props, const char *name)
+{
+    if (!props.block) return NULL;
+    size_t length = strlen(name);
+    const char *tag = props.legacy ? "Property" : "P";
+    for (uint32_t i = 0; i < props.block->child_count; i++) {
+        const fbx_node *p = &props.block->children[i];
+        if (!fbx_name_is(p, tag) || p->value_count == 0) continue;
+        const fbx_value *v = &p->values[0];
+        if (v->kind == FBX_STRING && v->u.s.length == length && memcmp(v->u.s.data, name, length) == 0)
+            return p;
+    }
+    return NULL;
+}
+
+int fbx_prop_number_opt(fbx_props props, const char *name, double *out)
+{
+    const fbx_node *p = fbx_prop_find(props, name);
+    uint32_t at = fbx_prop_payload(props);
+    if (!p || p->value_count <= at) return 0;
+    return fbx_value_float(&p->values[at], out);
+}
+
+double fbx_prop_number(fbx_props props, const char *name, double fallback)
+{
+    double x;
+    return fbx_prop_number_opt(props, name, &x) ? x : fallback;
+}
+
+int fbx_prop_vec3(fbx_props props, const char *name, double out[3])
+{
+    const fbx_node *p = fbx_prop_find(props, name);
+    uint32_t at = fbx_prop_payload(props);
+    if (!p || p->value_count < at + 3) return 0;
+    double v[3];
+    for (int i = 0; i < 3; i++)
+        if (!fbx_value_float(&p->values[at + (uint32_t)i], &v[i])) return 0;
+    memcpy(out, v, sizeof v);
+    return 1;
+}
+
+int fbx_prop_int64(fbx_props props, const char *name, int64_t *out)
+{
+    const fbx_node *p = fbx_prop_find(props, name);
+    uint32_t at = fbx_prop_payload(props);
+    if (!p || p->value_count <= at) return 0;
+    return fbx_value_int(&p->values[at], out);
+}
+
+int fbx_prop_string(fbx_props props, const char *name, const char **data, uint32_t *length)
+{
+    const fbx_node *p = fbx_prop_find(props, name);
+    uint32_t at = fbx_prop_payload(props);
+    if (!p || p->value_count <= at) return 0;
+    return fbx_value_string(&p->values[at], data, length);
+}

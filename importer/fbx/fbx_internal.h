@@ -1,0 +1,132 @@
+/* FBX importer internals: the document tree both parsers build, its accessors, and the
+ * interpretation steps (scene, mesh, blend shapes, curves, transforms).
+ *
+ * The tree mirrors the file: a node has a name, a list of values ("properties" in the binary
+ * spec) and children. Scalars and strings are decoded while parsing; arrays are decoded lazily
+ * (binary arrays keep their file offset and encoding, ASCII arrays keep their text span), so a
+ * large file never holds more than the arrays currently being converted. Everything lives in
+ * the parse arena; accessors that decode arrays allocate from it and the caller releases them.
+ */
+#ifndef MK_FBX_INTERNAL_H
+#define MK_FBX_INTERNAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "import.h"
+
+/* Limits against hostile input (files from real tools are far below these). */
+#define FBX_MAX_DEPTH 64              /* node nesting */
+#define FBX_MAX_VALUES_PER_NODE (1u << 28)
+#define FBX_MAX_ARRAY_BYTES ((uint64_t)1 << 32)  /* one decoded array */
+#define FBX_MAX_INFLATE_RATIO 1100u   /* deflate cannot exceed ~1032:1 */
+
+typedef enum fbx_value_kind {
+    FBX_INT,      /* Y, I, L, B, Z (and C when numeric) */
+    FBX_FLOAT,    /* F, D */
+    FBX_CHAR,     /* C: binary one-byte char/bool, ASCII bare word (first char) */
+    FBX_STRING,   /* S, R, ASCII quoted string */
+    FBX_ARRAY     /* typed binary array or ASCII *N { a: ... } */
+} fbx_value_kind;
+
+typedef struct fbx_value {
+    uint8_t kind;           /* fbx_value_kind */
+    uint8_t type;           /* binary type code ('i','l','f','d','b','c') or 'a' (ASCII array) */
+    uint8_t encoding;       /* binary arrays: 0 raw, 1 zlib */
+    uint8_t unused;
+    uint32_t count;         /* arrays: declared element count */
+    uint64_t offset;        /* byte offset of the value in the file */
+    union {
+        int64_t i;          /* FBX_INT, FBX_CHAR */
+        double f;           /* FBX_FLOAT */
+        struct { const char *data; uint32_t length; } s;     /* FBX_STRING (decoded copy or file span) */
+        struct { const uint8_t *data; uint64_t size; } a;    /* FBX_ARRAY: payload bytes / text */
+    } u;
+} fbx_value;
+
+typedef struct fbx_node fbx_node;
+struct fbx_node {
+    const char *name;
+    uint32_t name_length;
+    uint32_t value_count;
+    uint32_t child_count;
+    uint32_t depth;
+    fbx_value *values;
+    fbx_node *children;
+    const fbx_node *parent;
+    uint64_t offset;        /* byte offset of the record / line start */
+};
+
+typedef struct fbx_doc {
+    mk_arena *arena;
+    const uint8_t *data;
+    size_t size;
+    int binary;
+    uint32_t version;       /* header version (binary) or "; FBX x.y.z" (ASCII); may be raised from FBXVersion */
+    uint32_t header_version;/* as found in the header (binary) */
+    fbx_node root;          /* children = top-level nodes */
+    mk_error *err;
+    void *inflater;         /* libdeflate decompressor, made on first use, freed by fbx_doc_free */
+} fbx_doc;
+
+void fbx_doc_free(fbx_doc *doc);
+
+/* Parsers (fbx_binary.c, fbx_ascii.c). Fill doc->root; errors carry offsets. */
+mk_result fbx_parse_binary(fbx_doc *doc);
+mk_result fbx_parse_ascii(fbx_doc *doc);
+int fbx_is_binary(const void *data, size_t size);
+
+/* Arena helpers that accept NULL (grow from nothing, release nothing). */
+void *fbx_grow(mk_arena *arena, void *ptr, size_t old_size, size_t new_size);
+void fbx_release(mk_arena *arena, void *ptr);
+
+/* ---- Tree accessors (fbx_dom.c) ---- */
+/* Sets parent pointers and depths after parsing (the parsers move nodes while building). */
+void fbx_link_parents(fbx_node *node);
+int fbx_name_is(const fbx_node *node, const char *name);
+const fbx_node *fbx_child(const fbx_node *node, const char *name);
+/* Next child named `name` after `prev` (NULL: first). */
+const fbx_node *fbx_next_child(const fbx_node *node, const fbx_node *prev, const char *name);
+int fbx_value_int(const fbx_value *v, int64_t *out);
+int fbx_value_float(const fbx_value *v, double *out);
+/* String as a NUL-free span; returns 0 when not a string. */
+int fbx_value_string(const fbx_value *v, const char **data, uint32_t *length);
+/* Convenience: the i-th value of a child node. */
+int fbx_child_int(const fbx_node *node, const char *name, int64_t *out);
+int fbx_child_float(const fbx_node *node, const char *name, double *out);
+int fbx_child_string(const fbx_node *node, const char *name, const char **data, uint32_t *length);
+
+/* Node path for messages: "Objects/Geometry/Vertices". */
+void fbx_node_path(const fbx_node *node, char *buffer, size_t size);
+
+/* Array of a node's data as the requested element type. Works for a typed binary array, an
+ * ASCII *N array, or a run of scalar values (FBX 5.x/6.x); `first` skips leading values (for
+ * `Key:` runs after scalar headers). Allocates from doc->arena (release with
+ * mk_arena_release); count 0 gives a valid pointer. Errors name the node path and offset. */
+typedef enum fbx_elem { FBX_ELEM_F64, FBX_ELEM_F32, FBX_ELEM_I32, FBX_ELEM_I64, FBX_ELEM_F32_BITS } fbx_elem;
+mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void **out, size_t *count);
+/* Same for the child named `name`; *out NULL and count 0 when the child is absent (MK_OK). */
+mk_result fbx_child_array(fbx_doc *doc, const fbx_node *node, const char *name, fbx_elem elem,
+                          void **out, size_t *count);
+
+/* ---- Properties (fbx_dom.c): Properties70 "P" and Properties60 "Property" ---- */
+typedef struct fbx_props {
+    const fbx_node *block;  /* Properties70 / Properties60 node, or NULL */
+    int legacy;             /* Properties60: 3 metadata strings instead of 4 */
+} fbx_props;
+fbx_props fbx_props_of(const fbx_node *object);
+/* The P node with that name, or NULL. */
+const fbx_node *fbx_prop_find(fbx_props props, const char *name);
+/* Number (first value after the metadata), or `fallback`. */
+double fbx_prop_number(fbx_props props, const char *name, double fallback);
+int fbx_prop_number_opt(fbx_props props, const char *name, double *out);
+/* 3 numbers; returns 0 and leaves out unchanged when absent. */
+int fbx_prop_vec3(fbx_props props, const char *name, double out[3]);
+int fbx_prop_int64(fbx_props props, const char *name, int64_t *out);
+int fbx_prop_string(fbx_props props, const char *name, const char **data, uint32_t *length);
+/* Value index where a P node's payload starts. */
+uint32_t fbx_prop_payload(fbx_props props);
+
+/* ---- Interpretation (fbx_scene.c etc.) ---- */
+mk_result fbx_convert(fbx_doc *doc, const mk_import_options *options, mk_raw_asset *out);
+
+#endif

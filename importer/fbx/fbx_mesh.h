@@ -1,0 +1,37 @@
+/* FBX mesh conversion and blend shape expansion (fbx_mesh.c). */
+#ifndef MK_FBX_MESH_H
+#define MK_FBX_MESH_H
+
+#include "fbx_internal.h"
+
+/* Control point -> render vertices of one converted mesh (scratch in the parse arena). */
+typedef struct fbx_mesh_map {
+    uint32_t control_point_count, vertex_count;
+    uint32_t *first;            /* control_point_count + 1 offsets into vertices */
+    uint32_t *vertices;         /* render vertices grouped by control point, increasing */
+    const uint32_t *vertex_cp;  /* render vertex -> control point (the raw mesh's array) */
+    uint32_t *cp_entry;         /* scratch for fbx_expand_shape */
+} fbx_mesh_map;
+
+/* Reads Vertices, PolygonVertexIndex and the normal/UV layers of `geometry` into `mesh`
+ * (positions, normals, triangles, control_points; world and name are the caller's). */
+mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geometry, mk_raw_mesh *mesh,
+                         fbx_mesh_map *map);
+void fbx_mesh_map_free(fbx_doc *doc, fbx_mesh_map *map);
+
+/* One shape: sparse deltas at control points. */
+typedef struct fbx_shape_data {
+    size_t count;
+    const int32_t *indexes;
+    const double *positions;       /* 3 per entry */
+    const double *normals;         /* 3 per entry, or NULL (not used) */
+    const double *vertex_weights;  /* Blender per-entry weights (0..1), or NULL */
+    const char *path;              /* node path for messages */
+} fbx_shape_data;
+
+/* Fills target->count/indices/positions/normals with the deltas on render vertices (strictly
+ * increasing indices). Entries with out-of-range indices are skipped and counted. */
+mk_result fbx_expand_shape(fbx_doc *doc, mk_raw_asset *raw, fbx_mesh_map *map, const fbx_shape_data *shape,
+                           mk_raw_target *target, size_t *skipped);
+
+#endif

@@ -1,0 +1,838 @@
+/* FBX import of writer-made fixtures: every format the writer produces (binary 7100..7700,
+ * 13/25-byte records, raw and zlib arrays, ASCII 7100..7700) imports to the same raw model and
+ * evaluates to the positions computed here by hand from the fixture's definition (shape
+ * deltas, in-between interpolation, curve shapes, the FBX transform stack). Also: quirks
+ * (Blender per-vertex FullWeights, duplicate full weights), warnings, and clear errors for
+ * hostile constructs.
+ *
+ * `test_fbx_writer --write-seeds DIR` writes the fixtures as fuzzer seeds instead. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <libdeflate.h>
+#include "check.h"
+#include "fbx_fixtures.h"
+#include "fbx_test_util.h"
+
+/* Hand-computed world position of the Box fixture's control point `cp` with Squash weight ws
+ * and Grow weight wg: deltas first (mesh-local), then geometric translation (0,0,.25), the
+ * pivot-wrapped 90 degree Z rotation, translation (1,2,3), and the parent's scale 2. */
+static void expected_box(int cp, double ws, double wg, double out[3])
+{
+    static const double points[8][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 0, 1 }, { 0, 0, 1 },
+                                         { 0, 1, 0 }, { 1, 1, 0 }, { 1, 1, 1 }, { 0, 1, 1 } };
+    double p[3] = { points[cp][0], points[cp][1], points[cp][2] };
+    if (cp >= 4) p[1] += -0.5 * ws;
+    if (cp == 0) {
+        /* Grow: keys (0.5, -0.25) and (1, -1) plus the implicit (0, 0); linear extrapolation. */
+        double dx = wg <= 0.5 ? wg / 0.5 * -0.25 : -0.25 + (wg - 0.5) / 0.5 * (-1.0 + 0.25);
+        p[0] += dx;
+    }
+    p[2] += 0.25;
+    p[0] -= 0.5;
+    double x = -p[1], y = p[0];
+    p[0] = x + 0.5 + 1;
+    p[1] = y + 2;
+    p[2] = p[2] + 3;
+    for (int k = 0; k < 3; k++) out[k] = 2 * p[k];
+}
+
+static double smoothstep(double s) { return s * s * (3 - 2 * s); }
+
+static const uint32_t versions[] = { 7100, 7200, 7400, 7500, 7700 };
+
+static unsigned char *make_fixture(uint32_t version, int binary, int compress, size_t *size)
+{
+    fbxw_scene scene;
+    fixture_cube(&scene, version, binary, compress);
+    unsigned char *data = NULL;
+    if (fbxw_write(&scene, &data, size) != 0) return NULL;
+    return data;
+}
+
+static void check_box_import(const mk_raw_asset *raw, const char *label)
+{
+    CHECK_MSG(raw->mesh_count == 2, "%s: %u meshes", label, raw->mesh_count);
+    int32_t box = ft_find_mesh(raw, "Box");
+    CHECK_MSG(box >= 0, "%s: no Box mesh (names must drop the Model:: prefix)", label);
+    CHECK(ft_find_mesh(raw, "Root") >= 0);
+    if (box < 0) return;
+    const mk_raw_mesh *m = &raw->meshes[box];
+    CHECK_EQ_INT(m->control_point_count, 8);
+    CHECK_EQ_INT(m->vertex_count, 24);       /* split at every hard edge */
+    CHECK_EQ_INT(m->triangle_count, 12);
+    CHECK(m->normals != NULL);
+    /* Every render vertex maps to a control point and keeps its position. */
+    for (uint32_t v = 0; v < m->vertex_count; v++) CHECK(m->control_points[v] < 8);
+    CHECK_EQ_INT(raw->channel_count, 2);
+    if (raw->channel_count != 2) return;
+    const mk_raw_channel *squash = &raw->channels[0], *grow = &raw->channels[1];
+    CHECK(strcmp(squash->name, "Squash") == 0);
+    CHECK(strcmp(grow->name, "Grow") == 0);
+    CHECK_NEAR(squash->default_weight, 0.25, 1e-7);
+    CHECK_NEAR(grow->default_weight, 0.0, 1e-7);
+    CHECK_EQ_INT(squash->target_count, 1);
+    CHECK_EQ_INT(grow->target_count, 2);
+    if (grow->target_count == 2) {
+        /* FullWeights pair with shapes in connection order: Grow100 <- 100, Grow50 <- 50. */
+        CHECK(strcmp(grow->targets[0].name, "Grow50") == 0);
+        CHECK_NEAR(grow->targets[0].full_weight, 0.5, 1e-7);
+        CHECK(strcmp(grow->targets[1].name, "Grow100") == 0);
+        CHECK_NEAR(grow->targets[1].full_weight, 1.0, 1e-7);
+        /* Grow50: out-of-range entry skipped, zero delta dropped: only control point 0's
+         * three render vertices move, in increasing order (other entries are neighbours whose
+         * normals change: computed normal deltas with zero position delta). */
+        const mk_raw_target *t = &grow->targets[0];
+        uint32_t moved = 0;
+        for (uint32_t i = 0; i < t->count; i++) {
+            if (i) CHECK(t->indices[i] > t->indices[i - 1]);
+            int zero = t->positions[3 * i] == 0 && t->positions[3 * i + 1] == 0 && t->positions[3 * i + 2] == 0;
+            if (zero) continue;
+            moved++;
+            CHECK(m->control_points[t->indices[i]] == 0);
+            CHECK_NEAR(t->positions[3 * i], -0.25, 1e-7);
+        }
+        CHECK_EQ_INT(moved, 3);
+    }
+    if (squash->target_count == 1) {
+        const mk_raw_target *t = &squash->targets[0];
+        uint32_t moved = 0;
+        for (uint32_t i = 0; i < t->count; i++) {
+            if (t->positions[3 * i + 1] == 0) continue;
+            moved++;
+            CHECK(m->control_points[t->indices[i]] >= 4);
+            CHECK_NEAR(t->positions[3 * i + 1], -0.5, 1e-7);
+        }
+        CHECK_EQ_INT(moved, 12);     /* 4 top points x 3 render vertices each */
+        CHECK(t->normals != NULL);   /* computed from positions (no shape normals in the file) */
+    }
+    /* One warning at least: the out-of-range index. */
+    int warned = 0;
+    for (uint32_t i = 0; i < raw->warning_count && i < MK_RAW_MAX_WARNINGS; i++)
+        if (strstr(raw->warnings[i].message, "outside")) warned = 1;
+    CHECK_MSG(warned, "%s: no warning for the out-of-range shape index", label);
+    CHECK_EQ_INT(raw->clip_count, 1);
+    if (raw->clip_count == 1) {
+        CHECK_NEAR(raw->clips[0].start, 0.0, 1e-7);
+        CHECK_NEAR(raw->clips[0].duration, 2.0, 1e-6);
+        CHECK_EQ_INT(raw->clips[0].track_count, 2);
+    }
+}
+
+static void check_box_frames(const mk_raw_asset *raw, const char *label)
+{
+    int32_t box = ft_find_mesh(raw, "Box");
+    if (box < 0 || raw->clip_count != 1) return;
+    static const double times[] = { 0.0, 0.25, 0.5, 1.0, 1.3, 1.75, 2.0, 3.0 };
+    for (size_t i = 0; i < sizeof times / sizeof times[0]; i++) {
+        double t = times[i] > 2 ? 2 : times[i];
+        double ws = t <= 1 ? smoothstep(t) : smoothstep(2 - t);
+        double wg = t / 2;
+        float *p = NULL;
+        uint32_t n = 0;
+        CHECK(ft_eval_control_points(raw, (uint32_t)box, 0, (float)times[i], NULL, 1, &p, &n) == 0);
+        if (!p) continue;
+        CHECK_EQ_INT(n, 8);
+        for (int cp = 0; cp < 8 && n == 8; cp++) {
+            double e[3];
+            expected_box(cp, ws, wg, e);
+            for (int k = 0; k < 3; k++)
+                CHECK_MSG(fabs(p[3 * cp + k] - e[k]) < 2e-5, "%s t=%g cp %d[%d]: %g, expected %g", label, times[i], cp, k,
+                          (double)p[3 * cp + k], e[k]);
+        }
+        free(p);
+    }
+    /* Rest pose (no clip): default weights 0.25 / 0. */
+    float *p = NULL;
+    uint32_t n = 0;
+    CHECK(ft_eval_control_points(raw, (uint32_t)box, -1, 0, NULL, 1, &p, &n) == 0);
+    for (int cp = 0; p && cp < 8; cp++) {
+        double e[3];
+        expected_box(cp, 0.25, 0.0, e);
+        for (int k = 0; k < 3; k++) CHECK_NEAR(p[3 * cp + k], e[k], 2e-5);
+    }
+    free(p);
+    /* Extrapolated in-between weights (1.5 and -0.5) follow the first/last span. */
+    float weights[2] = { 0.0f, 1.5f };
+    CHECK(ft_eval_control_points(raw, (uint32_t)box, -1, 0, weights, 1, &p, &n) == 0);
+    if (p) {
+        double e[3];
+        expected_box(0, 0, 1.5, e);
+        for (int k = 0; k < 3; k++) CHECK_NEAR(p[k], e[k], 2e-5);
+        free(p);
+    }
+}
+
+static void test_formats_roundtrip(void)
+{
+    for (size_t v = 0; v < sizeof versions / sizeof versions[0]; v++)
+        for (int mode = 0; mode < 3; mode++) {  /* 0 ASCII, 1 binary raw arrays, 2 binary zlib arrays */
+            char label[64];
+            snprintf(label, sizeof label, "%u %s", versions[v], mode == 0 ? "ascii" : mode == 1 ? "binary" : "binary+zlib");
+            size_t size;
+            unsigned char *data = make_fixture(versions[v], mode > 0, mode == 2, &size);
+            CHECK(data != NULL);
+            if (!data) continue;
+            mk_raw_asset raw;
+            mk_error err;
+            mk_result r = ft_import(data, size, NULL, &raw, &err);
+            CHECK_MSG(r == MK_OK, "%s: %s", label, err.message);
+            if (r == MK_OK) {
+                CHECK_MSG(mk_raw_validate(&raw, &err) == MK_OK, "%s: %s", label, err.message);
+                char expect[32];
+                snprintf(expect, sizeof expect, "fbx %u %s", versions[v], mode ? "binary" : "ascii");
+                CHECK_MSG(strcmp(raw.source_format, expect) == 0, "%s: source_format '%s'", label, raw.source_format);
+                CHECK(strcmp(raw.source_creator, "morphkit test writer") == 0);
+                CHECK_EQ_INT(raw.up_axis, 1);
+                CHECK_NEAR(raw.unit_scale, 1.0, 0);
+                check_box_import(&raw, label);
+                check_box_frames(&raw, label);
+            }
+            mk_raw_free(&raw);
+            free(data);
+        }
+}
+
+static void test_stacking_option(void)
+{
+    size_t size;
+    unsigned char *data = make_fixture(7400, 1, 0, &size);
+    CHECK(data != NULL);
+    if (!data) return;
+    mk_import_options options;
+    memset(&options, 0, sizeof options);
+    mk_raw_asset raw;
+    mk_error err;
+    CHECK(ft_import(data, size, &options, &raw, &err) == MK_OK);
+    for (uint32_t m = 0; m < raw.mesh_count; m++) CHECK_EQ_INT(raw.meshes[m].stacking, MK_STACKING_ADDITIVE);
+    mk_raw_free(&raw);
+    options.stacking = MK_STACKING_SEQUENTIAL;
+    CHECK(ft_import(data, size, &options, &raw, &err) == MK_OK);
+    for (uint32_t m = 0; m < raw.mesh_count; m++) CHECK_EQ_INT(raw.meshes[m].stacking, MK_STACKING_SEQUENTIAL);
+    mk_raw_free(&raw);
+    options.stacking = (mk_stacking)7;
+    CHECK(ft_import(data, size, &options, &raw, &err) == MK_ERROR_INVALID_ARGUMENT);
+    mk_raw_free(&raw);
+    options.stacking = MK_STACKING_ADDITIVE;
+    options.max_input_size = size - 1;
+    CHECK(ft_import(data, size, &options, &raw, &err) == MK_ERROR_LIMIT);
+    mk_raw_free(&raw);
+    free(data);
+}
+
+/* ---- curves: one channel, keys chosen per case ---- */
+
+static const double one_point[3] = { 0, 0, 0 };
+static const int32_t one_triangle[3] = { 0, 0, ~0 };
+
+static int import_curve(const int64_t *times, const float *values, const int32_t *flags, const float *attr, uint32_t count,
+                        int binary, mk_raw_asset *raw)
+{
+    static const int32_t idx[1] = { 0 };
+    static const double delta[3] = { 1, 0, 0 };
+    static const double fw[1] = { 100 };
+    fbxw_shape shape = { "S", 1, idx, delta, NULL };
+    fbxw_curve curve = { count, times, values, flags, attr };
+    fbxw_channel channel;
+    memset(&channel, 0, sizeof channel);
+    channel.name = "C";
+    channel.shape_count = 1;
+    channel.shapes = &shape;
+    channel.full_weight_count = 1;
+    channel.full_weights = fw;
+    channel.curve = &curve;
+    fbxw_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.name = "M";
+    mesh.control_point_count = 1;
+    mesh.control_points = one_point;
+    mesh.polygon_vertex_count = 3;
+    mesh.polygon_vertex_index = one_triangle;
+    mesh.channel_count = 1;
+    mesh.channels = &channel;
+    mesh.parent = -1;
+    fbxw_scene scene;
+    memset(&scene, 0, sizeof scene);
+    scene.version = 7500;
+    scene.binary = binary;
+    scene.stack_stop = FIXTURE_KTIME(4);
+    scene.mesh_count = 1;
+    scene.meshes = &mesh;
+    unsigned char *data;
+    size_t size;
+    if (fbxw_write(&scene, &data, &size)) return -1;
+    mk_error err;
+    mk_result r = ft_import(data, size, NULL, raw, &err);
+    free(data);
+    if (r != MK_OK) fprintf(stderr, "curve import: %s\n", err.message);
+    return r == MK_OK && raw->clip_count == 1 && raw->clips[0].track_count == 1 ? 0 : -1;
+}
+
+static float sample(const mk_raw_asset *raw, double t)
+{
+    const mk_raw_track *tr = &raw->clips[0].tracks[0];
+    return mk_curve_eval(tr->keys, tr->key_count, (float)t, NULL);
+}
+
+static float packed(uint32_t bits)
+{
+    float f;
+    memcpy(&f, &bits, 4);
+    return f;
+}
+
+static void test_curves(void)
+{
+    for (int binary = 0; binary < 2; binary++) {
+        mk_raw_asset raw;
+        int64_t t3[3] = { FIXTURE_KTIME(0), FIXTURE_KTIME(1), FIXTURE_KTIME(3) };
+        /* Constant, then constant-next, then linear (last key's flags unused). */
+        {
+            float v[3] = { 10, 50, 90 };
+            int32_t f[3] = { 0x2, 0x102, 0x4 };
+            float a[12] = { 0 };
+            CHECK(import_curve(t3, v, f, a, 3, binary, &raw) == 0);
+            if (raw.clip_count) {
+                CHECK_NEAR(sample(&raw, 0.5), 0.10, 1e-6);   /* hold */
+                CHECK_NEAR(sample(&raw, 2.0), 0.90, 1e-6);   /* constant-next: next key's value */
+                CHECK_NEAR(sample(&raw, 1.0), 0.50, 1e-6);
+                CHECK_NEAR(sample(&raw, -1.0), 0.10, 1e-6);  /* before the first key: first value */
+                CHECK_NEAR(sample(&raw, 9.0), 0.90, 1e-6);   /* after the last key: last value */
+            }
+            mk_raw_free(&raw);
+        }
+        /* User tangents (Hermite with 1/3 weights): slopes in percent per second. */
+        {
+            float v[3] = { 0, 100, 0 };
+            int32_t f[3] = { 0x408, 0x408, 0x408 };
+            float a[12] = { 200, -100, packed(0x0D050D05u), 0, 0, 0, packed(0x0D050D05u), 0, 0, 0, packed(0x0D050D05u), 0 };
+            CHECK(import_curve(t3, v, f, a, 3, binary, &raw) == 0);
+            if (raw.clip_count) {
+                /* Segment 0..1: p0=0, p1=1 (normalized), m0 = 2/s, m1 = -1/s; Hermite at s=.5. */
+                double s = 0.5, h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s;
+                double h01 = -2 * s * s * s + 3 * s * s, h11 = s * s * s - s * s;
+                double expect = h00 * 0 + h10 * 2.0 + h01 * 1 + h11 * -1.0;
+                CHECK_NEAR(sample(&raw, 0.5), expect, 2e-4);
+            }
+            mk_raw_free(&raw);
+        }
+        /* Auto tangents recomputed: interior key on a monotonic run gets the neighbour slope
+         * (clamped so handles stay within the neighbours); extremum and ends get 0. */
+        {
+            float v[3] = { 0, 50, 100 };
+            int32_t f[3] = { 0x6108, 0x6108, 0x6108 };
+            float a[12] = { 0, 0, packed(0x0D050D05u), 0, 0, 0, packed(0x0D050D05u), 0, 0, 0, packed(0x0D050D05u), 0 };
+            CHECK(import_curve(t3, v, f, a, 3, binary, &raw) == 0);
+            if (raw.clip_count) {
+                const mk_key *k = raw.clips[0].tracks[0].keys;
+                /* (100 - 0) / (3 - 0) % per s = 1/3 per s; clamp limits: left 0.5/(1/3*1) = 1.5, right 0.5/(1/3*2) = .75. */
+                CHECK_NEAR(k[1].left_slope, 1.0 / 3.0, 1e-6);
+                CHECK_NEAR(k[1].right_slope, 1.0 / 3.0, 1e-6);
+                CHECK_NEAR(k[0].right_slope, 0.0, 0);
+                CHECK_NEAR(k[2].left_slope, 0.0, 0);
+            }
+            mk_raw_free(&raw);
+        }
+        /* Weighted tangents: packed weights (right 0.2 of key 0, next-left 0.6). */
+        {
+            float v[3] = { 0, 100, 0 };
+            int32_t f[3] = { 0x408 | 0x1000000 | 0x2000000, 0x408, 0x408 };
+            uint32_t bits = 2000u | (6000u << 16);
+            float a[12] = { 0, 0, packed(bits), 0, 0, 0, packed(0x0D050D05u), 0, 0, 0, packed(0x0D050D05u), 0 };
+            CHECK(import_curve(t3, v, f, a, 3, binary, &raw) == 0);
+            if (raw.clip_count) {
+                const mk_key *k = raw.clips[0].tracks[0].keys;
+                CHECK_NEAR(k[0].right_weight, 0.2, 1e-6);
+                CHECK_NEAR(k[1].left_weight, 0.6, 1e-6);
+                CHECK_NEAR(k[1].right_weight, 1.0 / 3.0, 1e-6);
+                CHECK_EQ_INT(k[0].interp, MK_INTERP_CUBIC);
+            }
+            mk_raw_free(&raw);
+        }
+        /* TCB with tension = continuity = bias = 0: Catmull-Rom-like slopes from the one-sided
+         * secants, halved in the interior (ufbxi_solve_tcb): key 1 = .5 (100/1 - 100/2) = 25 %/s,
+         * key 0 (an end, factor 1) = its right secant 100 %/s. */
+        {
+            float v[3] = { 0, 100, 0 };
+            int32_t f[3] = { 0x208, 0x208, 0x208 };
+            float a[12] = { 0 };
+            CHECK(import_curve(t3, v, f, a, 3, binary, &raw) == 0);
+            if (raw.clip_count) {
+                const mk_key *k = raw.clips[0].tracks[0].keys;
+                CHECK_NEAR(k[1].left_slope, 0.25, 1e-6);
+                CHECK_NEAR(k[1].right_slope, 0.25, 1e-6);
+                CHECK_NEAR(k[0].right_slope, 1.0, 1e-6);
+            }
+            mk_raw_free(&raw);
+        }
+        /* Auto tangents without the time-independent flag average the neighbour secant with the
+         * time-weighted one-sided secants (ufbxi_solve_auto_tangent):
+         * slope = total/2 + (left (1 - d) + right d)/2, d = (t1 - t0)/(t2 - t0). */
+        {
+            float v[3] = { 0, 100, 150 };
+            int32_t f[3] = { 0x108, 0x108, 0x108 };  /* cubic auto, no clamp, not time-independent */
+            float a[12] = { 0 };
+            CHECK(import_curve(t3, v, f, a, 3, binary, &raw) == 0);
+            if (raw.clip_count) {
+                const mk_key *k = raw.clips[0].tracks[0].keys;
+                double total = 150.0 / 3.0, left = 100.0, right = 25.0, delta = 1.0 / 3.0;
+                double expect = total * 0.5 + (left * (1 - delta) + right * delta) * 0.5;
+                CHECK_NEAR(k[1].right_slope, expect / 100.0, 1e-6);
+                /* Unclamped end keys take their one-sided secant. */
+                CHECK_NEAR(k[0].right_slope, 1.0, 1e-6);
+                CHECK_NEAR(k[2].left_slope, 0.25, 1e-6);
+            }
+            mk_raw_free(&raw);
+        }
+        /* Duplicate key times collapse to the first key (warning), never an invalid track. */
+        {
+            int64_t td[3] = { FIXTURE_KTIME(0), FIXTURE_KTIME(1), FIXTURE_KTIME(1) };
+            float v[3] = { 0, 100, 50 };
+            int32_t f[3] = { 0x4, 0x4, 0x4 };
+            float a[12] = { 0 };
+            CHECK(import_curve(td, v, f, a, 3, binary, &raw) == 0);
+            if (raw.clip_count) CHECK_EQ_INT(raw.clips[0].tracks[0].key_count, 2);
+            mk_error err;
+            CHECK(mk_raw_validate(&raw, &err) == MK_OK);
+            CHECK(raw.warning_count > 0);
+            mk_raw_free(&raw);
+        }
+    }
+}
+
+/* ---- quirks ---- */
+
+static void test_blender_full_weights(void)
+{
+    static const int32_t idx[2] = { 0, 1 };
+    static const double delta[6] = { 0, 0, 2, 0, 0, 2 };
+    static const double fw[2] = { 25, 100 };  /* per Indexes entry: Blender vertex-group weights */
+    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
+    static const int32_t tri[3] = { 0, 1, ~2 };
+    for (int blender = 0; blender < 2; blender++) {
+        fbxw_shape shape = { "Key", 2, idx, delta, NULL };
+        fbxw_channel channel;
+        memset(&channel, 0, sizeof channel);
+        channel.name = "Key";
+        channel.deform_percent = 100;
+        channel.deform_as_field_only = 1;
+        channel.shape_count = 1;
+        channel.shapes = &shape;
+        channel.full_weight_count = 2;
+        channel.full_weights = fw;
+        fbxw_mesh mesh;
+        memset(&mesh, 0, sizeof mesh);
+        mesh.name = "Tri";
+        mesh.control_point_count = 3;
+        mesh.control_points = points;
+        mesh.polygon_vertex_count = 3;
+        mesh.polygon_vertex_index = tri;
+        mesh.channel_count = 1;
+        mesh.channels = &channel;
+        mesh.parent = -1;
+        fbxw_scene scene;
+        memset(&scene, 0, sizeof scene);
+        scene.version = 7400;
+        scene.binary = 1;
+        scene.creator = blender ? "Blender (stable FBX IO) - 4.4.1 - 5.12.7" : "FBX SDK/FBX Plugins version 2020.1";
+        scene.mesh_count = 1;
+        scene.meshes = &mesh;
+        unsigned char *data;
+        size_t size;
+        CHECK(fbxw_write(&scene, &data, &size) == 0);
+        mk_raw_asset raw;
+        mk_error err;
+        CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
+        free(data);
+        CHECK_EQ_INT(raw.channel_count, 1);
+        if (raw.channel_count == 1) {
+            const mk_raw_channel *ch = &raw.channels[0];
+            CHECK_NEAR(ch->default_weight, 1.0, 1e-7);  /* DeformPercent read from the plain field */
+            CHECK_EQ_INT(ch->target_count, 1);
+            const mk_raw_target *t = &ch->targets[0];
+            /* Blender: weights scale the deltas, full weight 1. Others: FullWeights[0] = 25 %. */
+            CHECK_NEAR(t->full_weight, blender ? 1.0 : 0.25, 1e-7);
+            for (uint32_t i = 0; i < t->count; i++) {
+                uint32_t cp = raw.meshes[0].control_points[t->indices[i]];
+                double expect = cp > 1 ? 0.0 : blender ? (cp == 0 ? 0.5 : 2.0) : 2.0;
+                CHECK_NEAR(t->positions[3 * i + 2], expect, 1e-7);
+            }
+        }
+        mk_raw_free(&raw);
+    }
+}
+
+static void test_duplicate_full_weights(void)
+{
+    static const int32_t idx[1] = { 0 };
+    static const double d1[3] = { 1, 0, 0 }, d2[3] = { 2, 0, 0 }, d3[3] = { 3, 0, 0 };
+    static const double fw[3] = { 50, 50, 0 };  /* duplicate, then a zero full weight */
+    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
+    static const int32_t tri[3] = { 0, 1, ~2 };
+    fbxw_shape shapes[3] = { { "A", 1, idx, d1, NULL }, { "B", 1, idx, d2, NULL }, { "C", 1, idx, d3, NULL } };
+    fbxw_channel channel;
+    memset(&channel, 0, sizeof channel);
+    channel.name = "Dup";
+    channel.shape_count = 3;
+    channel.shapes = shapes;
+    channel.full_weight_count = 3;
+    channel.full_weights = fw;
+    fbxw_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.name = "Tri";
+    mesh.control_point_count = 3;
+    mesh.control_points = points;
+    mesh.polygon_vertex_count = 3;
+    mesh.polygon_vertex_index = tri;
+    mesh.channel_count = 1;
+    mesh.channels = &channel;
+    mesh.parent = -1;
+    fbxw_scene scene;
+    memset(&scene, 0, sizeof scene);
+    scene.version = 7500;
+    scene.binary = 0;
+    scene.mesh_count = 1;
+    scene.meshes = &mesh;
+    unsigned char *data;
+    size_t size;
+    CHECK(fbxw_write(&scene, &data, &size) == 0);
+    mk_raw_asset raw;
+    mk_error err;
+    CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
+    free(data);
+    CHECK_EQ_INT(raw.channel_count, 1);
+    if (raw.channel_count == 1) {
+        CHECK_EQ_INT(raw.channels[0].target_count, 1);
+        if (raw.channels[0].target_count) CHECK(strcmp(raw.channels[0].targets[0].name, "A") == 0);
+    }
+    CHECK(raw.warning_count >= 2);
+    CHECK(mk_raw_validate(&raw, &err) == MK_OK);
+    mk_raw_free(&raw);
+}
+
+/* Rotation order and pre-rotation: a point at (1,0,0) under T(1,0,0) and R(90,0,90).
+ * XYZ applies X first: (1,0,0) -> (1,0,0) -> (0,1,0), + T = (1,1,0).
+ * ZYX applies Z first: (1,0,0) -> (0,1,0) -> (0,0,1), + T = (1,0,1).
+ * R(90,0,0) XYZ with PreRotation(0,0,90): Rpre after R: (1,0,0) -> (1,0,0) -> (0,1,0) + T. */
+static void test_rotation_order(void)
+{
+    static const double points[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
+    static const int32_t tri[3] = { 0, 1, ~2 };
+    struct { double r[3], pre[3]; int order; double expect[3]; } cases[] = {
+        { { 90, 0, 90 }, { 0, 0, 0 }, 0, { 1, 1, 0 } },
+        { { 90, 0, 90 }, { 0, 0, 0 }, 5, { 1, 0, 1 } },
+        { { 90, 0, 0 }, { 0, 0, 90 }, 0, { 1, 1, 0 } },
+        { { 90, 0, 0 }, { 0, 0, 0 }, 0, { 2, 0, 0 } },
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        for (int binary = 0; binary < 2; binary++) {
+            fbxw_mesh mesh;
+            memset(&mesh, 0, sizeof mesh);
+            mesh.name = "Tri";
+            mesh.control_point_count = 3;
+            mesh.control_points = points;
+            mesh.polygon_vertex_count = 3;
+            mesh.polygon_vertex_index = tri;
+            mesh.translation[0] = 1;
+            memcpy(mesh.rotation, cases[c].r, sizeof mesh.rotation);
+            memcpy(mesh.pre_rotation, cases[c].pre, sizeof mesh.pre_rotation);
+            mesh.rotation_order = cases[c].order;
+            mesh.parent = -1;
+            fbxw_scene scene;
+            memset(&scene, 0, sizeof scene);
+            scene.version = 7400;
+            scene.binary = binary;
+            scene.mesh_count = 1;
+            scene.meshes = &mesh;
+            unsigned char *data;
+            size_t size;
+            CHECK(fbxw_write(&scene, &data, &size) == 0);
+            mk_raw_asset raw;
+            mk_error err;
+            CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
+            free(data);
+            float *p = NULL;
+            uint32_t n = 0;
+            CHECK(raw.mesh_count == 1 && ft_eval_control_points(&raw, 0, -1, 0, NULL, 1, &p, &n) == 0);
+            for (int k = 0; p && k < 3; k++)
+                CHECK_MSG(fabs(p[k] - cases[c].expect[k]) < 1e-6, "case %zu axis %d: %g expected %g", c, k, (double)p[k],
+                          cases[c].expect[k]);
+            free(p);
+            mk_raw_free(&raw);
+        }
+    }
+}
+
+/* FBX 6.1 ASCII written by hand (always runs, unlike the corpus): geometry and a `Shape:`
+ * inside the Model, the weight as a Properties60 property named after the shape, name-based
+ * connections, and a Take whose `Key:` list mixes linear, constant-next and cubic keys. */
+static void test_legacy_61_ascii(void)
+{
+    const char *text = fixture_legacy61;
+    mk_raw_asset raw;
+    mk_error err;
+    mk_result r = ft_import(text, strlen(text), NULL, &raw, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    if (r != MK_OK) { mk_raw_free(&raw); return; }
+    CHECK(strcmp(raw.source_format, "fbx 6100 ascii") == 0);
+    CHECK_EQ_INT(raw.mesh_count, 1);
+    CHECK_EQ_INT(raw.channel_count, 1);
+    if (raw.mesh_count == 1 && raw.channel_count == 1) {
+        CHECK(strcmp(raw.meshes[0].name, "Tri") == 0);
+        CHECK_EQ_INT(raw.meshes[0].control_point_count, 3);
+        CHECK(strcmp(raw.channels[0].name, "Up") == 0);
+        CHECK_NEAR(raw.channels[0].default_weight, 0.4, 1e-7);
+        CHECK_EQ_INT(raw.clip_count, 1);
+        if (raw.clip_count == 1) {
+            CHECK_NEAR(raw.clips[0].duration, 2.0, 1e-6);
+            CHECK_EQ_INT(raw.clips[0].track_count, 1);
+            /* 0 -> 1 linear over 1 s, then constant-next: 0.5 right after t = 1. */
+            CHECK_NEAR(sample(&raw, 0.5), 0.5, 1e-6);
+            CHECK_NEAR(sample(&raw, 1.2), 0.5, 1e-6);
+            CHECK_NEAR(sample(&raw, 1.0), 1.0, 1e-6);
+        }
+        /* World: scale 2 then translate 10: point 2 at (0,1,0) + weight 0.4 * (0,0,1). */
+        float *p = NULL;
+        uint32_t n = 0;
+        CHECK(ft_eval_control_points(&raw, 0, -1, 0, NULL, 1, &p, &n) == 0);
+        if (p && n == 3) {
+            CHECK_NEAR(p[6], 10.0, 1e-6);
+            CHECK_NEAR(p[7], 2.0, 1e-6);
+            CHECK_NEAR(p[8], 0.8, 1e-6);
+        }
+        free(p);
+    }
+    mk_raw_free(&raw);
+}
+
+/* InheritType: a child at T(1,0,0) under a parent scaled by 2 has its origin at x = 2 either
+ * way (the parent scales the child's translation); its own unit x is 4 with RSrs (the default)
+ * and 3 with Rrs (Maya segment scale compensate: the parent's scale does not scale the child). */
+static void test_inherit_type(void)
+{
+    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
+    static const int32_t tri[3] = { 0, 1, ~2 };
+    for (int ignore = 0; ignore < 2; ignore++) {
+        fbxw_mesh meshes[2];
+        memset(meshes, 0, sizeof meshes);
+        for (int m = 0; m < 2; m++) {
+            meshes[m].name = m ? "Child" : "Parent";
+            meshes[m].control_point_count = 3;
+            meshes[m].control_points = points;
+            meshes[m].polygon_vertex_count = 3;
+            meshes[m].polygon_vertex_index = tri;
+            meshes[m].parent = m ? 0 : -1;
+        }
+        meshes[0].scaling[0] = meshes[0].scaling[1] = meshes[0].scaling[2] = 2;
+        meshes[1].translation[0] = 1;
+        meshes[1].ignore_parent_scale = ignore;
+        fbxw_scene scene;
+        memset(&scene, 0, sizeof scene);
+        scene.version = 7500;
+        scene.binary = 1;
+        scene.mesh_count = 2;
+        scene.meshes = meshes;
+        unsigned char *data;
+        size_t size;
+        CHECK(fbxw_write(&scene, &data, &size) == 0);
+        mk_raw_asset raw;
+        mk_error err;
+        CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
+        free(data);
+        int32_t child = ft_find_mesh(&raw, "Child");
+        float *p = NULL;
+        uint32_t n = 0;
+        CHECK(child >= 0 && ft_eval_control_points(&raw, (uint32_t)child, -1, 0, NULL, 1, &p, &n) == 0);
+        if (p) {
+            CHECK_NEAR(p[0], 2.0, 1e-6);                     /* control point 0 = the child's origin */
+            CHECK_NEAR(p[3], ignore ? 3.0 : 4.0, 1e-6);      /* (1,0,0): the child's own unit, scaled or not */
+        }
+        free(p);
+        mk_raw_free(&raw);
+    }
+}
+
+/* ---- hostile constructs: clear errors ---- */
+
+typedef struct buf { unsigned char data[4096]; size_t size; } buf;
+static void b_bytes(buf *b, const void *p, size_t n) { memcpy(b->data + b->size, p, n); b->size += n; }
+static void b_u32(buf *b, uint32_t v) { unsigned char x[4] = { (unsigned char)v, (unsigned char)(v >> 8), (unsigned char)(v >> 16), (unsigned char)(v >> 24) }; b_bytes(b, x, 4); }
+static void b_header(buf *b, uint32_t version)
+{
+    b->size = 0;
+    b_bytes(b, "Kaydara FBX Binary  \0\x1a\0", 23);
+    b_u32(b, version);
+}
+
+static mk_result import_buf(const buf *b, mk_error *err)
+{
+    mk_raw_asset raw;
+    mk_result r = ft_import(b->data, b->size, NULL, &raw, err);
+    mk_raw_free(&raw);
+    return r;
+}
+
+static void test_hostile_constructs(void)
+{
+    buf b;
+    mk_error err;
+    /* A zlib array whose stream inflates to more than its declared element count. */
+    {
+        double values[3] = { 1, 2, 3 };
+        unsigned char z[256];
+        struct libdeflate_compressor *c = libdeflate_alloc_compressor(6);
+        size_t zn = libdeflate_zlib_compress(c, values, sizeof values, z, sizeof z);
+        libdeflate_free_compressor(c);
+        b_header(&b, 7400);
+        size_t start = b.size;
+        b_u32(&b, 0); b_u32(&b, 1); b_u32(&b, (uint32_t)(13 + zn)); b_bytes(&b, "\x08Vertices", 9);
+        b_bytes(&b, "d", 1); b_u32(&b, 2); b_u32(&b, 1); b_u32(&b, (uint32_t)zn); b_bytes(&b, z, zn);
+        uint32_t end = (uint32_t)b.size;
+        memcpy(b.data + start, &end, 4);
+        unsigned char zero[13] = { 0 };
+        b_bytes(&b, zero, 13);
+        /* The parser is lazy about arrays: wrap it so the scene reads it (Objects/Geometry). */
+        CHECK(import_buf(&b, &err) == MK_OK);  /* a stray top-level array is never decoded */
+    }
+    /* Node end offset past the end of the file. */
+    {
+        b_header(&b, 7400);
+        b_u32(&b, 100000); b_u32(&b, 0); b_u32(&b, 0); b_bytes(&b, "\x03" "Foo", 4);
+        CHECK(import_buf(&b, &err) == MK_ERROR_PARSE);
+        CHECK(err.offset == 27);
+        CHECK(strstr(err.message, "end offset") != NULL);
+    }
+    /* 25-byte records from 7500: a 13-byte record is misread and rejected, not overread. */
+    {
+        b_header(&b, 7500);
+        b_u32(&b, 40); b_u32(&b, 0); b_u32(&b, 0); b_bytes(&b, "\x03" "Foo", 4);
+        CHECK(import_buf(&b, &err) != MK_OK);
+    }
+    /* Nesting beyond the limit. */
+    {
+        b_header(&b, 7400);
+        size_t starts[80];
+        for (int d = 0; d < 80; d++) {
+            starts[d] = b.size;
+            b_u32(&b, 0); b_u32(&b, 0); b_u32(&b, 0); b_bytes(&b, "\x01N", 2);
+        }
+        unsigned char zero[13] = { 0 };
+        for (int d = 79; d >= 0; d--) {
+            b_bytes(&b, zero, 13);
+            uint32_t end = (uint32_t)b.size;
+            memcpy(b.data + starts[d], &end, 4);
+        }
+        b_bytes(&b, zero, 13);
+        CHECK(import_buf(&b, &err) == MK_ERROR_LIMIT);
+    }
+    /* ASCII: array shorter than its count; unterminated node; compressed array lies. */
+    {
+        const char *text = "; FBX 7.5.0 project file\nObjects: {\n Geometry: 1, \"Geometry::\", \"Mesh\" {\n"
+                           "  Vertices: *6 { a: 0,0,0 }\n  PolygonVertexIndex: *3 { a: 0,0,-1 }\n }\n"
+                           " Model: 2, \"Model::M\", \"Mesh\" {\n }\n}\nConnections: {\n C: \"OO\",1,2\n}\n";
+        mk_raw_asset raw;
+        CHECK(ft_import(text, strlen(text), NULL, &raw, &err) == MK_ERROR_PARSE);
+        CHECK(strstr(err.message, "Objects/Geometry/Vertices") != NULL);
+        CHECK(strstr(err.message, "fewer values") != NULL);
+        mk_raw_free(&raw);
+        const char *open = "; FBX 7.5.0 project file\nObjects: {\n Geometry: 1, \"x\", \"Mesh\" {\n";
+        CHECK(ft_import(open, strlen(open), NULL, &raw, &err) == MK_ERROR_PARSE);
+        mk_raw_free(&raw);
+        const char *bad_index = "; FBX 7.5.0 project file\nObjects: {\n Geometry: 1, \"Geometry::\", \"Mesh\" {\n"
+                                "  Vertices: *3 { a: 0,0,0 }\n  PolygonVertexIndex: *3 { a: 0,5,-1 }\n }\n"
+                                " Model: 2, \"Model::M\", \"Mesh\" {\n }\n}\nConnections: {\n C: \"OO\",1,2\n}\n";
+        CHECK(ft_import(bad_index, strlen(bad_index), NULL, &raw, &err) == MK_ERROR_PARSE);
+        CHECK(strstr(err.message, "PolygonVertexIndex") != NULL);
+        mk_raw_free(&raw);
+    }
+    /* A zlib array inside a mesh that inflates beyond its declared size. */
+    {
+        fbxw_scene scene;
+        fixture_cube(&scene, 7400, 1, 1);
+        unsigned char *data;
+        size_t size;
+        CHECK(fbxw_write(&scene, &data, &size) == 0);
+        /* Find the Box's compressed normals (72 doubles, 'd' + count 72 + encoding 1) and
+         * declare 71 elements: the stream then inflates past the buffer. */
+        int patched = 0;
+        for (size_t i = 0; i + 9 < size && !patched; i++) {
+            if (data[i] == 'd' && data[i + 1] == 72 && data[i + 2] == 0 && data[i + 5] == 1 && data[i + 6] == 0) {
+                data[i + 1] = 71;
+                patched = 1;
+            }
+        }
+        CHECK(patched);
+        mk_raw_asset raw;
+        CHECK(ft_import(data, size, NULL, &raw, &err) == MK_ERROR_PARSE);
+        CHECK(strstr(err.message, "inflates beyond") != NULL);
+        CHECK(err.offset != UINT64_MAX && err.offset < size);
+        mk_raw_free(&raw);
+        free(data);
+    }
+}
+
+/* Failing allocation K for every K gives MK_ERROR_OUT_OF_MEMORY (never a crash, another
+ * error or a leak: ASan's leak check covers the arenas), until K is past the last allocation. */
+static void test_allocation_failures(void)
+{
+    static const struct { uint32_t version; int binary, compress; } forms[] = { { 7500, 1, 1 }, { 7400, 0, 0 } };
+    for (size_t f = 0; f < sizeof forms / sizeof forms[0]; f++) {
+        size_t size;
+        unsigned char *data = make_fixture(forms[f].version, forms[f].binary, forms[f].compress, &size);
+        CHECK(data != NULL);
+        if (!data) continue;
+        int succeeded = 0;
+        uint64_t k;
+        for (k = 1; k < 100000 && !succeeded; k++) {
+            mk_allocator allocator;
+            memset(&allocator, 0, sizeof allocator);
+            allocator.fail_after = k;
+            mk_raw_asset raw;
+            mk_raw_init(&raw, &allocator);
+            mk_error err;
+            mk_result r = mk_import_fbx(data, size, NULL, &raw, &err);
+            if (r == MK_OK) succeeded = 1;
+            else CHECK_MSG(r == MK_ERROR_OUT_OF_MEMORY, "fail_after %llu: %s (%s)", (unsigned long long)k,
+                           mk_result_name(r), err.message);
+            mk_raw_free(&raw);
+        }
+        CHECK(succeeded);
+        CHECK(k > 10);
+        free(data);
+    }
+}
+
+static int write_seeds(const char *dir)
+{
+    int failures = 0;
+    for (size_t v = 0; v < sizeof versions / sizeof versions[0]; v++)
+        for (int mode = 0; mode < 3; mode++) {
+            size_t size;
+            unsigned char *data = make_fixture(versions[v], mode > 0, mode == 2, &size);
+            char path[1024];
+            snprintf(path, sizeof path, "%s/fixture_%u_%d.fbx", dir, versions[v], mode);
+            FILE *f = data ? fopen(path, "wb") : NULL;
+            if (!f || fwrite(data, 1, size, f) != size) failures++;
+            if (f) fclose(f);
+            free(data);
+        }
+    char path[1024];
+    snprintf(path, sizeof path, "%s/fixture_legacy61.fbx", dir);
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(fixture_legacy61, 1, strlen(fixture_legacy61), f) != strlen(fixture_legacy61)) failures++;
+    if (f) fclose(f);
+    return failures ? 1 : 0;
+}
+
+static const check_case cases[] = {
+    CASE(test_formats_roundtrip), CASE(test_stacking_option), CASE(test_curves), CASE(test_blender_full_weights),
+    CASE(test_duplicate_full_weights), CASE(test_hostile_constructs), CASE(test_allocation_failures),
+    CASE(test_rotation_order), CASE(test_legacy_61_ascii), CASE(test_inherit_type),
+};
+
+int main(int argc, char **argv)
+{
+    if (argc == 3 && strcmp(argv[1], "--write-seeds") == 0) return write_seeds(argv[2]);
+    return check_run(cases, (int)(sizeof cases / sizeof cases[0]), argc, argv);
+}
