@@ -16,6 +16,7 @@
  * (Gram-Schmidt) and its change stored as the tangent delta.
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "raw.h"
 
@@ -24,8 +25,18 @@ typedef struct topology {
     uint32_t *group_of;        /* per vertex */
     uint32_t *group_vert_first, *group_verts;  /* CSR group -> vertices */
     uint32_t *group_tri_first, *group_tris;    /* CSR group -> triangles */
+    double *face;              /* per triangle: area-weighted base face normal (cross product) */
     float *base_normal;        /* per group, unit */
 } topology;
+
+/* Per-target work arrays, allocated once per mesh and reset after each target. */
+typedef struct work {
+    int32_t *moved;            /* per vertex: index in the target, or -1 */
+    int32_t *group_slot;       /* per group: index in groups[], or -1 */
+    int32_t *tri_slot;         /* per triangle: index in tris[], or -1 */
+    uint8_t *vert_mark;        /* per vertex: joined the index set */
+    uint32_t *groups, *tris, *extra;   /* affected groups, triangles; added vertices */
+} work;
 
 static void face_normal(const float *p0, const float *p1, const float *p2, double out[3])
 {
@@ -60,23 +71,15 @@ static int build_csr(mk_arena *arena, const uint32_t *key, uint32_t items, uint3
     return 1;
 }
 
-/* Normal of group g for positions given by (base + optional sparse delta lookup). */
-static void group_normal(const mk_raw_mesh *m, const topology *topo, uint32_t g, const float *positions,
-                         const int32_t *moved, const float *delta, float out[3])
+/* Unit normal of group g: the sum of its triangles' face normals, taking a triangle's
+ * deformed normal from `deformed` where tri_slot says it has one. */
+static void group_normal(const topology *topo, uint32_t g, const int32_t *tri_slot, const double *deformed,
+                         float out[3])
 {
     double sum[3] = { 0, 0, 0 };
     for (uint32_t k = topo->group_tri_first[g]; k < topo->group_tri_first[g + 1]; k++) {
-        const uint32_t *tri = &m->triangles[3u * topo->group_tris[k]];
-        float p[3][3];
-        for (int c = 0; c < 3; c++) {
-            uint32_t v = tri[c];
-            for (int d = 0; d < 3; d++) {
-                p[c][d] = positions[3u * v + (uint32_t)d];
-                if (moved && moved[v] >= 0) p[c][d] += delta[3u * (uint32_t)moved[v] + (uint32_t)d];
-            }
-        }
-        double n[3];
-        face_normal(p[0], p[1], p[2], n);
+        uint32_t t = topo->group_tris[k];
+        const double *n = tri_slot && tri_slot[t] >= 0 ? &deformed[3u * (uint32_t)tri_slot[t]] : &topo->face[3u * t];
         sum[0] += n[0]; sum[1] += n[1]; sum[2] += n[2];
     }
     double len = sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
@@ -104,6 +107,8 @@ static int build_topology(mk_arena *arena, const mk_raw_mesh *m, topology *topo)
                 topo->group_of[v] = g != UINT32_MAX ? g : topo->group_count++;
             }
         }
+        mk_arena_release(arena, cp_first);
+        mk_arena_release(arena, cp_verts);
     } else {
         for (uint32_t v = 0; v < n; v++) topo->group_of[v] = v;
         topo->group_count = n;
@@ -127,10 +132,14 @@ static int build_topology(mk_arena *arena, const mk_raw_mesh *m, topology *topo)
     topo->group_tris = slots;
     mk_arena_release(arena, tri_group);
     mk_arena_release(arena, tri_index);
-    topo->base_normal = mk_arena_array(arena, (size_t)topo->group_count * 3, sizeof(float));
-    if (!topo->base_normal) return 0;
-    for (uint32_t g = 0; g < topo->group_count; g++)
-        group_normal(m, topo, g, m->positions, NULL, NULL, &topo->base_normal[3u * g]);
+    topo->face = mk_arena_array(arena, (size_t)m->triangle_count * 3 + 3, sizeof(double));
+    topo->base_normal = mk_arena_array(arena, (size_t)topo->group_count * 3 + 3, sizeof(float));
+    if (!topo->face || !topo->base_normal) return 0;
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *tri = &m->triangles[3u * t];
+        face_normal(&m->positions[3u * tri[0]], &m->positions[3u * tri[1]], &m->positions[3u * tri[2]], &topo->face[3u * t]);
+    }
+    for (uint32_t g = 0; g < topo->group_count; g++) group_normal(topo, g, NULL, NULL, &topo->base_normal[3u * g]);
     return 1;
 }
 
@@ -144,53 +153,76 @@ static void orthogonal_tangent(const float *t, const float *n, float out[3])
     out[0] = v[0] / len; out[1] = v[1] / len; out[2] = v[2] / len;
 }
 
+static int compare_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* One target, in time proportional to what it touches: the triangles around moved vertices
+ * get deformed face normals, the groups around those triangles new normals, and the
+ * target's index set grows by the vertices of those groups. */
 static mk_result compute_target(mk_raw_asset *raw, const mk_raw_mesh *m, const topology *topo, mk_raw_target *t,
-                                int32_t *moved, int32_t *group_slot, uint32_t *group_list, uint8_t *vert_mark,
-                                mk_error *err)
+                                work *w, mk_error *err)
 {
     mk_arena *arena = &raw->arena;
-    for (uint32_t j = 0; j < t->count; j++) moved[t->indices[j]] = (int32_t)j;
-    /* Groups whose normal can change: every corner group of a triangle touching a moved vertex. */
-    uint32_t affected = 0;
+    for (uint32_t j = 0; j < t->count; j++) w->moved[t->indices[j]] = (int32_t)j;
+    uint32_t tri_count = 0, group_count = 0, extra = 0;
+    /* Triangles with a moved corner (found through the moved vertices' groups). */
     for (uint32_t j = 0; j < t->count; j++) {
         uint32_t g = topo->group_of[t->indices[j]];
         for (uint32_t k = topo->group_tri_first[g]; k < topo->group_tri_first[g + 1]; k++) {
-            const uint32_t *tri = &m->triangles[3u * topo->group_tris[k]];
-            for (int c = 0; c < 3; c++) {
-                uint32_t gc = topo->group_of[tri[c]];
-                if (group_slot[gc] < 0) { group_slot[gc] = (int32_t)affected; group_list[affected++] = gc; }
+            uint32_t tri = topo->group_tris[k];
+            if (w->tri_slot[tri] >= 0) continue;
+            const uint32_t *c = &m->triangles[3u * tri];
+            if (w->moved[c[0]] < 0 && w->moved[c[1]] < 0 && w->moved[c[2]] < 0) continue;
+            w->tri_slot[tri] = (int32_t)tri_count;
+            w->tris[tri_count++] = tri;
+            for (int q = 0; q < 3; q++) {
+                uint32_t gc = topo->group_of[c[q]];
+                if (w->group_slot[gc] < 0) { w->group_slot[gc] = (int32_t)group_count; w->groups[group_count++] = gc; }
             }
         }
     }
-    /* Vertices of the new index set: moved ones plus every vertex of an affected group. */
-    uint32_t total = t->count;
-    for (uint32_t a = 0; a < affected; a++) {
-        uint32_t g = group_list[a];
-        for (uint32_t k = topo->group_vert_first[g]; k < topo->group_vert_first[g + 1]; k++) {
-            uint32_t v = topo->group_verts[k];
-            if (moved[v] < 0 && !vert_mark[v]) { vert_mark[v] = 1; total++; }
+    double *deformed = mk_arena_array(arena, (size_t)tri_count * 3 + 3, sizeof(double));
+    float *group_new = mk_arena_array(arena, (size_t)group_count * 3 + 3, sizeof(float));
+    if (!deformed || !group_new) return mk_error_oom(err, "computing target normals");
+    for (uint32_t k = 0; k < tri_count; k++) {
+        const uint32_t *c = &m->triangles[3u * w->tris[k]];
+        float p[3][3];
+        for (int q = 0; q < 3; q++)
+            for (int d = 0; d < 3; d++) {
+                p[q][d] = m->positions[3u * c[q] + (uint32_t)d];
+                if (w->moved[c[q]] >= 0) p[q][d] += t->positions[3u * (uint32_t)w->moved[c[q]] + (uint32_t)d];
+            }
+        face_normal(p[0], p[1], p[2], &deformed[3u * k]);
+    }
+    for (uint32_t k = 0; k < group_count; k++) {
+        group_normal(topo, w->groups[k], w->tri_slot, deformed, &group_new[3u * k]);
+        uint32_t g = w->groups[k];
+        for (uint32_t i = topo->group_vert_first[g]; i < topo->group_vert_first[g + 1]; i++) {
+            uint32_t v = topo->group_verts[i];
+            if (w->moved[v] < 0 && !w->vert_mark[v]) { w->vert_mark[v] = 1; w->extra[extra++] = v; }
         }
     }
-    uint32_t *indices = mk_arena_array(arena, total ? total : 1, sizeof(uint32_t));
-    float *positions = mk_arena_array(arena, (size_t)(total ? total : 1) * 3, sizeof(float));
-    float *normals = mk_arena_array(arena, (size_t)(total ? total : 1) * 3, sizeof(float));
-    float *tangents = m->tangents ? mk_arena_array(arena, (size_t)(total ? total : 1) * 3, sizeof(float)) : NULL;
-    float *group_new = mk_arena_array(arena, (size_t)(affected ? affected : 1) * 3, sizeof(float));
-    if (!indices || !positions || !normals || (m->tangents && !tangents) || !group_new)
-        return mk_error_oom(err, "computing target normals");
-    for (uint32_t a = 0; a < affected; a++)
-        group_normal(m, topo, group_list[a], m->positions, moved, t->positions, &group_new[3u * a]);
-    /* Merge: walk vertices in increasing order (sorted output) over moved ∪ marked. */
-    uint32_t out = 0;
-    for (uint32_t v = 0; v < m->vertex_count && out < total; v++) {
-        int is_moved = moved[v] >= 0;
-        if (!is_moved && !vert_mark[v]) continue;
+    qsort(w->extra, extra, sizeof *w->extra, compare_u32);
+    uint32_t total = t->count + extra;
+    uint32_t *indices = mk_arena_array(arena, (size_t)total + 1, sizeof(uint32_t));
+    float *positions = mk_arena_array(arena, (size_t)total * 3 + 3, sizeof(float));
+    float *normals = mk_arena_array(arena, (size_t)total * 3 + 3, sizeof(float));
+    float *tangents = m->tangents ? mk_arena_array(arena, (size_t)total * 3 + 3, sizeof(float)) : NULL;
+    if (!indices || !positions || !normals || (m->tangents && !tangents)) return mk_error_oom(err, "computing target normals");
+    /* Merge the sorted moved indices with the sorted added vertices. */
+    uint32_t a = 0, b = 0;
+    for (uint32_t out = 0; out < total; out++) {
+        int from_moved = b >= extra || (a < t->count && t->indices[a] < w->extra[b]);
+        uint32_t v = from_moved ? t->indices[a] : w->extra[b];
         indices[out] = v;
-        if (is_moved) memcpy(&positions[3u * out], &t->positions[3u * (uint32_t)moved[v]], 3 * sizeof(float));
+        if (from_moved) memcpy(&positions[3u * out], &t->positions[3u * a++], 3 * sizeof(float));
+        else b++;
         uint32_t g = topo->group_of[v];
         const float *nb = &topo->base_normal[3u * g];
-        const float *nt = nb;
-        if (group_slot[g] >= 0) nt = &group_new[3u * (uint32_t)group_slot[g]];
+        const float *nt = w->group_slot[g] >= 0 ? &group_new[3u * (uint32_t)w->group_slot[g]] : nb;
         for (int d = 0; d < 3; d++) normals[3u * out + (uint32_t)d] = nt[d] - nb[d];
         if (tangents) {
             const float *bt = &m->tangents[4u * v];
@@ -199,21 +231,20 @@ static mk_result compute_target(mk_raw_asset *raw, const mk_raw_mesh *m, const t
             orthogonal_tangent(bt, nt, tt);
             for (int d = 0; d < 3; d++) tangents[3u * out + (uint32_t)d] = tt[d] - tb[d];
         }
-        out++;
     }
-    for (uint32_t j = 0; j < t->count; j++) moved[t->indices[j]] = -1;
-    for (uint32_t a = 0; a < affected; a++) {
-        uint32_t g = group_list[a];
-        group_slot[g] = -1;
-        for (uint32_t k = topo->group_vert_first[g]; k < topo->group_vert_first[g + 1]; k++)
-            vert_mark[topo->group_verts[k]] = 0;
-    }
+    /* Reset the work arrays for the next target. */
+    for (uint32_t j = 0; j < t->count; j++) w->moved[t->indices[j]] = -1;
+    for (uint32_t k = 0; k < tri_count; k++) w->tri_slot[w->tris[k]] = -1;
+    for (uint32_t k = 0; k < group_count; k++) w->group_slot[w->groups[k]] = -1;
+    for (uint32_t k = 0; k < extra; k++) w->vert_mark[w->extra[k]] = 0;
+    mk_arena_release(arena, deformed);
     mk_arena_release(arena, group_new);
+    /* The old arrays are replaced (they may belong to the importer: left to the arena). */
     t->indices = indices;
     t->positions = positions;
     t->normals = normals;
     t->tangents = tangents;
-    t->count = out;
+    t->count = total;
     return MK_OK;
 }
 
@@ -231,22 +262,33 @@ mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int fo
     if (!needed) return MK_OK;
     mk_arena *arena = &raw->arena;
     topology topo;
-    int32_t *moved = mk_arena_array(arena, m->vertex_count, sizeof(int32_t));
-    uint8_t *vert_mark = mk_arena_array(arena, m->vertex_count, 1);
-    if (!moved || !vert_mark || !build_topology(arena, m, &topo)) return mk_error_oom(err, "building mesh topology");
-    int32_t *group_slot = mk_arena_array(arena, topo.group_count, sizeof(int32_t));
-    uint32_t *group_list = mk_arena_array(arena, topo.group_count, sizeof(uint32_t));
-    if (!group_slot || !group_list) return mk_error_oom(err, "computing target normals");
-    for (uint32_t g = 0; g < topo.group_count; g++) group_slot[g] = -1;
-    for (uint32_t v = 0; v < m->vertex_count; v++) moved[v] = -1;
+    work w;
+    if (!build_topology(arena, m, &topo)) return mk_error_oom(err, "building mesh topology");
+    w.moved = mk_arena_array(arena, m->vertex_count, sizeof(int32_t));
+    w.vert_mark = mk_arena_array(arena, m->vertex_count, 1);
+    w.extra = mk_arena_array(arena, m->vertex_count, sizeof(uint32_t));
+    w.group_slot = mk_arena_array(arena, topo.group_count + 1u, sizeof(int32_t));
+    w.groups = mk_arena_array(arena, topo.group_count + 1u, sizeof(uint32_t));
+    w.tri_slot = mk_arena_array(arena, (size_t)m->triangle_count + 1, sizeof(int32_t));
+    w.tris = mk_arena_array(arena, (size_t)m->triangle_count + 1, sizeof(uint32_t));
+    if (!w.moved || !w.vert_mark || !w.extra || !w.group_slot || !w.groups || !w.tri_slot || !w.tris)
+        return mk_error_oom(err, "computing target normals");
+    for (uint32_t v = 0; v < m->vertex_count; v++) w.moved[v] = -1;
+    for (uint32_t g = 0; g < topo.group_count; g++) w.group_slot[g] = -1;
+    for (uint32_t t = 0; t < m->triangle_count; t++) w.tri_slot[t] = -1;
     for (uint32_t c = 0; c < raw->channel_count; c++) {
         if (raw->channels[c].mesh != mesh) continue;
         for (uint32_t k = 0; k < raw->channels[c].target_count; k++) {
             mk_raw_target *t = &raw->channels[c].targets[k];
             if (!force && t->normals) continue;
-            mk_result r = compute_target(raw, m, &topo, t, moved, group_slot, group_list, vert_mark, err);
+            mk_result r = compute_target(raw, m, &topo, t, &w, err);
             if (r) return r;
         }
     }
+    /* Work and topology memory is only needed here: give it back (lowers the import peak). */
+    void *scratch[] = { w.moved, w.vert_mark, w.extra, w.group_slot, w.groups, w.tri_slot, w.tris, topo.group_of,
+                        topo.group_vert_first, topo.group_verts, topo.group_tri_first, topo.group_tris, topo.face,
+                        topo.base_normal };
+    for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
     return MK_OK;
 }
