@@ -210,6 +210,9 @@ static mk_result compute_target(mk_raw_asset *raw, const mk_raw_mesh *m, const t
     uint32_t *indices = mk_arena_array(arena, (size_t)total + 1, sizeof(uint32_t));
     float *positions = mk_arena_array(arena, (size_t)total * 3 + 3, sizeof(float));
     float *normals = mk_arena_array(arena, (size_t)total * 3 + 3, sizeof(float));
+    /* Authored tangent deltas are kept (re-spread to the grown index set); otherwise the
+     * base tangent is re-orthogonalized against the new normal. */
+    const float *authored_tangents = t->tangents;
     float *tangents = m->tangents ? mk_arena_array(arena, (size_t)total * 3 + 3, sizeof(float)) : NULL;
     if (!indices || !positions || !normals || (m->tangents && !tangents)) return mk_error_oom(err, "computing target normals");
     /* Merge the sorted moved indices with the sorted added vertices. */
@@ -218,13 +221,16 @@ static mk_result compute_target(mk_raw_asset *raw, const mk_raw_mesh *m, const t
         int from_moved = b >= extra || (a < t->count && t->indices[a] < w->extra[b]);
         uint32_t v = from_moved ? t->indices[a] : w->extra[b];
         indices[out] = v;
+        uint32_t src = a;
         if (from_moved) memcpy(&positions[3u * out], &t->positions[3u * a++], 3 * sizeof(float));
         else b++;
         uint32_t g = topo->group_of[v];
         const float *nb = &topo->base_normal[3u * g];
         const float *nt = w->group_slot[g] >= 0 ? &group_new[3u * (uint32_t)w->group_slot[g]] : nb;
         for (int d = 0; d < 3; d++) normals[3u * out + (uint32_t)d] = nt[d] - nb[d];
-        if (tangents) {
+        if (tangents && authored_tangents) {
+            for (int d = 0; d < 3; d++) tangents[3u * out + (uint32_t)d] = from_moved ? authored_tangents[3u * src + (uint32_t)d] : 0.0f;
+        } else if (tangents) {
             const float *bt = &m->tangents[4u * v];
             float tb[3], tt[3];
             orthogonal_tangent(bt, nb, tb);

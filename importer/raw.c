@@ -3,6 +3,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include "format.h"
 #include "raw.h"
 
 void mk_raw_init(mk_raw_asset *raw, const mk_allocator *allocator)
@@ -180,10 +181,11 @@ static mk_result validate_target(const mk_raw_asset *raw, const mk_raw_channel *
     const mk_raw_target *t = &ch->targets[k];
     const mk_raw_mesh *m = &raw->meshes[ch->mesh];
     const char *cn = ch->name ? ch->name : "";
-    if (!isfinite(t->full_weight) || t->full_weight == 0.0f)
-        return mk_error_set(err, MK_ERROR_CORRUPT, UINT64_MAX, "channel %u '%s' target %u: full weight %g must be finite and nonzero",
+    if (!isfinite(t->full_weight) || fabsf(t->full_weight) < MK_MIN_FULL_WEIGHT_GAP)
+        return mk_error_set(err, MK_ERROR_CORRUPT, UINT64_MAX,
+                            "channel %u '%s' target %u: full weight %g must be finite and at least 1e-6 away from 0",
                             c, cn, k, (double)t->full_weight);
-    if (k > 0 && !(t->full_weight > ch->targets[k - 1].full_weight))
+    if (k > 0 && !(t->full_weight - ch->targets[k - 1].full_weight >= MK_MIN_FULL_WEIGHT_GAP))
         return mk_error_set(err, MK_ERROR_CORRUPT, UINT64_MAX,
                             "channel %u '%s' target %u: full weight %g does not increase (previous %g)", c, cn, k,
                             (double)t->full_weight, (double)ch->targets[k - 1].full_weight);

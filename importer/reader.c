@@ -1,6 +1,7 @@
 /* mk_read_blob: an opened .morph asset back into a raw model (deltas dequantized). Dense
- * blocks store zeros for vertices a target does not move; those are dropped again so a
- * read-back target has the sparse vertex set it was written with. */
+ * blocks store zeros for vertices a target does not move; all-zero vertices of dense blocks
+ * are dropped again (a vertex the author stored with a zero delta inside a dense block is
+ * indistinguishable from padding; sparse entries keep every stored vertex). */
 #include <stdio.h>
 #include <string.h>
 #include "blob_io.h"
@@ -36,7 +37,7 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
     const int hn = (bt->flags & MK_TARGET_HAS_NORMALS) != 0, ht = (bt->flags & MK_TARGET_HAS_TANGENTS) != 0;
     uint64_t capacity = 0;
     for (uint64_t e = 0; e < bm->entry_count; e++)
-        if (entries[e].target == local) capacity += (uint64_t)__builtin_popcountll(entries[e].mask);
+        if (entries[e].target == local) capacity += (uint64_t)mk_popcount64(entries[e].mask);
     t->indices = mk_arena_array(arena, capacity + 1, sizeof(uint32_t));
     t->positions = mk_arena_array(arena, 3 * capacity + 3, sizeof(float));
     t->normals = hn ? mk_arena_array(arena, 3 * capacity + 3, sizeof(float)) : NULL;
@@ -48,9 +49,11 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
         for (uint32_t e = block_first[b]; e < block_first[b + 1]; e++) {
             const mk_blob_entry *en = &entries[e];
             if (en->target != local) continue;
-            uint32_t m = (uint32_t)__builtin_popcountll(en->mask);
+            uint32_t m = mk_popcount64(en->mask);
             size_t attr = (size_t)m * 3 * (q ? 2 : 4);
             const uint8_t *p = a->data + bm->target_data + (size_t)en->data * MK_ALIGN;
+            uint32_t in_block = bm->vertex_count - b * MK_BLOCK_SIZE;
+            int dense = m == (in_block < MK_BLOCK_SIZE ? in_block : MK_BLOCK_SIZE);
             uint32_t j = 0;
             for (uint64_t bits = en->mask; bits; bits &= bits - 1, j++) {
                 float pv[3], nv[3] = { 0, 0, 0 }, tv[3] = { 0, 0, 0 };
@@ -61,8 +64,8 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
                     if (ht) tv[c] = decode(p + attr * (hn ? 2 : 1), q, m, c, j, bt->tangent_scale);
                     nonzero |= pv[c] != 0 || nv[c] != 0 || tv[c] != 0;
                 }
-                if (!nonzero) continue;
-                t->indices[n] = b * MK_BLOCK_SIZE + (uint32_t)__builtin_ctzll(bits);
+                if (!nonzero && dense) continue;
+                t->indices[n] = b * MK_BLOCK_SIZE + mk_ctz64(bits);
                 memcpy(&t->positions[3u * n], pv, sizeof pv);
                 if (hn) memcpy(&t->normals[3u * n], nv, sizeof nv);
                 if (ht) memcpy(&t->tangents[3u * n], tv, sizeof tv);

@@ -145,7 +145,7 @@ static void put_component_arrays(uint8_t *dst, const mk_raw_target *t, const flo
     for (int c = 0; c < 3; c++) {
         uint32_t j = 0, k = cursor;
         for (uint64_t bits = mask; bits; bits &= bits - 1, j++) {
-            uint32_t v = block * MK_BLOCK_SIZE + (uint32_t)__builtin_ctzll(bits);
+            uint32_t v = block * MK_BLOCK_SIZE + mk_ctz64(bits);
             while (k < t->count && t->indices[k] < v) k++;
             float value = (k < t->count && t->indices[k] == v) ? src[3u * k + (uint32_t)c] : 0.0f;
             if (quantized) {
@@ -213,9 +213,9 @@ static mk_result write_mesh_data(const mk_raw_asset *raw, uint32_t mi, uint32_t 
             while (end < tg->count && tg->indices[end] < start + in_block) mask |= 1ull << (tg->indices[end++] - start);
             cursor[t] = end;
             if (!mask) continue;
-            uint32_t moved = (uint32_t)__builtin_popcountll(mask);
+            uint32_t moved = mk_popcount64(mask);
             if (moved >= dense_threshold) mask = all;
-            uint32_t count = (uint32_t)__builtin_popcountll(mask);
+            uint32_t count = mk_popcount64(mask);
             const target_plan *p = &plans[t];
             int q = (p->flags & MK_TARGET_QUANTIZED) != 0;
             size_t size = (size_t)mk_entry_data_size(p->flags, count);

@@ -14,6 +14,7 @@
  *                  otherwise the parameter is solved from the time (FBX weighted tangents).
  * Before the first key the curve holds the first value, after the last key the last value.
  */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 #include "format.h"
@@ -59,13 +60,15 @@ static float segment_value(const mk_key *k0, const mk_key *k1, double time)
     double u = s;
     if (fabs(wr - 1.0 / 3.0) > 1e-6 || fabs(wl - 1.0 / 3.0) > 1e-6)
         u = solve_bezier_parameter(wr, 1.0 - wl, s);
-    return (float)bezier1(k0->value, p1, p2, k1->value, u);
+    /* Steep finite slopes can exceed float range: saturate so sampling stays finite. */
+    double v = bezier1(k0->value, p1, p2, k1->value, u);
+    return (float)(v > FLT_MAX ? FLT_MAX : v < -FLT_MAX ? -FLT_MAX : v);
 }
 
 /* Index k of the segment with keys[k].time <= time < keys[k+1].time (count >= 2, time inside). */
 static uint32_t find_segment(const mk_key *keys, uint32_t count, double time, uint32_t *cursor)
 {
-    if (cursor && *cursor + 1 < count) {
+    if (cursor && *cursor < count - 1) {   /* count >= 2 here; no wrap for any cursor value */
         uint32_t c = *cursor;
         if (keys[c].time <= time && time < keys[c + 1].time) return c;
         if (c + 2 < count && keys[c + 1].time <= time && time < keys[c + 2].time) return *cursor = c + 1;
@@ -126,6 +129,7 @@ mk_result mk_sample_run(const mk_sample_job *job, mk_error *err)
     if (job->loop && clip->duration > 0) {
         double local = fmod(time - clip->start, clip->duration);
         if (local < 0) local += clip->duration;
+        if (local >= clip->duration) local = 0;   /* rounding of a tiny negative remainder */
         time = clip->start + local;
     }
     for (uint32_t c = 0; c < a->channel_count; c++) job->weights[c] = a->channels[c].default_weight;

@@ -32,6 +32,12 @@ static void channel_span_strided(const float *full_weights, size_t stride, uint3
 {
     /* Key points sorted by full weight with the implicit zero key inserted after the
      * negative ones: virtual index j -> (weight, target), target -1 = the zero key. */
+    if (count == 0) {       /* no targets: D(w) = 0 */
+        *ia = *ib = -1;
+        *ca = *cb = 0.0f;
+        if (t_out) *t_out = 0.0f;
+        return;
+    }
     uint32_t zero = 0;
     while (zero < count && full_weight_at(full_weights, stride, zero) < 0) zero++;
 #define KEY_W(j) ((j) < zero ? full_weight_at(full_weights, stride, (j)) \
@@ -209,25 +215,9 @@ static void compute_coefficients(frame *f, const mk_eval_job *job, mk_stacking s
  * baseline ISA and for x86-64-v3 (AVX2, FMA, BMI, POPCNT), picked once at load time by feature
  * level, not CPU model ("arch=haswell" would check the model and never match an AMD CPU),
  * (GCC/Clang target_clones through a glibc ifunc). The helpers it calls are force-inlined so each
- * clone gets its own vector code. Define MK_NO_TARGET_CLONES to build one baseline copy. */
-#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__GLIBC__) && \
-    !defined(MK_NO_TARGET_CLONES) && !defined(__SANITIZE_ADDRESS__)
-#define MK_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
-#else
-#define MK_CLONES
-#endif
-#if defined(__GNUC__) || defined(__clang__)
-#define MK_INLINE static inline __attribute__((always_inline))
-#else
-#define MK_INLINE static inline
-#endif
-
-/* The block loop is compiled twice where the compiler and platform allow it: for the
- * baseline ISA and for x86-64-v3 (AVX2, FMA, BMI, POPCNT), picked once at load time by feature
- * level, not CPU model ("arch=haswell" would check the model and never match an AMD CPU),
- * (GCC/Clang target_clones through a glibc ifunc). The helpers it calls are force-inlined so each
- * clone gets its own vector code. Define MK_NO_TARGET_CLONES to build one baseline copy. */
-#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && defined(__GLIBC__) && \
+ * clone gets its own vector code. Define MK_NO_TARGET_CLONES to build one baseline copy.
+ * GCC only: clang 14 emits the resolver as a global symbol. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__GLIBC__) && \
     !defined(MK_NO_TARGET_CLONES) && !defined(__SANITIZE_ADDRESS__)
 #define MK_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
@@ -263,7 +253,7 @@ MK_INLINE void add_q16(float (*acc)[MK_BLOCK_SIZE], uint64_t mask, uint32_t m, c
         return;
     }
     for (uint32_t j = 0; mask; j++, mask &= mask - 1) {
-        unsigned i = (unsigned)__builtin_ctzll(mask);
+        unsigned i = (unsigned)mk_ctz64(mask);
         acc[0][i] += factor * (float)src[j];
         acc[1][i] += factor * (float)src[m + j];
         acc[2][i] += factor * (float)src[2 * m + j];
@@ -281,7 +271,7 @@ MK_INLINE void add_f32(float (*acc)[MK_BLOCK_SIZE], uint64_t mask, uint32_t m, c
         return;
     }
     for (uint32_t j = 0; mask; j++, mask &= mask - 1) {
-        unsigned i = (unsigned)__builtin_ctzll(mask);
+        unsigned i = (unsigned)mk_ctz64(mask);
         acc[0][i] += factor * src[j];
         acc[1][i] += factor * src[m + j];
         acc[2][i] += factor * src[2 * m + j];
@@ -328,7 +318,7 @@ static void add_slerp_normals(float (*acc_n)[MK_BLOCK_SIZE], const float (*delta
                               const float *base_normals, uint32_t block_start)
 {
     for (; touched; touched &= touched - 1) {
-        unsigned i = (unsigned)__builtin_ctzll(touched);
+        unsigned i = (unsigned)mk_ctz64(touched);
         const float *bn = base_normals + 3u * (block_start + i);
         float base[3] = { bn[0], bn[1], bn[2] };
         normalize3(base, bn);
@@ -465,7 +455,7 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
             float c = f.coef[en->target];
             if (c == 0.0f) continue;
             const mk_blob_target *tg = &f.targets[en->target];
-            const uint32_t count = (uint32_t)__builtin_popcountll(en->mask);
+            const uint32_t count = mk_popcount64(en->mask);
             const int q = (tg->flags & MK_TARGET_QUANTIZED) != 0;
             const uint8_t *p = data + (size_t)en->data * MK_ALIGN;
             p = add_attribute(&acc[PX], en->mask, count, p, q, c * (q ? tg->position_scale : 1.0f));

@@ -128,6 +128,34 @@ typedef struct mk_blob_track {
     uint32_t reserved;
 } mk_blob_track;                   /* 16 bytes */
 
+/* Smallest |full weight| and smallest gap between a channel's key points (including the
+ * implicit 0): keeps span parameters finite for any reasonable weight. */
+#define MK_MIN_FULL_WEIGHT_GAP 1e-6f
+
+/* Bit helpers with a portable fallback (the runtime must build with any C11 compiler). */
+static inline uint32_t mk_popcount64(uint64_t x)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return (uint32_t)__builtin_popcountll(x);
+#else
+    uint32_t n = 0;
+    while (x) { x &= x - 1; n++; }
+    return n;
+#endif
+}
+
+/* Index of the lowest set bit; x must be nonzero. */
+static inline unsigned mk_ctz64(uint64_t x)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return (unsigned)__builtin_ctzll(x);
+#else
+    unsigned n = 0;
+    while (!(x & 1)) { x >>= 1; n++; }
+    return n;
+#endif
+}
+
 /* 64-bit checksum (documented in docs/format.md). */
 uint64_t mk_checksum(const void *data, uint64_t size);
 

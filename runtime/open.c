@@ -92,16 +92,6 @@ static int all_finite(const float *p, uint64_t n)
 
 static int valid_string(const mk_asset *a, uint32_t offset) { return offset < a->strings_size; }
 
-static unsigned popcount64(uint64_t x)
-{
-#if defined(__GNUC__)
-    return (unsigned)__builtin_popcountll(x);
-#else
-    unsigned n = 0;
-    while (x) { x &= x - 1; n++; }
-    return n;
-#endif
-}
 
 static mk_result validate_sections(validator *v, mk_asset *a)
 {
@@ -190,11 +180,11 @@ static mk_result validate_channels_and_targets(validator *v, const mk_asset *a)
                 return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": channel index does not match");
             if (!valid_string(a, tg->name))
                 return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": name string out of range");
-            if (!isfinite(tg->full_weight) || tg->full_weight == 0.0f)
-                return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": full weight is zero or not finite");
-            if (k > 0 && !(tg->full_weight > a->targets[t - 1].full_weight))
+            if (!isfinite(tg->full_weight) || fabsf(tg->full_weight) < MK_MIN_FULL_WEIGHT_GAP)
+                return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": full weight is (nearly) zero or not finite");
+            if (k > 0 && !(tg->full_weight - a->targets[t - 1].full_weight >= MK_MIN_FULL_WEIGHT_GAP))
                 return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t,
-                            ": full weights of a channel must be strictly increasing");
+                            ": full weights of a channel must increase (by at least 1e-6)");
             if (tg->flags & ~7u)
                 return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": unknown flags");
             if (((tg->flags & MK_TARGET_HAS_NORMALS) && !(m->flags & MK_MESH_HAS_NORMALS))
@@ -231,10 +221,13 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
     const mk_blob_entry *entries = (const mk_blob_entry *)(v->data + m->entries);
     if (first[0] != 0 || first[m->block_count] != m->entry_count)
         return fail(v->err, MK_ERROR_CORRUPT, m->block_entries, "mesh ", mi, ": block table does not span the entries");
-    for (uint32_t b = 0; b < m->block_count; b++) {
+    /* The whole table first: non-decreasing (so every value is <= entry_count) before any
+     * block's entries are read. */
+    for (uint32_t b = 0; b < m->block_count; b++)
         if (first[b + 1] < first[b])
             return fail(v->err, MK_ERROR_CORRUPT, m->block_entries + 4ull * b, "mesh ", mi,
                         ": block table is not increasing");
+    for (uint32_t b = 0; b < m->block_count; b++) {
         uint32_t in_block = m->vertex_count - b * MK_BLOCK_SIZE;
         if (in_block > MK_BLOCK_SIZE) in_block = MK_BLOCK_SIZE;
         uint64_t allowed = in_block == 64 ? ~0ull : ((1ull << in_block) - 1);
@@ -248,7 +241,7 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
             if (en->mask == 0 || (en->mask & ~allowed))
                 return fail(v->err, MK_ERROR_CORRUPT, at, "entry ", e, ": vertex mask is empty or past the mesh end");
             const mk_blob_target *tg = &a->targets[m->first_target + en->target];
-            uint32_t count = popcount64(en->mask);
+            uint32_t count = mk_popcount64(en->mask);
             uint64_t bytes = mk_entry_data_size(tg->flags, count);
             uint64_t offset = (uint64_t)en->data * MK_ALIGN;
             if (offset > m->target_data_size || bytes > m->target_data_size - offset)
@@ -273,7 +266,7 @@ static mk_result validate_meshes(validator *v, const mk_asset *a)
             return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": name string out of range");
         if (m->vertex_count == 0)
             return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": has no vertices");
-        if (m->block_count != (m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE)
+        if ((uint64_t)m->block_count != ((uint64_t)m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE)
             return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": block count does not match vertex count");
         if (m->first_channel != next_channel || m->channel_count > a->channel_count - next_channel)
             return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": channel range does not follow the previous mesh's");
@@ -325,8 +318,10 @@ static mk_result validate_clips(validator *v, const mk_asset *a)
         uint64_t at = (uint64_t)((const uint8_t *)c - v->data);
         if (!valid_string(a, c->name))
             return fail(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": name string out of range");
-        if (c->first_track > a->track_count || c->track_count > a->track_count - c->first_track)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": track range out of bounds");
+        /* Clips tile the track table in order, so every track is validated once. */
+        uint32_t expected_track = i == 0 ? 0 : a->clips[i - 1].first_track + a->clips[i - 1].track_count;
+        if (c->first_track != expected_track || c->track_count > a->track_count - c->first_track)
+            return fail(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": track range does not follow the previous clip's");
         if (!isfinite(c->start) || !isfinite(c->duration) || c->duration < 0)
             return fail(v->err, MK_ERROR_NOT_FINITE, at, "clip ", i, ": start or duration is not finite or negative");
     }
@@ -335,8 +330,10 @@ static mk_result validate_clips(validator *v, const mk_asset *a)
         uint64_t at = (uint64_t)((const uint8_t *)t - v->data);
         if (t->channel >= a->channel_count)
             return fail(v->err, MK_ERROR_CORRUPT, at, "track ", i, ": channel index out of range");
-        if (t->key_count == 0 || t->first_key > a->key_count || t->key_count > a->key_count - t->first_key)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "track ", i, ": key range out of bounds or empty");
+        /* Tracks tile the key table in order, so every key is validated once (O(size)). */
+        uint32_t expected_key = i == 0 ? 0 : a->tracks[i - 1].first_key + a->tracks[i - 1].key_count;
+        if (t->key_count == 0 || t->first_key != expected_key || t->key_count > a->key_count - t->first_key)
+            return fail(v->err, MK_ERROR_CORRUPT, at, "track ", i, ": key range empty or not following the previous track's");
         for (uint32_t k = 0; k < t->key_count; k++) {
             const mk_key *key = &a->keys[t->first_key + k];
             uint64_t kat = (uint64_t)((const uint8_t *)key - v->data);

@@ -213,7 +213,7 @@ static double frame_bytes(const mk_asset *a, const float *weights, int normals)
             if (!active[e[k].target]) continue;
             uint32_t flags = a->targets[m->first_target + e[k].target].flags;
             if (!normals) flags &= ~(uint32_t)(MK_TARGET_HAS_NORMALS | MK_TARGET_HAS_TANGENTS);
-            bytes += (double)mk_entry_data_size(flags, (uint32_t)__builtin_popcountll(e[k].mask));
+            bytes += (double)mk_entry_data_size(flags, mk_popcount64(e[k].mask));
         }
         int with_normals = normals && (m->flags & MK_MESH_HAS_NORMALS);
         bytes += (double)m->vertex_count * 12.0 * 2 * (with_normals ? 2 : 1);

@@ -173,11 +173,12 @@ static void compare_mesh(const mk_asset *a, uint32_t mi, const float *weights, c
         if (ref_nrm && nrm) {
             const float *rn = &ref_nrm[3 * r], *n = &nrm[3 * v];
             double rl = sqrt((double)rn[0] * rn[0] + (double)rn[1] * rn[1] + (double)rn[2] * rn[2]);
+            double nl = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
             if (rl > 1e-12) {
-                double dot = ((double)n[0] * rn[0] + (double)n[1] * rn[1] + (double)n[2] * rn[2]) / rl;
+                double dot = ((double)n[0] * rn[0] + (double)n[1] * rn[1] + (double)n[2] * rn[2]) / (rl * nl);
                 dot = dot > 1 ? 1 : dot < -1 ? -1 : dot;
                 double angle = acos(dot) * 180.0 / 3.14159265358979323846;
-                if (angle > res->normal_error_deg) res->normal_error_deg = angle;
+                if (!(angle <= res->normal_error_deg)) res->normal_error_deg = angle;  /* NaN fails closed */
             }
         }
     }

@@ -203,6 +203,40 @@ static void patch_data_offset(unsigned char *b, mk_asset *a)
     e->data = 0xFFFFFFF0u;
 }
 
+static void patch_overlapping_tracks(unsigned char *b, mk_asset *a)
+{
+    (void)b;
+    mk_blob_track *t = (mk_blob_track *)(uintptr_t)a->tracks;
+    t[1].first_key = 0;            /* shares track 0's keys: validation must stay O(size) */
+}
+static void patch_tiny_full_weight(unsigned char *b, mk_asset *a)
+{
+    (void)b;
+    ((mk_blob_target *)(uintptr_t)&a->targets[4])->full_weight = 1e-42f;   /* spans would overflow */
+}
+
+/* A block table whose middle value points past the entries must be rejected before any
+ * block's entries are read (ASan catches the read otherwise). */
+static void test_block_table_checked_first(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_line(&raw, 200, 3, 2);
+    size_t size;
+    unsigned char *blob = fixture_blob(&raw, MK_PRECISION_FLOAT, &raw.arena, &size);
+    unsigned char *copy = exact_copy(blob, size);
+    mk_asset a;
+    mk_error err;
+    CHECK(mk_asset_open(copy, size, &a, &err) == MK_OK);
+    uint32_t *first = (uint32_t *)(uintptr_t)(a.data + a.meshes[0].block_entries);
+    first[1] = 1000000;
+    rechecksum(copy, size);
+    CHECK(mk_asset_open(copy, size, &a, &err) == MK_ERROR_CORRUPT);
+    CHECK(strstr(err.message, "block table") != NULL);
+    free(copy);
+    mk_raw_free(&raw);
+}
+
 static void test_targeted_corruptions(void)
 {
     expect_corrupt(patch_magic, MK_ERROR_BAD_MAGIC, "magic");
@@ -215,6 +249,8 @@ static void test_targeted_corruptions(void)
     expect_corrupt(patch_key_order, MK_ERROR_CORRUPT, "key order");
     expect_corrupt(patch_mask, MK_ERROR_CORRUPT, "mask past mesh end");
     expect_corrupt(patch_data_offset, MK_ERROR_CORRUPT, "entry data offset");
+    expect_corrupt(patch_overlapping_tracks, MK_ERROR_CORRUPT, "overlapping key ranges");
+    expect_corrupt(patch_tiny_full_weight, MK_ERROR_CORRUPT, "subnormal full weight");
 }
 
 static void test_alignment_and_arguments(void)
@@ -237,4 +273,5 @@ static void test_alignment_and_arguments(void)
 }
 
 CHECK_MAIN(CASE(test_valid_blob_opens), CASE(test_every_truncation), CASE(test_random_flips_fail_checksum),
-           CASE(test_random_flips_with_checksum), CASE(test_targeted_corruptions), CASE(test_alignment_and_arguments))
+           CASE(test_random_flips_with_checksum), CASE(test_targeted_corruptions), CASE(test_block_table_checked_first),
+           CASE(test_alignment_and_arguments))

@@ -83,6 +83,8 @@ static void test_cursor_matches_search(void)
         float t = (float)i * 0.01f;
         same &= mk_curve_eval(k, 50, t, &cursor) == mk_curve_eval(k, 50, t, NULL);
     }
+    cursor = UINT32_MAX;                          /* must not wrap into keys[UINT32_MAX] */
+    same &= mk_curve_eval(k, 50, 2.05, &cursor) == mk_curve_eval(k, 50, 2.05, NULL);
     cursor = 12345;                               /* a garbage cursor is ignored */
     /* Time is double: an instant just before a step key still gets the previous value. */
     mk_key st[2] = { key(0, 1, MK_INTERP_CONSTANT), key(3.9f, 2, MK_INTERP_CONSTANT) };
@@ -90,6 +92,21 @@ static void test_cursor_matches_search(void)
     CHECK_NEAR(mk_curve_eval(st, 2, (double)3.9f, NULL), 2, 0);
     same &= mk_curve_eval(k, 50, 2.05f, &cursor) == mk_curve_eval(k, 50, 2.05f, NULL);
     CHECK(same);
+}
+
+static void test_steep_slopes_stay_finite(void)
+{
+    mk_key k[2] = { key(0, 0, MK_INTERP_CUBIC), key(100, 0, MK_INTERP_CUBIC) };
+    k[0].right_slope = 3e38f;
+    CHECK(isfinite(mk_curve_eval(k, 2, 50.0, NULL)));
+}
+
+static void test_span_without_targets(void)
+{
+    int32_t ia = 7, ib = 7;
+    float ca = 1, cb = 1, t = 1;
+    mk_channel_span(NULL, 0, 0.5f, &ia, &ca, &ib, &cb, &t);
+    CHECK(ia == -1 && ib == -1 && ca == 0 && cb == 0);
 }
 
 static void test_sample_job(void)
@@ -124,4 +141,5 @@ static void test_sample_job(void)
 }
 
 CHECK_MAIN(CASE(test_constant_linear), CASE(test_clamp_outside), CASE(test_hermite), CASE(test_weighted_bezier),
-           CASE(test_cursor_matches_search), CASE(test_sample_job))
+           CASE(test_cursor_matches_search), CASE(test_steep_slopes_stay_finite),
+           CASE(test_span_without_targets), CASE(test_sample_job))
