@@ -354,39 +354,46 @@ MK_INLINE void normalize_rows(float *restrict x, float *restrict y, float *restr
     }
 }
 
-/* Adds the base (stride floats per vertex, xyz first) to three planar rows, keeping a planar
- * copy of the base for the normalization fallback. */
-MK_INLINE void add_base(float *restrict x, float *restrict y, float *restrict z, float (*restrict copy)[MK_BLOCK_SIZE],
-                     const float *restrict base, size_t stride, size_t lo, size_t hi)
+/* Loads three planar rows from an xyz-first base array (stride floats per vertex). */
+MK_INLINE void load_rows(float *restrict x, float *restrict y, float *restrict z, const float *restrict base,
+                         size_t stride, size_t lo, size_t hi)
 {
     for (size_t i = lo; i < hi; i++) {
-        copy[0][i] = base[stride * i];
-        copy[1][i] = base[stride * i + 1];
-        copy[2][i] = base[stride * i + 2];
-        x[i] += copy[0][i];
-        y[i] += copy[1][i];
-        z[i] += copy[2][i];
+        x[i] = base[stride * i];
+        y[i] = base[stride * i + 1];
+        z[i] = base[stride * i + 2];
     }
 }
 
-/* acc becomes the final planar outputs: positions = base + d, normals/tangents normalized. */
-MK_INLINE void finish_block(block_acc acc, size_t lo, size_t hi, const float *restrict base_p,
-                         const float *restrict base_n, const float *restrict base_t)
+/* The accumulator starts as the base (so no zeroing pass and no separate base add);
+ * normals/tangents also keep a planar copy of the base for the normalization fallback.
+ * Lanes outside [lo, hi) are zeroed: they may lie past the mesh end. */
+MK_INLINE void init_block(block_acc acc, int rows, size_t lo, size_t hi, const float *restrict base_p,
+                          const float *restrict base_n, const float *restrict base_t,
+                          float (*restrict copy_n)[MK_BLOCK_SIZE], float (*restrict copy_t)[MK_BLOCK_SIZE])
 {
-    for (size_t i = lo; i < hi; i++) {
-        acc[PX][i] += base_p[3 * i];
-        acc[PY][i] += base_p[3 * i + 1];
-        acc[PZ][i] += base_p[3 * i + 2];
+    if (lo != 0 || hi != MK_BLOCK_SIZE) {
+        memset(acc, 0, sizeof(float) * MK_BLOCK_SIZE * (size_t)rows);
+        if (base_n) memset(copy_n, 0, sizeof(float) * 3 * MK_BLOCK_SIZE);
+        if (base_t) memset(copy_t, 0, sizeof(float) * 3 * MK_BLOCK_SIZE);
     }
-    float base[3][MK_BLOCK_SIZE];
+    load_rows(acc[PX], acc[PY], acc[PZ], base_p, 3, lo, hi);
     if (base_n) {
-        add_base(acc[NX], acc[NY], acc[NZ], base, base_n, 3, lo, hi);
-        normalize_rows(acc[NX], acc[NY], acc[NZ], base[0], base[1], base[2], lo, hi);
+        load_rows(copy_n[0], copy_n[1], copy_n[2], base_n, 3, lo, hi);
+        memcpy(acc[NX], copy_n, sizeof(float) * 3 * MK_BLOCK_SIZE);
     }
     if (base_t) {
-        add_base(acc[TX], acc[TY], acc[TZ], base, base_t, 4, lo, hi);
-        normalize_rows(acc[TX], acc[TY], acc[TZ], base[0], base[1], base[2], lo, hi);
+        load_rows(copy_t[0], copy_t[1], copy_t[2], base_t, 4, lo, hi);
+        memcpy(acc[TX], copy_t, sizeof(float) * 3 * MK_BLOCK_SIZE);
     }
+}
+
+/* acc (base + deltas) becomes the final planar outputs: normals/tangents normalized. */
+MK_INLINE void finish_block(block_acc acc, size_t lo, size_t hi, float (*copy_n)[MK_BLOCK_SIZE],
+                            float (*copy_t)[MK_BLOCK_SIZE], int normals, int tangents)
+{
+    if (normals) normalize_rows(acc[NX], acc[NY], acc[NZ], copy_n[0], copy_n[1], copy_n[2], lo, hi);
+    if (tangents) normalize_rows(acc[TX], acc[TY], acc[TZ], copy_t[0], copy_t[1], copy_t[2], lo, hi);
 }
 
 /* Interleaves three planar rows into a strided xyz output. Tightly packed outputs (stride
@@ -442,12 +449,17 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
                  ts = stride_or(job->tangents_stride, 16);
 
     block_acc acc;
+    float copy_n[3][MK_BLOCK_SIZE], copy_t[3][MK_BLOCK_SIZE];
     float slerp_a[3][MK_BLOCK_SIZE], slerp_b[3][MK_BLOCK_SIZE];
     const uint32_t block_end = (end + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
     for (uint32_t b = first / MK_BLOCK_SIZE; b < block_end; b++) {
         const uint32_t block_start = b * MK_BLOCK_SIZE;
         const int rows = want_tangents ? ACC_ROWS : want_normals ? TX : NX;
-        memset(acc, 0, sizeof(float) * MK_BLOCK_SIZE * (size_t)rows);
+        const uint32_t lo = block_start > first ? block_start : first;
+        const uint32_t hi = block_start + MK_BLOCK_SIZE < end ? block_start + MK_BLOCK_SIZE : end;
+        init_block(acc, rows, lo - block_start, hi - block_start, base_p + 3u * (size_t)block_start,
+                   want_normals ? base_n + 3u * (size_t)block_start : NULL,
+                   want_tangents ? base_t + 4u * (size_t)block_start : NULL, copy_n, copy_t);
         int32_t open_channel = -1;          /* slerp channel whose deltas are being gathered */
         uint64_t touched = 0;
         for (uint32_t e = block_first[b]; e < block_first[b + 1]; e++) {
@@ -492,11 +504,7 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
 
         /* Write each output vertex of the block once: finish in planar form (vectorizable),
          * then interleave into the caller's strided buffers. */
-        uint32_t lo = block_start > first ? block_start : first;
-        uint32_t hi = block_start + MK_BLOCK_SIZE < end ? block_start + MK_BLOCK_SIZE : end;
-        finish_block(acc, lo - block_start, hi - block_start, base_p + 3u * (size_t)block_start,
-                     want_normals ? base_n + 3u * (size_t)block_start : NULL,
-                     want_tangents ? base_t + 4u * (size_t)block_start : NULL);
+        finish_block(acc, lo - block_start, hi - block_start, copy_n, copy_t, want_normals, want_tangents);
         store_block(acc, lo - block_start, hi - block_start, (uint8_t *)job->positions + (size_t)(lo - first) * ps, ps,
                     want_normals ? (uint8_t *)job->normals + (size_t)(lo - first) * ns : NULL, ns,
                     want_tangents ? (uint8_t *)job->tangents + (size_t)(lo - first) * ts : NULL, ts,
