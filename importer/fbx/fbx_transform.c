@@ -23,18 +23,6 @@ static void identity(double m[16])
     m[0] = m[5] = m[10] = m[15] = 1.0;
 }
 
-static void multiply(double out[16], const double a[16], const double b[16])
-{
-    double r[16];
-    for (int c = 0; c < 4; c++)
-        for (int row = 0; row < 4; row++) {
-            double s = 0;
-            for (int k = 0; k < 4; k++) s += a[k * 4 + row] * b[c * 4 + k];
-            r[c * 4 + row] = s;
-        }
-    memcpy(out, r, sizeof r);
-}
-
 static void translation(double m[16], const double t[3], double sign)
 {
     identity(m);
@@ -73,7 +61,7 @@ static void euler(double m[16], const double degrees[3], int order)
         int axis = sequence[order][k];
         double r[16];
         axis_rotation(r, axis, degrees[axis]);
-        multiply(m, r, m);  /* later rotations multiply on the left */
+        mk_mat4d_multiply(m, r, m);  /* later rotations multiply on the left */
     }
 }
 
@@ -145,20 +133,20 @@ void fbx_model_transforms(const fbx_node *model, double local[16], double geomet
     }
     double m[16], x[16];
     translation(local, t, 1);
-    translation(x, roff, 1); multiply(local, local, x);
-    translation(x, rp, 1); multiply(local, local, x);
-    euler(x, pre, 0); multiply(local, local, x);
-    euler(x, r, (int)order); multiply(local, local, x);
-    euler(x, post, 0); transpose3(x); multiply(local, local, x);
-    translation(x, rp, -1); multiply(local, local, x);
-    translation(x, soff, 1); multiply(local, local, x);
-    translation(x, sp, 1); multiply(local, local, x);
-    scaling(x, s); multiply(local, local, x);
-    translation(x, sp, -1); multiply(local, local, x);
+    translation(x, roff, 1); mk_mat4d_multiply(local, local, x);
+    translation(x, rp, 1); mk_mat4d_multiply(local, local, x);
+    euler(x, pre, 0); mk_mat4d_multiply(local, local, x);
+    euler(x, r, (int)order); mk_mat4d_multiply(local, local, x);
+    euler(x, post, 0); transpose3(x); mk_mat4d_multiply(local, local, x);
+    translation(x, rp, -1); mk_mat4d_multiply(local, local, x);
+    translation(x, soff, 1); mk_mat4d_multiply(local, local, x);
+    translation(x, sp, 1); mk_mat4d_multiply(local, local, x);
+    scaling(x, s); mk_mat4d_multiply(local, local, x);
+    translation(x, sp, -1); mk_mat4d_multiply(local, local, x);
 
     translation(geometric, gt, 1);
-    euler(m, gr, 0); multiply(geometric, geometric, m);
-    scaling(m, gs); multiply(geometric, geometric, m);
+    euler(m, gr, 0); mk_mat4d_multiply(geometric, geometric, m);
+    scaling(m, gs); mk_mat4d_multiply(geometric, geometric, m);
 }
 
 int fbx_model_inherit_type(const fbx_node *model)
@@ -176,7 +164,7 @@ void fbx_model_scaling(const fbx_node *model, double out[3])
 
 void fbx_mat_multiply(double out[16], const double a[16], const double b[16])
 {
-    multiply(out, a, b);
+    mk_mat4d_multiply(out, a, b);
 }
 
 void fbx_mat_identity(double m[16])

@@ -31,18 +31,6 @@ typedef struct importer {
 
 /* ---- transforms ---- */
 
-static void mat_mul(const double a[16], const double b[16], double o[16])
-{
-    double r[16];
-    for (int c = 0; c < 4; c++)
-        for (int row = 0; row < 4; row++) {
-            double s = 0;
-            for (int k = 0; k < 4; k++) s += a[k * 4 + row] * b[c * 4 + k];
-            r[c * 4 + row] = s;
-        }
-    memcpy(o, r, sizeof r);
-}
-
 /* Local matrix of a node: `matrix`, else T * R * S (spec §3.5.3), column-major. */
 static void node_local(const mk_gltf_node *n, double m[16])
 {
@@ -82,7 +70,7 @@ static mk_result compute_world(importer *im, mk_error *err)
             if (++steps > n) return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "node %u: the node hierarchy has a cycle", i);
             double pm[16];
             node_local(&d->nodes[p], pm);
-            mat_mul(pm, m, m);
+            mk_mat4d_multiply(m, pm, m);
         }
         memcpy(im->world[i], m, sizeof m);
     }
