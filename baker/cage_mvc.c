@@ -180,12 +180,12 @@ mk_result mk_cage_bind(const mk_raw_mesh *mesh, const mk_cage *cage, const mk_al
     if (!b->weights || !b->moves) { mk_arena_free_all(&arena); return mk_error_oom(err, "cage binding"); }
     b->mesh = mesh;
     b->cage_vertices = cage->vertex_count;
-    double lo[3], hi[3];
+    double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
     for (size_t j = 0; j < m; j++)
         for (int c = 0; c < 3; c++) {
             double v = cage->rest[3 * j + (size_t)c];
-            if (j == 0 || v < lo[c]) lo[c] = v;
-            if (j == 0 || v > hi[c]) hi[c] = v;
+            if (v < lo[c]) lo[c] = v;
+            if (v > hi[c]) hi[c] = v;
             b->moves[3 * j + (size_t)c] = cage->deformed[3 * j + (size_t)c] - v;
         }
     double diag[3] = { hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2] };
