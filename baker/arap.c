@@ -67,26 +67,40 @@ static void eigen_max4(double A[4][4], double q[4])
     for (int k = 0; k < 4; k++) q[k] = V[k][best];
 }
 
-/* Rotation R (row-major) maximizing tr(R S) for S = sum w e e'^T (rest e, deformed e'). */
-static void best_rotation(const double S[9], double R[9])
+/* Horn's symmetric 4x4 matrix of S: its top eigenvector is the quaternion of the rotation
+ * maximizing tr(R S). */
+static void horn_matrix(const double S[9], double N[4][4])
 {
     double sxx = S[0], sxy = S[1], sxz = S[2], syx = S[3], syy = S[4], syz = S[5],
            szx = S[6], szy = S[7], szz = S[8];
-    double N[4][4] = {
+    double m[4][4] = {
         { sxx + syy + szz, syz - szy, szx - sxz, sxy - syx },
         { syz - szy, sxx - syy - szz, sxy + syx, szx + sxz },
         { szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy },
         { sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz },
     };
-    double q[4];
-    eigen_max4(N, q);
-    double w = q[0], x = q[1], y = q[2], z = q[3];
-    double l = sqrt(w * w + x * x + y * y + z * z);
+    memcpy(N, m, sizeof m);
+}
+
+/* Row-major rotation of quaternion q = (w, x, y, z), normalized here; identity if q is 0. */
+static void quaternion_rotation(const double q[4], double R[9])
+{
+    double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     if (!(l > 0)) { memset(R, 0, 9 * sizeof(double)); R[0] = R[4] = R[8] = 1; return; }
-    w /= l; x /= l; y /= l; z /= l;
+    double w = q[0] / l, x = q[1] / l, y = q[2] / l, z = q[3] / l;
     R[0] = 1 - 2 * (y * y + z * z); R[1] = 2 * (x * y - w * z);     R[2] = 2 * (x * z + w * y);
     R[3] = 2 * (x * y + w * z);     R[4] = 1 - 2 * (x * x + z * z); R[5] = 2 * (y * z - w * x);
     R[6] = 2 * (x * z - w * y);     R[7] = 2 * (y * z + w * x);     R[8] = 1 - 2 * (x * x + y * y);
+}
+
+/* Rotation R (row-major) maximizing tr(R S) for S = sum w e e'^T (rest e, deformed e'). */
+static void best_rotation(const double S[9], double R[9])
+{
+    double N[4][4];
+    horn_matrix(S, N);
+    double q[4];
+    eigen_max4(N, q);
+    quaternion_rotation(q, R);
 }
 
 /* Global step: rhs from the rotations (NULL = identity), solve, write s->solution. */
@@ -149,14 +163,8 @@ static double det3(double a, double b, double c, double d, double e, double f, d
  * (a repeated top eigenvalue, e.g. a vertex whose one-ring collapsed) use the Jacobi solver. */
 static void fit_rotation(const double S[9], double R[9])
 {
-    double sxx = S[0], sxy = S[1], sxz = S[2], syx = S[3], syy = S[4], syz = S[5],
-           szx = S[6], szy = S[7], szz = S[8];
-    double N[4][4] = {
-        { sxx + syy + szz, syz - szy, szx - sxz, sxy - syx },
-        { syz - szy, sxx - syy - szz, sxy + syx, szx + sxz },
-        { szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy },
-        { sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz },
-    };
+    double N[4][4];
+    horn_matrix(S, N);
     /* N is symmetric and traceless: det(lambda I - N) = l^4 + c2 l^2 + c1 l + c0 with
      * c2 = -tr(N^2)/2, c1 = -tr(N^3)/3, c0 = det N (Newton's identities). */
     double N2[4][4], p2 = 0, p3 = 0;
@@ -216,12 +224,7 @@ static void fit_rotation(const double S[9], double R[9])
         best_rotation(S, R);
         return;
     }
-    double inv = 1 / sqrt(best_norm);
-    double q[4] = { best[0] * inv, best[1] * inv, best[2] * inv, best[3] * inv };
-    double w = q[0], x = q[1], y = q[2], z = q[3];
-    R[0] = 1 - 2 * (y * y + z * z); R[1] = 2 * (x * y - w * z);     R[2] = 2 * (x * z + w * y);
-    R[3] = 2 * (x * y + w * z);     R[4] = 1 - 2 * (x * x + z * z); R[5] = 2 * (y * z - w * x);
-    R[6] = 2 * (x * z - w * y);     R[7] = 2 * (y * z + w * x);     R[8] = 1 - 2 * (x * x + y * y);
+    quaternion_rotation(best, R);
 }
 
 static void local_step(mk_surface_edit *s)

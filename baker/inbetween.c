@@ -159,6 +159,21 @@ static double verify_grid(sampler *s, const float *full, float *const *key_delta
     return worst;
 }
 
+/* Does the deformation move vertex v (position beyond eps_p, or normal/tangent beyond eps_n)?
+ * nrm/tan NULL when the target stores none. */
+static int vertex_moved(const mk_raw_mesh *mesh, size_t v, const double *pos, const double *nrm, const double *tan,
+                        double eps_p, double eps_n)
+{
+    double dp[3], dn = 0, dt = 0;
+    for (int c = 0; c < 3; c++) {
+        size_t i = 3 * v + (size_t)c;
+        dp[c] = pos[i] - mesh->positions[i];
+        if (nrm) dn = fmax(dn, fabs(nrm[i] - mesh->normals[i]));
+        if (tan) dt = fmax(dt, fabs(tan[i] - mesh->tangents[4 * v + (size_t)c]));
+    }
+    return mk_len3(dp) > eps_p || dn > eps_n || dt > eps_n;
+}
+
 static mk_result write_target(mk_raw_asset *raw, mk_raw_channel *channel, uint32_t mesh_index,
                               const mk_deformer *deformer, double weight, const char *name,
                               double diagonal, const float *deltas, double *pos, double *nrm,
@@ -188,14 +203,7 @@ static mk_result write_target(mk_raw_asset *raw, mk_raw_channel *channel, uint32
                 return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX,
                                     "deformation is not finite at vertex %zu (weight %g)", v, weight);
         }
-        double dp[3], dn = 0, dt = 0;
-        for (int c = 0; c < 3; c++) {
-            size_t i = 3 * v + (size_t)c;
-            dp[c] = pos[i] - mesh->positions[i];
-            if (want_normals) dn = fmax(dn, fabs(nrm[i] - mesh->normals[i]));
-            if (want_tangents) dt = fmax(dt, fabs(tan[i] - mesh->tangents[4 * v + (size_t)c]));
-        }
-        if (mk_len3(dp) > eps_p || dn > eps_n || dt > eps_n) count++;
+        if (vertex_moved(mesh, v, pos, want_normals ? nrm : NULL, want_tangents ? tan : NULL, eps_p, eps_n)) count++;
     }
     mk_raw_target *target = mk_raw_add_targets(raw, channel, 1);
     if (!target) return mk_error_oom(err, "baked target");
@@ -213,14 +221,7 @@ static mk_result write_target(mk_raw_asset *raw, mk_raw_channel *channel, uint32
         return mk_error_oom(err, "baked target");
     uint32_t k = 0;
     for (size_t v = 0; v < n; v++) {
-        double dp[3], dn = 0, dt = 0;
-        for (int c = 0; c < 3; c++) {
-            size_t i = 3 * v + (size_t)c;
-            dp[c] = pos[i] - mesh->positions[i];
-            if (want_normals) dn = fmax(dn, fabs(nrm[i] - mesh->normals[i]));
-            if (want_tangents) dt = fmax(dt, fabs(tan[i] - mesh->tangents[4 * v + (size_t)c]));
-        }
-        if (!(mk_len3(dp) > eps_p || dn > eps_n || dt > eps_n)) continue;
+        if (!vertex_moved(mesh, v, pos, want_normals ? nrm : NULL, want_tangents ? tan : NULL, eps_p, eps_n)) continue;
         target->indices[k] = (uint32_t)v;
         for (int c = 0; c < 3; c++) {
             /* Same float rounding as the sampler's deltas, so verified error == stored error. */

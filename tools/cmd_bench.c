@@ -197,13 +197,10 @@ static double frame_bytes(const mk_asset *a, const float *weights, int normals)
         uint8_t *active = calloc(m->target_count + 1u, 1);
         for (uint32_t c = m->first_channel; c < m->first_channel + m->channel_count; c++) {
             const mk_blob_channel *ch = &a->channels[c];
-            float full[256];
-            uint32_t n = ch->target_count < 256 ? ch->target_count : 256;
-            for (uint32_t k = 0; k < n; k++) full[k] = a->targets[ch->first_target + k].full_weight;
             int32_t ia, ib;
             float ca, cb;
             if (weights[c] == 0) continue;
-            mk_channel_span(full, n, weights[c], &ia, &ca, &ib, &cb, NULL);
+            frame_channel_span(a, c, weights[c], &ia, &ca, &ib, &cb);
             if (ia >= 0 && ca != 0) active[ch->first_target - m->first_target + (uint32_t)ia] = 1;
             if (ib >= 0 && cb != 0) active[ch->first_target - m->first_target + (uint32_t)ib] = 1;
         }
@@ -260,8 +257,9 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
     for (uint32_t mi = 0; mi < raw.mesh_count; mi++) {
         const mk_raw_mesh *m = &raw.meshes[mi];
         size_t n = m->vertex_count;
-        float **dense_p = calloc(raw.channel_count * 4u + 1, sizeof(float *));
-        float **dense_n = calloc(raw.channel_count * 4u + 1, sizeof(float *));
+        /* Dense arrays per asset target (indexed like the blob's target table). */
+        float **dense_p = calloc(a->target_count + 1u, sizeof(float *));
+        float **dense_n = calloc(a->target_count + 1u, sizeof(float *));
         float *out_p = malloc(12 * n), *out_n = malloc(12 * n);
         mk_mesh_info info;
         mk_mesh_get(a, mi, &info);
@@ -270,7 +268,7 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
             for (uint32_t f = 0; f < frames; f++) ever |= weight_sets[(size_t)f * a->channel_count + c] != 0;
             if (!ever) continue;
             const mk_raw_channel *ch = &raw.channels[c];
-            for (uint32_t k = 0; k < ch->target_count && k < 4; k++) {
+            for (uint32_t k = 0; k < ch->target_count; k++) {
                 const mk_raw_target *t = &ch->targets[k];
                 float *dp = calloc(3 * n, sizeof(float)), *dn = calloc(3 * n, sizeof(float));
                 for (uint32_t j = 0; j < t->count; j++)
@@ -278,8 +276,8 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
                         dp[3 * (size_t)t->indices[j] + (size_t)d] = t->positions[3 * (size_t)j + (size_t)d];
                         if (t->normals) dn[3 * (size_t)t->indices[j] + (size_t)d] = t->normals[3 * (size_t)j + (size_t)d];
                     }
-                dense_p[c * 4 + k] = dp;
-                dense_n[c * 4 + k] = dn;
+                dense_p[a->channels[c].first_target + k] = dp;
+                dense_n[a->channels[c].first_target + k] = dn;
             }
         }
         double best = INFINITY;
@@ -291,18 +289,15 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
                 if (m->normals) memcpy(out_n, m->normals, 12 * n);
                 for (uint32_t c = info.first_channel; c < info.first_channel + info.channel_count; c++) {
                     if (w[c] == 0) continue;
-                    const mk_raw_channel *ch = &raw.channels[c];
-                    float full[4];
-                    uint32_t count = ch->target_count < 4 ? ch->target_count : 4;
-                    for (uint32_t k = 0; k < count; k++) full[k] = ch->targets[k].full_weight;
                     int32_t ia, ib;
                     float ca, cb;
-                    mk_channel_span(full, count, w[c], &ia, &ca, &ib, &cb, NULL);
+                    frame_channel_span(a, c, w[c], &ia, &ca, &ib, &cb);
+                    const uint32_t first_target = a->channels[c].first_target;
                     for (int side = 0; side < 2; side++) {
                         int32_t k = side ? ib : ia;
                         float coef = side ? cb : ca;
-                        if (k < 0 || !dense_p[c * 4 + (uint32_t)k]) continue;
-                        const float *dp = dense_p[c * 4 + (uint32_t)k], *dn = dense_n[c * 4 + (uint32_t)k];
+                        if (k < 0 || !dense_p[first_target + (uint32_t)k]) continue;
+                        const float *dp = dense_p[first_target + (uint32_t)k], *dn = dense_n[first_target + (uint32_t)k];
                         for (size_t i = 0; i < 3 * n; i++) out_p[i] += coef * dp[i];
                         if (m->normals) for (size_t i = 0; i < 3 * n; i++) out_n[i] += coef * dn[i];
                     }
@@ -328,7 +323,7 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
             }
         free(rp);
         free(rn);
-        for (uint32_t k = 0; k < raw.channel_count * 4u; k++) { free(dense_p[k]); free(dense_n[k]); }
+        for (uint32_t k = 0; k < a->target_count; k++) { free(dense_p[k]); free(dense_n[k]); }
         free(dense_p);
         free(dense_n);
         free(out_p);

@@ -100,18 +100,9 @@ static double coefficient_sum(const mk_asset *a, const mk_mesh_info *m, const fl
 {
     double sum = 0;
     for (uint32_t c = m->first_channel; c < m->first_channel + m->channel_count; c++) {
-        mk_channel_info ch;
-        mk_channel_get(a, c, &ch);
-        float full[256];
-        uint32_t n = ch.target_count < 256 ? ch.target_count : 256;
-        for (uint32_t k = 0; k < n; k++) {
-            mk_target_info t;
-            mk_target_get(a, c, k, &t);
-            full[k] = t.full_weight;
-        }
         int32_t ia, ib;
         float ca, cb;
-        mk_channel_span(full, n, weights[c], &ia, &ca, &ib, &cb, NULL);
+        frame_channel_span(a, c, weights[c], &ia, &ca, &ib, &cb);
         sum += (ia >= 0 ? fabs(ca) : 0) + (ib >= 0 ? fabs(cb) : 0);
     }
     return sum;

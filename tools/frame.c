@@ -37,6 +37,22 @@ mk_result frame_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *wei
     return r;
 }
 
+void frame_channel_span(const mk_asset *asset, uint32_t channel, float w, int32_t *ia, float *ca, int32_t *ib,
+                        float *cb)
+{
+    mk_channel_info ch;
+    mk_channel_get(asset, channel, &ch);
+    float small[64], *full = ch.target_count <= 64 ? small : malloc(ch.target_count * sizeof(float));
+    uint32_t n = full ? ch.target_count : 0;
+    for (uint32_t k = 0; k < n; k++) {
+        mk_target_info t;
+        mk_target_get(asset, channel, k, &t);
+        full[k] = t.full_weight;
+    }
+    mk_channel_span(full, n, w, ia, ca, ib, cb, NULL);
+    if (full != small) free(full);
+}
+
 void frame_to_world(const float w[16], float *positions, float *normals, uint32_t count)
 {
     /* Column-major: x' = w[0] x + w[4] y + w[8] z + w[12]. */

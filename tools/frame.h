@@ -12,6 +12,11 @@ mk_result frame_weights(const mk_asset *asset, int32_t clip, double time, float 
 mk_result frame_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
                           mk_normal_mode normals_mode, float *positions, float *normals, mk_error *err);
 
+/* mk_channel_span for asset channel `channel` at weight w (any number of in-betweens): the
+ * two contributing targets as indices into the channel's targets (-1 = implicit zero key). */
+void frame_channel_span(const mk_asset *asset, uint32_t channel, float w, int32_t *ia, float *ca, int32_t *ib,
+                        float *cb);
+
 /* In place: p = W p (points), n = normalize((W^-1)^T n). */
 void frame_to_world(const float world[16], float *positions, float *normals, uint32_t count);
 

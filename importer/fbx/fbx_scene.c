@@ -356,6 +356,16 @@ static uint64_t binding_hash(uint32_t object_index, const char *prop, uint32_t p
     return mix(fnv(1469598103934665603ull ^ object_index, prop, prop_length));
 }
 
+/* Open addressing with linear probing; slot value = binding index + 1 (0 = empty). */
+static void table_insert(scene *s, uint32_t index)
+{
+    const binding *b = &s->bindings[index];
+    size_t mask = s->binding_table_size - 1;
+    size_t slot = binding_hash(b->object, b->prop, b->prop_length) & mask;
+    while (s->binding_table[slot]) slot = (slot + 1) & mask;
+    s->binding_table[slot] = index + 1;
+}
+
 static mk_result bind(scene *s, uint32_t object_index, const char *prop, uint32_t prop_length, uint32_t channel)
 {
     if (s->binding_count == s->binding_cap) {
@@ -369,12 +379,7 @@ static mk_result bind(scene *s, uint32_t object_index, const char *prop, uint32_
         s->binding_table_size = (size_t)cap * 2;
         s->binding_table = mk_arena_array(s->doc->arena, s->binding_table_size, sizeof(uint32_t));
         if (!s->binding_table) return mk_error_oom(s->doc->err, "FBX bindings");
-        for (uint32_t i = 0; i < s->binding_count; i++) {
-            size_t mask = s->binding_table_size - 1;
-            size_t slot = binding_hash(b[i].object, b[i].prop, b[i].prop_length) & mask;
-            while (s->binding_table[slot]) slot = (slot + 1) & mask;
-            s->binding_table[slot] = i + 1;
-        }
+        for (uint32_t i = 0; i < s->binding_count; i++) table_insert(s, i);
     }
     uint32_t index = s->binding_count++;
     binding *b = &s->bindings[index];
@@ -382,10 +387,7 @@ static mk_result bind(scene *s, uint32_t object_index, const char *prop, uint32_
     b->prop = prop;
     b->prop_length = prop_length;
     b->channel = channel;
-    size_t mask = s->binding_table_size - 1;
-    size_t slot = binding_hash(object_index, prop, prop_length) & mask;
-    while (s->binding_table[slot]) slot = (slot + 1) & mask;
-    s->binding_table[slot] = index + 1;
+    table_insert(s, index);
     return MK_OK;
 }
 
