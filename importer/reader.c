@@ -14,16 +14,16 @@ static void *copy(mk_arena *arena, const void *src, size_t n)
     return p;
 }
 
-/* Decodes component c of value j of an entry's attribute starting at p. */
-static float decode(const uint8_t *p, int quantized, uint32_t m, int c, uint32_t j, float scale)
+/* Decodes component c of the j-th xyz triple of an entry's attribute starting at p. */
+static float decode(const uint8_t *p, int quantized, int c, uint32_t j, float scale)
 {
     if (quantized) {
         int16_t q;
-        memcpy(&q, p + ((size_t)c * m + j) * 2, 2);
+        memcpy(&q, p + (3 * (size_t)j + (size_t)c) * 2, 2);
         return (float)q * scale;
     }
     float f;
-    memcpy(&f, p + ((size_t)c * m + j) * 4, 4);
+    memcpy(&f, p + (3 * (size_t)j + (size_t)c) * 4, 4);
     return f;
 }
 
@@ -59,9 +59,9 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
                 float pv[3], nv[3] = { 0, 0, 0 }, tv[3] = { 0, 0, 0 };
                 int nonzero = 0;
                 for (int c = 0; c < 3; c++) {
-                    pv[c] = decode(p, q, m, c, j, bt->position_scale);
-                    if (hn) nv[c] = decode(p + attr, q, m, c, j, bt->normal_scale);
-                    if (ht) tv[c] = decode(p + attr * (hn ? 2 : 1), q, m, c, j, bt->tangent_scale);
+                    pv[c] = decode(p, q, c, j, bt->position_scale);
+                    if (hn) nv[c] = decode(p + attr, q, c, j, bt->normal_scale);
+                    if (ht) tv[c] = decode(p + attr * (hn ? 2 : 1), q, c, j, bt->tangent_scale);
                     nonzero |= pv[c] != 0 || nv[c] != 0 || tv[c] != 0;
                 }
                 if (!nonzero && dense) continue;

@@ -137,10 +137,10 @@ static target_plan plan_target(const mk_raw_target *t, mk_precision precision, d
     return p;
 }
 
-/* Writes one attribute's planar components for the vertices of `mask` in block `block`.
+/* Writes one attribute's xyz triples for the vertices of `mask` in block `block`, in bit order.
  * src/index describe the target's sparse data; cursor is the first target entry in the block. */
-static void put_component_arrays(uint8_t *dst, const mk_raw_target *t, const float *src, uint32_t cursor,
-                                 uint64_t mask, uint32_t block, uint32_t m, int quantized, float scale)
+static void put_triples(uint8_t *dst, const mk_raw_target *t, const float *src, uint32_t cursor, uint64_t mask,
+                        uint32_t block, int quantized, float scale)
 {
     for (int c = 0; c < 3; c++) {
         uint32_t j = 0, k = cursor;
@@ -150,9 +150,9 @@ static void put_component_arrays(uint8_t *dst, const mk_raw_target *t, const flo
             float value = (k < t->count && t->indices[k] == v) ? src[3u * k + (uint32_t)c] : 0.0f;
             if (quantized) {
                 int16_t q = quantize(value, scale);
-                memcpy(dst + ((size_t)c * m + j) * 2, &q, 2);
+                memcpy(dst + (3 * (size_t)j + (size_t)c) * 2, &q, 2);
             } else {
-                memcpy(dst + ((size_t)c * m + j) * 4, &value, 4);
+                memcpy(dst + (3 * (size_t)j + (size_t)c) * 4, &value, 4);
             }
         }
     }
@@ -224,9 +224,9 @@ static mk_result write_mesh_data(const mk_raw_asset *raw, uint32_t mi, uint32_t 
             if (dst_buf->failed) return mk_error_oom(err, "writing target data");
             size_t attr = size / (1u + (tg->normals ? 1u : 0u) + (tg->tangents ? 1u : 0u));
             uint8_t *dst = dst_buf->data + at;
-            put_component_arrays(dst, tg, tg->positions, first, mask, b, count, q, p->position_scale);
-            if (tg->normals) put_component_arrays(dst += attr, tg, tg->normals, first, mask, b, count, q, p->normal_scale);
-            if (tg->tangents) put_component_arrays(dst + attr, tg, tg->tangents, first, mask, b, count, q, p->tangent_scale);
+            put_triples(dst, tg, tg->positions, first, mask, b, q, p->position_scale);
+            if (tg->normals) put_triples(dst += attr, tg, tg->normals, first, mask, b, q, p->normal_scale);
+            if (tg->tangents) put_triples(dst + attr, tg, tg->tangents, first, mask, b, q, p->tangent_scale);
             /* data is filled in once the target buffers are concatenated (below). */
             mk_blob_entry e = { t, 0, mask };
             size_t e_at = entries.size;

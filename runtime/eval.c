@@ -7,14 +7,23 @@
  * unrolls to d = sum_c D_c * prod_{c' > c} (1 - beta_c'), so it only multiplies each channel's
  * coefficients by a suffix product: it costs what additive costs.
  *
- * Per block of 64 vertices: an accumulator (positions, normals, tangents as planar float[64]
- * arrays, 2.3 KB, in L1) receives every active target's entry for the block (entries of a
- * block are stored together, so a vertex range finds its data without a search), then each
- * output vertex is written once. Inactive targets cost one 16-byte entry header per touched
- * block; dense int16 entries are plain vectorizable loops.
+ * Per block of 64 vertices: an accumulator per attribute (float xyz triples interleaved like
+ * the base arrays, the outputs and the stored deltas, 768 bytes each, in L1) starts as a copy
+ * of the base and receives every active target's entry for the block (entries of a block are
+ * stored together, so a vertex range finds its data without a search); then each output vertex
+ * is written once. Because everything is interleaved the same way, a dense entry is one
+ * vectorized loop over 192 values, a sparse entry one short loop per run of moved vertices,
+ * and the base and output copies are memcpy. Inactive targets cost one 16-byte entry header
+ * per touched block.
  */
 #include <math.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>   /* compiler intrinsics (non-temporal stores), not a library */
+#define MK_HAVE_STREAMING 1
+#else
+#define MK_HAVE_STREAMING 0
+#endif
 #include "format.h"
 #include "morphkit.h"
 
@@ -136,6 +145,8 @@ mk_result mk_eval_validate(const mk_eval_job *job, mk_error *err)
         return job_fail(err, MK_ERROR_INVALID_ARGUMENT, "eval job: unknown stacking mode");
     if ((unsigned)job->normal_mode > MK_NORMALS_SLERP)
         return job_fail(err, MK_ERROR_INVALID_ARGUMENT, "eval job: unknown normal mode");
+    if ((unsigned)job->store_mode > MK_STORE_STREAMING)
+        return job_fail(err, MK_ERROR_INVALID_ARGUMENT, "eval job: unknown store mode");
     if (!job->scratch || (uintptr_t)job->scratch % 16)
         return job_fail(err, MK_ERROR_INVALID_ARGUMENT, "eval job: scratch is NULL or not 16-byte aligned");
     if (job->scratch_size < scratch_bytes(m->target_count, m->channel_count))
@@ -229,65 +240,62 @@ static void compute_coefficients(frame *f, const mk_eval_job *job, mk_stacking s
 #define MK_INLINE static inline
 #endif
 
-enum { PX, PY, PZ, NX, NY, NZ, TX, TY, TZ, ACC_ROWS };
-typedef float block_acc[ACC_ROWS][MK_BLOCK_SIZE];
+/* Software prefetch. Delta data is target-major, so each active target is its own sequential
+ * stream, and a frame reads tens of them besides the base arrays: more streams than hardware
+ * prefetchers follow. So when a block's entry (or base) is read, the same number of bytes
+ * MK_PREFETCH_AHEAD further on in that stream (the target's next blocks) is prefetched into
+ * L2. The whole entry is prefetched even when only positions are evaluated, so the prefetches
+ * cover the stream without gaps. Measured on the default bench (docs/performance.md): 1.5 to
+ * 4 KB ahead is a plateau and 0.75 KB too short; locality 1 (L2) beats L1 (which evicts the
+ * accumulators) and non-temporal hints. The address may lie past the data: prefetches never
+ * fault, and it is formed as an integer, so no pointer leaves its object. */
+#define MK_PREFETCH_AHEAD 2048u
+#if defined(__GNUC__) || defined(__clang__)
+#define MK_PREFETCH(address) __builtin_prefetch((const void *)(address), 0, 1)
+#else
+#define MK_PREFETCH(address) ((void)(address))
+#endif
 
-/* acc[0..2][i] += factor * src[component][j] for the j-th set bit i of mask (m values per
- * component). Quantized sources are int16. */
-MK_INLINE void add_q16(float (*acc)[MK_BLOCK_SIZE], uint64_t mask, uint32_t m, const int16_t *src, float factor)
+MK_INLINE void prefetch_ahead(const uint8_t *p, size_t bytes)
 {
-    if (m == MK_BLOCK_SIZE) {
-        for (int c = 0; c < 3; c++) {
-            float *restrict out = acc[c];
-            const int16_t *restrict in = src + (size_t)c * MK_BLOCK_SIZE;
-            for (uint32_t i = 0; i < MK_BLOCK_SIZE; i++) out[i] += factor * (float)in[i];
-        }
-        return;
-    }
-    if ((mask & (mask + 1)) == 0) { /* contiguous from bit 0: the partial last block stored dense */
-        for (int c = 0; c < 3; c++) {
-            float *restrict out = acc[c];
-            const int16_t *restrict in = src + (size_t)c * m;
-            for (uint32_t i = 0; i < m; i++) out[i] += factor * (float)in[i];
-        }
-        return;
-    }
-    for (uint32_t j = 0; mask; j++, mask &= mask - 1) {
-        unsigned i = (unsigned)mk_ctz64(mask);
-        acc[0][i] += factor * (float)src[j];
-        acc[1][i] += factor * (float)src[m + j];
-        acc[2][i] += factor * (float)src[2 * m + j];
-    }
+    const uintptr_t ahead = (uintptr_t)p + MK_PREFETCH_AHEAD;
+    for (size_t off = 0; off < bytes; off += 64) MK_PREFETCH(ahead + off);
 }
 
-MK_INLINE void add_f32(float (*acc)[MK_BLOCK_SIZE], uint64_t mask, uint32_t m, const float *src, float factor)
+/* An attribute of a block, interleaved like the outputs: xyz of the block's vertex i at
+ * [3i, 3i + 3). */
+typedef float block_acc[3 * MK_BLOCK_SIZE];
+
+/* acc[k] += factor * src[k] for k < n. */
+MK_INLINE void add_span_q16(float *restrict acc, const int16_t *restrict src, uint32_t n, float factor)
 {
-    if ((mask & (mask + 1)) == 0) {
-        for (int c = 0; c < 3; c++) {
-            float *restrict out = acc[c];
-            const float *restrict in = src + (size_t)c * m;
-            for (uint32_t i = 0; i < m; i++) out[i] += factor * in[i];
-        }
-        return;
-    }
-    for (uint32_t j = 0; mask; j++, mask &= mask - 1) {
-        unsigned i = (unsigned)mk_ctz64(mask);
-        acc[0][i] += factor * src[j];
-        acc[1][i] += factor * src[m + j];
-        acc[2][i] += factor * src[2 * m + j];
-    }
+    for (uint32_t k = 0; k < n; k++) acc[k] += factor * (float)src[k];
 }
 
-/* Adds one attribute (3 planar components) of an entry; returns the next attribute's data. */
-MK_INLINE const uint8_t *add_attribute(float (*acc)[MK_BLOCK_SIZE], uint64_t mask, uint32_t m, const uint8_t *data,
-                                    int quantized, float factor)
+MK_INLINE void add_span_f32(float *restrict acc, const float *restrict src, uint32_t n, float factor)
 {
-    if (quantized) {
-        add_q16(acc, mask, m, (const int16_t *)(const void *)data, factor);
-        return data + 6u * m;
+    for (uint32_t k = 0; k < n; k++) acc[k] += factor * src[k];
+}
+
+/* Adds one attribute of an entry: xyz triples of the mask's vertices in bit order. A run of
+ * consecutive mask bits is one contiguous span of both the data and the accumulator, so a
+ * dense block is a single loop of 192 values and a sparse one a short loop per run. */
+MK_INLINE void add_attribute(float *restrict acc, uint64_t mask, const uint8_t *data, int quantized, float factor)
+{
+    const int16_t *q16 = (const int16_t *)(const void *)data;
+    const float *f32 = (const float *)(const void *)data;
+    if (mask == ~(uint64_t)0) {     /* constant trip count: no loop epilogue */
+        if (quantized) add_span_q16(acc, q16, 3 * MK_BLOCK_SIZE, factor);
+        else add_span_f32(acc, f32, 3 * MK_BLOCK_SIZE, factor);
+        return;
     }
-    add_f32(acc, mask, m, (const float *)(const void *)data, factor);
-    return data + 12u * m;
+    for (uint32_t j = 0; mask; mask &= mask + (mask & (0 - mask))) {   /* clears the lowest run */
+        const unsigned lo = mk_ctz64(mask);
+        const uint32_t len = mk_ctz64(~(mask >> lo));   /* mask != ~0, so ~(mask >> lo) != 0 */
+        if (quantized) add_span_q16(acc + 3 * lo, q16 + 3 * j, 3 * len, factor);
+        else add_span_f32(acc + 3 * lo, f32 + 3 * j, 3 * len, factor);
+        j += len;
+    }
 }
 
 static void normalize3(float *v, const float *fallback)
@@ -312,123 +320,104 @@ static void slerp3(const float *a, const float *b, float t, float *out)
 }
 
 /* Adds channel `span`'s slerped normal displacement for the vertices in `touched`:
- * slerp(n_a, n_b, t) - n_base, scaled by the sequential factor. */
-static void add_slerp_normals(float (*acc_n)[MK_BLOCK_SIZE], const float (*delta_a)[MK_BLOCK_SIZE],
-                              const float (*delta_b)[MK_BLOCK_SIZE], uint64_t touched, const channel_span *span,
-                              const float *base_normals, uint32_t block_start)
+ * slerp(n_a, n_b, t) - n_base, scaled by the sequential factor. base_normals addresses the
+ * block's vertex 0. */
+static void add_slerp_normals(float *acc_n, const float *delta_a, const float *delta_b, uint64_t touched,
+                              const channel_span *span, const float *base_normals)
 {
     for (; touched; touched &= touched - 1) {
         unsigned i = (unsigned)mk_ctz64(touched);
-        const float *bn = base_normals + 3u * (block_start + i);
+        const float *bn = base_normals + 3u * i;
         float base[3] = { bn[0], bn[1], bn[2] };
         normalize3(base, bn);
         float na[3] = { base[0], base[1], base[2] }, nb[3] = { base[0], base[1], base[2] };
         if (span->target_a >= 0) {
-            na[0] = bn[0] + delta_a[0][i]; na[1] = bn[1] + delta_a[1][i]; na[2] = bn[2] + delta_a[2][i];
+            for (int k = 0; k < 3; k++) na[k] = bn[k] + delta_a[3 * i + k];
             normalize3(na, base);
         }
         if (span->target_b >= 0) {
-            nb[0] = bn[0] + delta_b[0][i]; nb[1] = bn[1] + delta_b[1][i]; nb[2] = bn[2] + delta_b[2][i];
+            for (int k = 0; k < 3; k++) nb[k] = bn[k] + delta_b[3 * i + k];
             normalize3(nb, base);
         }
         float s[3];
         slerp3(na, nb, span->t, s);
-        for (int k = 0; k < 3; k++) acc_n[k][i] += span->scale * (s[k] - base[k]);
+        for (int k = 0; k < 3; k++) acc_n[3 * i + k] += span->scale * (s[k] - base[k]);
     }
 }
 
-/* Normalizes rows x,y,z in place for i in [lo, hi); where the length is below 1e-8 the
- * base vector (bx, by, bz) is used. Written as arithmetic selects over planar arrays so it
- * vectorizes (the build adds -fno-math-errno and -fvect-cost-model=dynamic for the runtime;
- * without them it is still correct, only scalar). */
-MK_INLINE void normalize_rows(float *restrict x, float *restrict y, float *restrict z, const float *restrict bx,
-                           const float *restrict by, const float *restrict bz, size_t lo, size_t hi)
+/* The accumulator starts as the base: vertices [lo, hi) of the block from base (the block's
+ * vertex 0, base_stride floats per vertex), the rest zero (they may lie past the mesh end). */
+MK_INLINE void init_block(float *restrict acc, const float *restrict base, size_t base_stride, uint32_t lo,
+                          uint32_t hi)
 {
-    for (size_t i = lo; i < hi; i++) {
-        float len2 = x[i] * x[i] + y[i] * y[i] + z[i] * z[i];
-        float keep = len2 < 1e-16f ? 1.0f : 0.0f;
-        float inv = (1.0f - keep) / sqrtf(len2 + keep);
-        x[i] = x[i] * inv + bx[i] * keep;
-        y[i] = y[i] * inv + by[i] * keep;
-        z[i] = z[i] * inv + bz[i] * keep;
-    }
-}
-
-/* Loads three planar rows from an xyz-first base array (stride floats per vertex). */
-MK_INLINE void load_rows(float *restrict x, float *restrict y, float *restrict z, const float *restrict base,
-                         size_t stride, size_t lo, size_t hi)
-{
-    for (size_t i = lo; i < hi; i++) {
-        x[i] = base[stride * i];
-        y[i] = base[stride * i + 1];
-        z[i] = base[stride * i + 2];
-    }
-}
-
-/* The accumulator starts as the base (so no zeroing pass and no separate base add);
- * normals/tangents also keep a planar copy of the base for the normalization fallback.
- * Lanes outside [lo, hi) are zeroed: they may lie past the mesh end. */
-MK_INLINE void init_block(block_acc acc, int rows, size_t lo, size_t hi, const float *restrict base_p,
-                          const float *restrict base_n, const float *restrict base_t,
-                          float (*restrict copy_n)[MK_BLOCK_SIZE], float (*restrict copy_t)[MK_BLOCK_SIZE])
-{
-    if (lo != 0 || hi != MK_BLOCK_SIZE) {
-        memset(acc, 0, sizeof(float) * MK_BLOCK_SIZE * (size_t)rows);
-        if (base_n) memset(copy_n, 0, sizeof(float) * 3 * MK_BLOCK_SIZE);
-        if (base_t) memset(copy_t, 0, sizeof(float) * 3 * MK_BLOCK_SIZE);
-    }
-    load_rows(acc[PX], acc[PY], acc[PZ], base_p, 3, lo, hi);
-    if (base_n) {
-        load_rows(copy_n[0], copy_n[1], copy_n[2], base_n, 3, lo, hi);
-        memcpy(acc[NX], copy_n, sizeof(float) * 3 * MK_BLOCK_SIZE);
-    }
-    if (base_t) {
-        load_rows(copy_t[0], copy_t[1], copy_t[2], base_t, 4, lo, hi);
-        memcpy(acc[TX], copy_t, sizeof(float) * 3 * MK_BLOCK_SIZE);
-    }
-}
-
-/* acc (base + deltas) becomes the final planar outputs: normals/tangents normalized. */
-MK_INLINE void finish_block(block_acc acc, size_t lo, size_t hi, float (*copy_n)[MK_BLOCK_SIZE],
-                            float (*copy_t)[MK_BLOCK_SIZE], int normals, int tangents)
-{
-    if (normals) normalize_rows(acc[NX], acc[NY], acc[NZ], copy_n[0], copy_n[1], copy_n[2], lo, hi);
-    if (tangents) normalize_rows(acc[TX], acc[TY], acc[TZ], copy_t[0], copy_t[1], copy_t[2], lo, hi);
-}
-
-/* Interleaves three planar rows into a strided xyz output. Tightly packed outputs (stride
- * 12) take a loop with a constant stride, which the compiler vectorizes. */
-MK_INLINE void store_rows(const float *restrict x, const float *restrict y, const float *restrict z, size_t lo,
-                          size_t hi, uint8_t *restrict out, size_t stride)
-{
-    if (stride == 12) {
-        float *restrict o = (float *)(void *)out;
-        const size_t n = hi - lo;
-        x += lo; y += lo; z += lo;
-        for (size_t i = 0; i < n; i++) {
-            o[3 * i] = x[i];
-            o[3 * i + 1] = y[i];
-            o[3 * i + 2] = z[i];
-        }
+    const int full = lo == 0 && hi == MK_BLOCK_SIZE;
+    if (!full) memset(acc, 0, sizeof(block_acc));
+    if (base_stride == 3) {
+        if (full) memcpy(acc, base, sizeof(block_acc));    /* constant size: inlined */
+        else memcpy(acc + 3 * lo, base + 3 * lo, sizeof(float) * 3 * (hi - lo));
         return;
     }
-    for (size_t i = lo; i < hi; i++, out += stride) {
-        float *o = (float *)(void *)out;
-        o[0] = x[i]; o[1] = y[i]; o[2] = z[i];
+    for (uint32_t i = lo; i < hi; i++)
+        for (int k = 0; k < 3; k++) acc[3 * i + k] = base[base_stride * i + (size_t)k];
+}
+
+/* Normalizes the triples [lo, hi) in place; where the length is below 1e-8 the base vector is
+ * used instead. The first loop is written as arithmetic selects, so it vectorizes (the build
+ * adds -fno-math-errno and -fvect-cost-model=dynamic for the runtime); short vectors are rare
+ * and replaced afterwards. */
+MK_INLINE void normalize_block(float *restrict v, const float *restrict base, size_t base_stride, size_t lo, size_t hi)
+{
+    int short_count = 0;
+    for (size_t i = lo; i < hi; i++) {
+        float x = v[3 * i], y = v[3 * i + 1], z = v[3 * i + 2];
+        float len2 = x * x + y * y + z * z;
+        float keep = len2 < 1e-16f ? 1.0f : 0.0f;
+        float inv = 1.0f / sqrtf(len2 + keep);
+        v[3 * i] = x * inv;
+        v[3 * i + 1] = y * inv;
+        v[3 * i + 2] = z * inv;
+        short_count += len2 < 1e-16f;
+    }
+    if (!short_count) return;
+    for (size_t i = lo; i < hi; i++) {
+        float *o = v + 3 * i;
+        if (o[0] * o[0] + o[1] * o[1] + o[2] * o[2] < 1e-16f)
+            for (int k = 0; k < 3; k++) o[k] = base[base_stride * i + (size_t)k];
     }
 }
 
-/* Interleaves the planar results into the strided outputs (pointers address vertex lo). */
-MK_INLINE void store_block(block_acc acc, uint32_t lo, uint32_t hi, uint8_t *pos, size_t ps, uint8_t *nrm,
-                        size_t ns, uint8_t *tan, size_t ts, const float *base_t)
+/* Writes the triples [lo, hi) to a strided output addressing vertex lo. With `stream`, a
+ * whole block going to a packed, 16-byte aligned output is written with non-temporal stores
+ * (x86 SSE2): 768 bytes that bypass the caches and need no read-for-ownership. */
+MK_INLINE void store_block(const float *restrict acc, uint32_t lo, uint32_t hi, uint8_t *restrict out, size_t stride,
+                           int stream)
 {
-    store_rows(acc[PX], acc[PY], acc[PZ], lo, hi, pos, ps);
-    if (nrm) store_rows(acc[NX], acc[NY], acc[NZ], lo, hi, nrm, ns);
-    if (tan)
-        for (uint32_t i = lo; i < hi; i++, tan += ts) {
-            float *o = (float *)(void *)tan;
-            o[0] = acc[TX][i]; o[1] = acc[TY][i]; o[2] = acc[TZ][i]; o[3] = base_t[4 * i + 3];
-        }
+    const int full = lo == 0 && hi == MK_BLOCK_SIZE;
+#if MK_HAVE_STREAMING
+    if (stream && full && stride == 12 && (uintptr_t)out % 16 == 0) {
+        for (uint32_t k = 0; k < 3 * MK_BLOCK_SIZE; k += 4)
+            _mm_stream_ps((float *)(void *)out + k, _mm_loadu_ps(acc + k));
+        return;
+    }
+#else
+    (void)stream;
+#endif
+    if (stride == 12) {
+        if (full) memcpy(out, acc, sizeof(block_acc));   /* constant size: inlined */
+        else memcpy(out, acc + 3 * lo, sizeof(float) * 3 * (hi - lo));
+        return;
+    }
+    for (uint32_t i = lo; i < hi; i++, out += stride) memcpy(out, acc + 3 * i, 12);
+}
+
+/* Whether a job's outputs are written with non-temporal stores (see mk_store_mode). */
+static int job_streams(const mk_eval_job *job)
+{
+    if (job->store_mode != MK_STORE_AUTO) return job->store_mode == MK_STORE_STREAMING;
+    /* The whole mesh's outputs, not the job's: a job system splitting a big mesh into small
+     * ranges still writes more per frame than the caches keep. */
+    size_t per_vertex = 12u + (job->normals ? 12u : 0u) + (job->tangents ? 16u : 0u);
+    return (size_t)job->asset->meshes[job->mesh].vertex_count * per_vertex >= MK_STREAM_MIN_BYTES;
 }
 
 /* The per-block work of one job (see the top of this file). */
@@ -448,68 +437,79 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
     const size_t ps = stride_or(job->positions_stride, 12), ns = stride_or(job->normals_stride, 12),
                  ts = stride_or(job->tangents_stride, 16);
 
-    block_acc acc;
-    float copy_n[3][MK_BLOCK_SIZE], copy_t[3][MK_BLOCK_SIZE];
-    float slerp_a[3][MK_BLOCK_SIZE], slerp_b[3][MK_BLOCK_SIZE];
+    const int stream = job_streams(job);
+    block_acc acc_p, acc_n, acc_t, slerp_a, slerp_b;
     const uint32_t block_end = (end + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
     for (uint32_t b = first / MK_BLOCK_SIZE; b < block_end; b++) {
         const uint32_t block_start = b * MK_BLOCK_SIZE;
-        const int rows = want_tangents ? ACC_ROWS : want_normals ? TX : NX;
-        const uint32_t lo = block_start > first ? block_start : first;
-        const uint32_t hi = block_start + MK_BLOCK_SIZE < end ? block_start + MK_BLOCK_SIZE : end;
-        init_block(acc, rows, lo - block_start, hi - block_start, base_p + 3u * (size_t)block_start,
-                   want_normals ? base_n + 3u * (size_t)block_start : NULL,
-                   want_tangents ? base_t + 4u * (size_t)block_start : NULL, copy_n, copy_t);
+        const uint32_t lo = (block_start > first ? block_start : first) - block_start;
+        const uint32_t hi = (block_start + MK_BLOCK_SIZE < end ? block_start + MK_BLOCK_SIZE : end) - block_start;
+        const float *bp = base_p + 3u * (size_t)block_start;
+        const float *bn = want_normals ? base_n + 3u * (size_t)block_start : NULL;
+        const float *bt = want_tangents ? base_t + 4u * (size_t)block_start : NULL;
+        prefetch_ahead((const uint8_t *)bp, sizeof(block_acc));   /* the base arrays too */
+        if (want_normals) prefetch_ahead((const uint8_t *)bn, sizeof(block_acc));
+        if (want_tangents) prefetch_ahead((const uint8_t *)bt, 4 * sizeof(float) * MK_BLOCK_SIZE);
+        init_block(acc_p, bp, 3, lo, hi);
+        if (want_normals) init_block(acc_n, bn, 3, lo, hi);
+        if (want_tangents) init_block(acc_t, bt, 4, lo, hi);
         int32_t open_channel = -1;          /* slerp channel whose deltas are being gathered */
         uint64_t touched = 0;
         for (uint32_t e = block_first[b]; e < block_first[b + 1]; e++) {
             const mk_blob_entry *en = &entries[e];
-            float c = f.coef[en->target];
+            const float c = f.coef[en->target];
             if (c == 0.0f) continue;
             const mk_blob_target *tg = &f.targets[en->target];
-            const uint32_t count = mk_popcount64(en->mask);
             const int q = (tg->flags & MK_TARGET_QUANTIZED) != 0;
+            const size_t attribute_bytes = (size_t)mk_popcount64(en->mask) * 3u * (q ? 2u : 4u);
             const uint8_t *p = data + (size_t)en->data * MK_ALIGN;
-            p = add_attribute(&acc[PX], en->mask, count, p, q, c * (q ? tg->position_scale : 1.0f));
+            prefetch_ahead(p, (size_t)mk_entry_data_size(tg->flags, mk_popcount64(en->mask)));
+            add_attribute(acc_p, en->mask, p, q, c * (q ? tg->position_scale : 1.0f));
             if (!want_normals && !want_tangents) continue;
+            p += attribute_bytes;
             if (tg->flags & MK_TARGET_HAS_NORMALS) {
-                int32_t sc = f.slerp_channel[en->target];
+                const int32_t sc = f.slerp_channel[en->target];
                 if (sc < 0) {
-                    if (want_normals) add_attribute(&acc[NX], en->mask, count, p, q, c * (q ? tg->normal_scale : 1.0f));
+                    if (want_normals) add_attribute(acc_n, en->mask, p, q, c * (q ? tg->normal_scale : 1.0f));
                 } else {
                     /* Gather this channel's two span targets' raw normal deltas. */
                     if (sc != open_channel) {
-                        if (open_channel >= 0)
-                            add_slerp_normals(&acc[NX], (const float (*)[MK_BLOCK_SIZE])slerp_a,
-                                              (const float (*)[MK_BLOCK_SIZE])slerp_b, touched,
-                                              &f.spans[open_channel], base_n, block_start);
+                        if (open_channel >= 0) add_slerp_normals(acc_n, slerp_a, slerp_b, touched, &f.spans[open_channel], bn);
                         memset(slerp_a, 0, sizeof slerp_a);
                         memset(slerp_b, 0, sizeof slerp_b);
                         open_channel = sc;
                         touched = 0;
                     }
-                    float (*dst)[MK_BLOCK_SIZE] = (int32_t)en->target == f.spans[sc].target_a ? slerp_a : slerp_b;
-                    add_attribute(dst, en->mask, count, p, q, q ? tg->normal_scale : 1.0f);
+                    float *dst = (int32_t)en->target == f.spans[sc].target_a ? slerp_a : slerp_b;
+                    add_attribute(dst, en->mask, p, q, q ? tg->normal_scale : 1.0f);
                     touched |= en->mask;
                 }
-                p += q ? 6u * count : 12u * count;
+                p += attribute_bytes;
             }
             if (want_tangents && (tg->flags & MK_TARGET_HAS_TANGENTS))
-                add_attribute(&acc[TX], en->mask, count, p, q, c * (q ? tg->tangent_scale : 1.0f));
+                add_attribute(acc_t, en->mask, p, q, c * (q ? tg->tangent_scale : 1.0f));
         }
-        if (open_channel >= 0)
-            add_slerp_normals(&acc[NX], (const float (*)[MK_BLOCK_SIZE])slerp_a,
-                              (const float (*)[MK_BLOCK_SIZE])slerp_b, touched, &f.spans[open_channel], base_n,
-                              block_start);
+        if (open_channel >= 0) add_slerp_normals(acc_n, slerp_a, slerp_b, touched, &f.spans[open_channel], bn);
 
-        /* Write each output vertex of the block once: finish in planar form (vectorizable),
-         * then interleave into the caller's strided buffers. */
-        finish_block(acc, lo - block_start, hi - block_start, copy_n, copy_t, want_normals, want_tangents);
-        store_block(acc, lo - block_start, hi - block_start, (uint8_t *)job->positions + (size_t)(lo - first) * ps, ps,
-                    want_normals ? (uint8_t *)job->normals + (size_t)(lo - first) * ns : NULL, ns,
-                    want_tangents ? (uint8_t *)job->tangents + (size_t)(lo - first) * ts : NULL, ts,
-                    want_tangents ? base_t + 4u * (size_t)block_start : NULL);
+        /* Each output vertex is written once. */
+        const size_t out = (size_t)(block_start + lo - first);
+        store_block(acc_p, lo, hi, (uint8_t *)job->positions + out * ps, ps, stream);
+        if (want_normals) {
+            normalize_block(acc_n, bn, 3, lo, hi);
+            store_block(acc_n, lo, hi, (uint8_t *)job->normals + out * ns, ns, stream);
+        }
+        if (want_tangents) {
+            normalize_block(acc_t, bt, 4, lo, hi);
+            uint8_t *o = (uint8_t *)job->tangents + out * ts;
+            for (uint32_t i = lo; i < hi; i++, o += ts) {
+                memcpy(o, acc_t + 3 * i, 12);
+                memcpy(o + 12, bt + 4 * i + 3, 4);
+            }
+        }
     }
+#if MK_HAVE_STREAMING
+    if (stream) _mm_sfence();   /* order the non-temporal stores before the job's completion */
+#endif
 }
 
 mk_result mk_eval_run(const mk_eval_job *job, mk_error *err)

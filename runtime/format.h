@@ -1,4 +1,4 @@
-/* The .morph blob layout, version 1 (docs/format.md is the prose description).
+/* The .morph blob layout, version 2 (docs/format.md is the prose description).
  *
  * Little-endian. Every record and array starts at a multiple of 16 bytes from the blob start.
  * Offsets are absolute byte offsets from the blob start. Strings are offsets into the STRINGS
@@ -106,9 +106,11 @@ typedef struct mk_blob_target {
 
 /* One target's data for one block of 64 vertices. Entries of a block are sorted by target
  * (mesh-local index), so a channel's targets are adjacent. The data holds m = popcount(mask)
- * values per component, in mask-bit order, as planar arrays: px[m] py[m] pz[m], then nx ny nz
- * if the target has normals, then tx ty tz if it has tangents; int16 for quantized targets,
- * float otherwise. A block stored dense has all its vertices' bits set. */
+ * xyz triples in mask-bit order, interleaved like the outputs: the position deltas
+ * x0 y0 z0 x1 y1 z1 ..., then the normal deltas if the target has normals, then the tangent
+ * deltas (xyz) if it has tangents; int16 for quantized targets, float otherwise. A run of
+ * consecutive mask bits is one contiguous span of data and output. A block stored dense has
+ * all its vertices' bits set. */
 typedef struct mk_blob_entry {
     uint32_t target;               /* mesh-local target index */
     uint32_t data;                 /* offset from mesh.target_data, in 16-byte units */

@@ -24,7 +24,7 @@
 extern "C" {
 #endif
 
-#define MK_FORMAT_VERSION 1u
+#define MK_FORMAT_VERSION 2u
 
 /* Result codes. Each comment says what fixes it. */
 typedef enum mk_result {
@@ -178,6 +178,20 @@ int32_t mk_find_clip(const mk_asset *asset, const char *name);
 /* Weights in, positions (+ normals, + tangents) out. Output pointers address vertex
  * `first_vertex` (not vertex 0), so a job system can hand each thread its own range and
  * buffer slice. A NULL output is skipped. */
+/* How an evaluation writes its outputs. Streaming (non-temporal) stores send whole 64-vertex
+ * blocks of packed (stride 12), 16-byte aligned position/normal outputs past the caches: no
+ * read-for-ownership, nothing useful evicted. Right for outputs larger than the caches and for
+ * GPU upload buffers; wrong when the caller reads the outputs right away from cache (CPU
+ * skinning of a small mesh). Only x86 (SSE2) builds stream; elsewhere every mode stores
+ * normally. The values written are identical in every mode. */
+typedef enum mk_store_mode {
+    MK_STORE_AUTO = 0,            /* streaming when the mesh's outputs (all its vertices, the
+                                   * attributes the job writes) take at least MK_STREAM_MIN_BYTES */
+    MK_STORE_CACHED = 1,          /* ordinary stores */
+    MK_STORE_STREAMING = 2        /* streaming wherever the output layout allows it */
+} mk_store_mode;
+#define MK_STREAM_MIN_BYTES ((size_t)8 << 20)
+
 typedef struct mk_eval_job {
     const mk_asset *asset;
     uint32_t mesh;
@@ -196,6 +210,7 @@ typedef struct mk_eval_job {
     size_t normals_stride, normals_size;
     float *tangents;              /* optional output: 4 floats per vertex (w copied from base) */
     size_t tangents_stride, tangents_size;
+    mk_store_mode store_mode;     /* default MK_STORE_AUTO */
 } mk_eval_job;
 
 /* Scratch bytes an evaluation of this mesh needs (0 for an invalid mesh). */

@@ -154,7 +154,7 @@ static void expect_corrupt(void (*patch)(unsigned char *, mk_asset *), mk_result
 
 #define FIELD(a, ptr) ((unsigned char *)(uintptr_t)(ptr))
 static void patch_magic(unsigned char *b, mk_asset *a) { (void)a; b[0] = 'X'; }
-static void patch_version(unsigned char *b, mk_asset *a) { (void)a; b[8] = 2; }
+static void patch_version(unsigned char *b, mk_asset *a) { (void)a; b[8] = (unsigned char)(MK_FORMAT_VERSION + 1); }
 static void patch_entry_target(unsigned char *b, mk_asset *a)
 {
     (void)b;

@@ -55,6 +55,7 @@ static void test_invalid_eval_jobs(void)
     j = valid_eval(); weights[1] = INFINITY; expect(j, MK_ERROR_NOT_FINITE, "inf weight"); weights[1] = 0;
     j = valid_eval(); j.stacking = (mk_stacking)7; expect(j, MK_ERROR_INVALID_ARGUMENT, "stacking");
     j = valid_eval(); j.normal_mode = (mk_normal_mode)5; expect(j, MK_ERROR_INVALID_ARGUMENT, "normal mode");
+    j = valid_eval(); j.store_mode = (mk_store_mode)3; expect(j, MK_ERROR_INVALID_ARGUMENT, "store mode");
     j = valid_eval(); j.scratch = NULL; expect(j, MK_ERROR_INVALID_ARGUMENT, "scratch NULL");
     j = valid_eval(); j.scratch = scratch + 4; expect(j, MK_ERROR_INVALID_ARGUMENT, "scratch misaligned");
     j = valid_eval(); j.scratch_size = 8; expect(j, MK_ERROR_BUFFER_TOO_SMALL, "scratch small");
