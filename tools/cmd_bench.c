@@ -11,6 +11,7 @@
 #define _GNU_SOURCE
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -127,30 +128,47 @@ typedef struct bench_ctx {
     void **scratch;            /* one per thread */
     uint32_t threads;
     pthread_barrier_t start, done;
+    atomic_uint next_chunk;    /* next range of the current mesh to evaluate */
     int quit;
 } bench_ctx;
 
 typedef struct worker { bench_ctx *ctx; uint32_t index; } worker;
 
-static void run_slice(bench_ctx *c, uint32_t index)
+/* Threads split a mesh the way a job system would: into ranges of BENCH_CHUNK_BLOCKS
+ * 64-vertex blocks (so no two jobs share a block), each one mk_eval_run job, taken from a
+ * shared counter until none is left. Dynamic assignment keeps both threads busy when the
+ * active targets are unevenly spread over the mesh. One thread runs the whole mesh as one job. */
+#define BENCH_CHUNK_BLOCKS 256u
+
+static void run_range(bench_ctx *c, uint32_t index, const mk_mesh_info *m, uint32_t first, uint32_t last)
 {
-    mk_mesh_info m;
-    mk_mesh_get(c->asset, c->mesh, &m);
-    /* Split on 64-vertex block boundaries so no two threads share a block. */
-    uint32_t blocks = (m.vertex_count + 63) / 64;
-    uint32_t b0 = (uint32_t)((uint64_t)blocks * index / c->threads), b1 = (uint32_t)((uint64_t)blocks * (index + 1) / c->threads);
-    uint32_t first = b0 * 64, last = b1 * 64 < m.vertex_count ? b1 * 64 : m.vertex_count;
-    if (first >= last) return;
     mk_eval_job job = {
         .asset = c->asset, .mesh = c->mesh, .first_vertex = first, .vertex_count = last - first,
-        .weights = c->weights + m.first_channel, .weight_count = m.channel_count, .stacking = c->stacking,
+        .weights = c->weights + m->first_channel, .weight_count = m->channel_count, .stacking = c->stacking,
         .scratch = c->scratch[index], .scratch_size = mk_eval_scratch_size(c->asset, c->mesh),
         .positions = c->positions + 3 * (size_t)first, .positions_size = 12 * (size_t)(last - first),
-        .normals = c->normals && m.has_normals ? c->out_normals + 3 * (size_t)first : NULL,
+        .normals = c->normals && m->has_normals ? c->out_normals + 3 * (size_t)first : NULL,
         .normals_size = 12 * (size_t)(last - first),
     };
     mk_error err;
     if (mk_eval_run(&job, &err) != MK_OK) { fprintf(stderr, "bench: eval failed: %s\n", err.message); exit(1); }
+}
+
+static void run_slice(bench_ctx *c, uint32_t index)
+{
+    mk_mesh_info m;
+    mk_mesh_get(c->asset, c->mesh, &m);
+    if (c->threads == 1) {
+        run_range(c, index, &m, 0, m.vertex_count);
+        return;
+    }
+    const uint32_t chunk = BENCH_CHUNK_BLOCKS * 64;
+    for (;;) {
+        uint32_t k = atomic_fetch_add(&c->next_chunk, 1);
+        if ((uint64_t)k * chunk >= m.vertex_count) return;
+        uint32_t first = k * chunk, last = m.vertex_count - first < chunk ? m.vertex_count : first + chunk;
+        run_range(c, index, &m, first, last);
+    }
 }
 
 static void *worker_main(void *arg)
@@ -164,18 +182,23 @@ static void *worker_main(void *arg)
     }
 }
 
-/* Average ns per frame over the weight sets, all meshes, best of 3 passes. */
+/* Passes over the frames; each result is the best pass. The machines this runs on are shared,
+ * and interference comes in bursts of a second or more, so more passes give steadier numbers. */
+#define BENCH_PASSES 5
+
+/* Average ns per frame over the weight sets, all meshes, best of BENCH_PASSES passes. */
 static double time_frames(bench_ctx *c, const float *weight_sets, uint32_t frames, mk_stacking stacking, int normals)
 {
     c->stacking = stacking;
     c->normals = normals;
     double best = INFINITY;
-    for (int pass = 0; pass < 3; pass++) {
+    for (int pass = 0; pass < BENCH_PASSES; pass++) {
         double t0 = now_ns();
         for (uint32_t f = 0; f < frames; f++) {
             c->weights = weight_sets + (size_t)f * c->asset->channel_count;
             for (uint32_t mi = 0; mi < c->asset->mesh_count; mi++) {
                 c->mesh = mi;
+                atomic_store(&c->next_chunk, 0);
                 if (c->threads > 1) pthread_barrier_wait(&c->start);
                 run_slice(c, 0);
                 if (c->threads > 1) pthread_barrier_wait(&c->done);
@@ -281,7 +304,7 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
             }
         }
         double best = INFINITY;
-        for (int pass = 0; pass < 3; pass++) {
+        for (int pass = 0; pass < BENCH_PASSES; pass++) {
             double t0 = now_ns();
             for (uint32_t f = 0; f < frames; f++) {
                 const float *w = weight_sets + (size_t)f * a->channel_count;
