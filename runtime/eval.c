@@ -461,9 +461,10 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
             if (c == 0.0f) continue;
             const mk_blob_target *tg = &f.targets[en->target];
             const int q = (tg->flags & MK_TARGET_QUANTIZED) != 0;
-            const size_t attribute_bytes = (size_t)mk_popcount64(en->mask) * 3u * (q ? 2u : 4u);
+            const uint32_t m = mk_popcount64(en->mask);
+            const size_t attribute_bytes = (size_t)mk_entry_data_size(tg->flags & MK_TARGET_QUANTIZED, m);
             const uint8_t *p = data + (size_t)en->data * MK_ALIGN;
-            prefetch_ahead(p, (size_t)mk_entry_data_size(tg->flags, mk_popcount64(en->mask)));
+            prefetch_ahead(p, (size_t)mk_entry_data_size(tg->flags, m));
             add_attribute(acc_p, en->mask, p, q, c * (q ? tg->position_scale : 1.0f));
             if (!want_normals && !want_tangents) continue;
             p += attribute_bytes;
