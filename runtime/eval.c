@@ -282,18 +282,18 @@ MK_INLINE void add_span_f32(float *restrict acc, const float *restrict src, uint
  * dense block is a single loop of 192 values and a sparse one a short loop per run. */
 MK_INLINE void add_attribute(float *restrict acc, uint64_t mask, const uint8_t *data, int quantized, float factor)
 {
-    const int16_t *q16 = (const int16_t *)(const void *)data;
-    const float *f32 = (const float *)(const void *)data;
+    /* Converted only on the branch that reads them: quantized normal deltas after an odd
+     * number of position triples are 2-byte aligned, never read as float. */
     if (mask == ~(uint64_t)0) {     /* constant trip count: no loop epilogue */
-        if (quantized) add_span_q16(acc, q16, 3 * MK_BLOCK_SIZE, factor);
-        else add_span_f32(acc, f32, 3 * MK_BLOCK_SIZE, factor);
+        if (quantized) add_span_q16(acc, (const int16_t *)(const void *)data, 3 * MK_BLOCK_SIZE, factor);
+        else add_span_f32(acc, (const float *)(const void *)data, 3 * MK_BLOCK_SIZE, factor);
         return;
     }
     for (uint32_t j = 0; mask; mask &= mask + (mask & (0 - mask))) {   /* clears the lowest run */
         const unsigned lo = mk_ctz64(mask);
         const uint32_t len = mk_ctz64(~(mask >> lo));   /* mask != ~0, so ~(mask >> lo) != 0 */
-        if (quantized) add_span_q16(acc + 3 * lo, q16 + 3 * j, 3 * len, factor);
-        else add_span_f32(acc + 3 * lo, f32 + 3 * j, 3 * len, factor);
+        if (quantized) add_span_q16(acc + 3 * lo, (const int16_t *)(const void *)data + 3 * j, 3 * len, factor);
+        else add_span_f32(acc + 3 * lo, (const float *)(const void *)data + 3 * j, 3 * len, factor);
         j += len;
     }
 }
@@ -461,10 +461,10 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
             if (c == 0.0f) continue;
             const mk_blob_target *tg = &f.targets[en->target];
             const int q = (tg->flags & MK_TARGET_QUANTIZED) != 0;
-            const uint32_t m = mk_popcount64(en->mask);
-            const size_t attribute_bytes = (size_t)mk_entry_data_size(tg->flags & MK_TARGET_QUANTIZED, m);
+            const uint32_t moved = mk_popcount64(en->mask);
+            const size_t attribute_bytes = (size_t)mk_entry_data_size(tg->flags & MK_TARGET_QUANTIZED, moved);
             const uint8_t *p = data + (size_t)en->data * MK_ALIGN;
-            prefetch_ahead(p, (size_t)mk_entry_data_size(tg->flags, m));
+            prefetch_ahead(p, (size_t)mk_entry_data_size(tg->flags, moved));
             add_attribute(acc_p, en->mask, p, q, c * (q ? tg->position_scale : 1.0f));
             if (!want_normals && !want_tangents) continue;
             p += attribute_bytes;

@@ -16,6 +16,7 @@
 #define MK_MAGIC "MORPHKIT"
 #define MK_BLOCK_SIZE 64u          /* vertices per block: one uint64 mask bit per vertex */
 #define MK_ALIGN 16u
+#define MK_MAX_VERTICES (UINT32_MAX - (MK_BLOCK_SIZE - 1))   /* per mesh: 2^32 - 64 */
 
 enum {
     MK_SECTION_STRINGS = 1,        /* char[] */

@@ -92,6 +92,14 @@ static int all_finite(const float *p, uint64_t n)
 
 static int valid_string(const mk_asset *a, uint32_t offset) { return offset < a->strings_size; }
 
+/* Reserved fields must be zero, so a later version can give them a meaning. */
+static int all_zero(const uint32_t *p, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (p[i]) return 0;
+    return 1;
+}
+
 
 static mk_result validate_sections(validator *v, mk_asset *a)
 {
@@ -128,9 +136,9 @@ static mk_result validate_sections(validator *v, mk_asset *a)
 
     a->strings = (const char *)(v->data + found[MK_SECTION_STRINGS]->offset);
     a->strings_size = found[MK_SECTION_STRINGS]->size;
-    if (a->strings_size == 0 || a->strings[a->strings_size - 1] != 0)
+    if (a->strings_size == 0 || a->strings[0] != 0 || a->strings[a->strings_size - 1] != 0)
         return fail(v->err, MK_ERROR_CORRUPT, found[MK_SECTION_STRINGS]->offset, "string section", NO_INDEX,
-                    " does not end with a NUL byte");
+                    " does not start and end with a NUL byte");
     a->meshes = (const mk_blob_mesh *)(v->data + found[MK_SECTION_MESHES]->offset);
     a->mesh_count = (uint32_t)found[MK_SECTION_MESHES]->count;
     a->channels = (const mk_blob_channel *)(v->data + found[MK_SECTION_CHANNELS]->offset);
@@ -172,6 +180,8 @@ static mk_result validate_channels_and_targets(validator *v, const mk_asset *a)
             return fail(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": targets do not follow the previous channel's");
         if (!isfinite(ch->default_weight))
             return fail(v->err, MK_ERROR_NOT_FINITE, at, "channel ", c, ": default weight is not finite");
+        if (!all_zero(ch->reserved, 2))
+            return fail(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": reserved fields are not zero");
         for (uint32_t k = 0; k < ch->target_count; k++) {
             uint32_t t = ch->first_target + k;
             const mk_blob_target *tg = &a->targets[t];
@@ -266,6 +276,8 @@ static mk_result validate_meshes(validator *v, const mk_asset *a)
             return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": name string out of range");
         if (m->vertex_count == 0)
             return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": has no vertices");
+        if (m->vertex_count > MK_MAX_VERTICES)   /* block arithmetic in eval stays in uint32 */
+            return fail(v->err, MK_ERROR_UNSUPPORTED, at, "mesh ", i, ": has more vertices than a mesh may have (2^32 - 64)");
         if ((uint64_t)m->block_count != ((uint64_t)m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE)
             return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": block count does not match vertex count");
         if (m->first_channel != next_channel || m->channel_count > a->channel_count - next_channel)
@@ -278,6 +290,11 @@ static mk_result validate_meshes(validator *v, const mk_asset *a)
             return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": unknown stacking mode");
         if (m->flags & ~3u)
             return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": unknown flags");
+        if (!all_zero(m->reserved, 2))
+            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": reserved fields are not zero");
+        if ((!(m->flags & MK_MESH_HAS_NORMALS) && m->normals) || (!(m->flags & MK_MESH_HAS_TANGENTS) && m->tangents))
+            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i,
+                        ": normal or tangent offset is set but the mesh's flags say it has none");
         if (!all_finite(m->world, 16))
             return fail(v->err, MK_ERROR_NOT_FINITE, at, "mesh ", i, ": world transform is not finite");
         if ((r = check_array(v, m->positions, m->vertex_count, 12, "mesh ", i, "positions"))) return r;
@@ -324,12 +341,16 @@ static mk_result validate_clips(validator *v, const mk_asset *a)
             return fail(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": track range does not follow the previous clip's");
         if (!isfinite(c->start) || !isfinite(c->duration) || c->duration < 0)
             return fail(v->err, MK_ERROR_NOT_FINITE, at, "clip ", i, ": start or duration is not finite or negative");
+        if (!all_zero(c->reserved, 3))
+            return fail(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": reserved fields are not zero");
     }
     for (uint32_t i = 0; i < a->track_count; i++) {
         const mk_blob_track *t = &a->tracks[i];
         uint64_t at = (uint64_t)((const uint8_t *)t - v->data);
         if (t->channel >= a->channel_count)
             return fail(v->err, MK_ERROR_CORRUPT, at, "track ", i, ": channel index out of range");
+        if (t->reserved)
+            return fail(v->err, MK_ERROR_CORRUPT, at, "track ", i, ": reserved field is not zero");
         /* Tracks tile the key table in order, so every key is validated once (O(size)). */
         uint32_t expected_key = i == 0 ? 0 : a->tracks[i - 1].first_key + a->tracks[i - 1].key_count;
         if (t->key_count == 0 || t->first_key != expected_key || t->key_count > a->key_count - t->first_key)
@@ -342,6 +363,8 @@ static mk_result validate_clips(validator *v, const mk_asset *a)
                 return fail(v->err, MK_ERROR_NOT_FINITE, kat, "key ", t->first_key + k, ": value is not finite");
             if (key->interp >= MK_INTERP_COUNT)
                 return fail(v->err, MK_ERROR_CORRUPT, kat, "key ", t->first_key + k, ": unknown interpolation");
+            if (key->reserved)
+                return fail(v->err, MK_ERROR_CORRUPT, kat, "key ", t->first_key + k, ": reserved field is not zero");
             /* Bezier tangent weights must stay inside the interval so time is monotonic. */
             if (!(key->right_weight > 0 && key->right_weight <= 1 && key->left_weight > 0 && key->left_weight <= 1))
                 return fail(v->err, MK_ERROR_CORRUPT, kat, "key ", t->first_key + k, ": tangent weight outside (0, 1]");
@@ -369,11 +392,20 @@ mk_result mk_asset_open(const void *data, size_t size, mk_asset *out, mk_error *
     a.header = (const mk_blob_header *)data;
     if (memcmp(a.header->magic, MK_MAGIC, 8) != 0)
         return fail(err, MK_ERROR_BAD_MAGIC, 0, "not a .morph blob (magic is not MORPHKIT)", NO_INDEX, "");
-    if (a.header->version != MK_FORMAT_VERSION)
-        return fail(err, MK_ERROR_BAD_VERSION, 8, "blob format version ", a.header->version,
-                    " is not supported (this runtime reads version 1)");
-    if (a.header->header_size != sizeof(mk_blob_header) || a.header->flags != 0)
-        return fail(err, MK_ERROR_CORRUPT, 12, "header size or flags", NO_INDEX, " are not those of version 1");
+    if (a.header->version != MK_FORMAT_VERSION) {
+        fail(err, MK_ERROR_BAD_VERSION, NO_OFFSET, "blob format version ", a.header->version,
+             " is not supported; this runtime reads version ");
+        if (err) {
+            size_t len = strlen(err->message);
+            append_u64(err->message, &len, MK_FORMAT_VERSION);
+            append(err->message, &len, " (byte offset 8)");
+            err->offset = 8;
+        }
+        return MK_ERROR_BAD_VERSION;
+    }
+    if (a.header->header_size != sizeof(mk_blob_header) || a.header->flags != 0 || !all_zero(a.header->reserved, 6))
+        return fail(err, MK_ERROR_CORRUPT, 12, "header size, flags or reserved fields", NO_INDEX,
+                    " are not those of this version (64, 0, 0)");
     if (a.header->file_size != size)
         return fail(err, size < a.header->file_size ? MK_ERROR_TRUNCATED : MK_ERROR_CORRUPT, 16,
                     "blob is ", size, a.header->file_size > size ? " bytes, shorter than the header's file size"

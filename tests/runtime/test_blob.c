@@ -134,8 +134,10 @@ static void test_random_flips_with_checksum(void)
     CHECK(rejected > 0);
 }
 
-/* Patches a field, fixes the checksum, and expects code. */
-static void expect_corrupt(void (*patch)(unsigned char *, mk_asset *), mk_result code, const char *what)
+/* Patches a field, fixes the checksum, and expects code (and, if given, a message naming the
+ * check, so a neighbouring check cannot stand in for the one under test). */
+static void expect_corrupt_message(void (*patch)(unsigned char *, mk_asset *), mk_result code, const char *what,
+                                   const char *message)
 {
     mk_raw_asset raw;
     size_t size;
@@ -148,8 +150,14 @@ static void expect_corrupt(void (*patch)(unsigned char *, mk_asset *), mk_result
     rechecksum(copy, size);
     mk_result r = mk_asset_open(copy, size, &a, &err);
     CHECK_MSG(r == code, "%s: got %s (%s)", what, mk_result_name(r), err.message);
+    if (message) CHECK_MSG(strstr(err.message, message) != NULL, "%s: message is '%s'", what, err.message);
     free(copy);
     mk_raw_free(&raw);
+}
+
+static void expect_corrupt(void (*patch)(unsigned char *, mk_asset *), mk_result code, const char *what)
+{
+    expect_corrupt_message(patch, code, what, NULL);
 }
 
 #define FIELD(a, ptr) ((unsigned char *)(uintptr_t)(ptr))
@@ -214,6 +222,64 @@ static void patch_tiny_full_weight(unsigned char *b, mk_asset *a)
     (void)b;
     ((mk_blob_target *)(uintptr_t)&a->targets[4])->full_weight = 1e-42f;   /* spans would overflow */
 }
+/* Reserved fields and the string section's leading NUL must be zero (format.md). */
+static void patch_header_reserved(unsigned char *b, mk_asset *a) { (void)a; b[60] = 1; }
+static void patch_mesh_reserved(unsigned char *b, mk_asset *a)
+{
+    (void)b;
+    ((mk_blob_mesh *)(uintptr_t)a->meshes)->reserved[1] = 7;
+}
+static void patch_mesh_normals_without_flag(unsigned char *b, mk_asset *a)
+{
+    (void)b;
+    mk_blob_mesh *m = (mk_blob_mesh *)(uintptr_t)a->meshes;
+    m->flags &= ~(uint32_t)MK_MESH_HAS_NORMALS;    /* the normals offset stays set */
+}
+static void patch_channel_reserved(unsigned char *b, mk_asset *a)
+{
+    (void)b;
+    ((mk_blob_channel *)(uintptr_t)a->channels)->reserved[0] = 1;
+}
+static void patch_clip_reserved(unsigned char *b, mk_asset *a)
+{
+    (void)b;
+    ((mk_blob_clip *)(uintptr_t)a->clips)->reserved[2] = 1;
+}
+static void patch_track_reserved(unsigned char *b, mk_asset *a)
+{
+    (void)b;
+    ((mk_blob_track *)(uintptr_t)a->tracks)->reserved = 1;
+}
+static void patch_key_reserved(unsigned char *b, mk_asset *a)
+{
+    (void)b;
+    ((mk_key *)(uintptr_t)a->keys)[2].reserved = 1;
+}
+static void patch_strings_start(unsigned char *b, mk_asset *a)
+{
+    (void)b;
+    *(char *)(uintptr_t)a->strings = 'x';
+}
+
+/* The version error says which version this runtime reads. */
+static void test_version_message(void)
+{
+    mk_raw_asset raw;
+    size_t size;
+    unsigned char *blob = basic_blob(&raw, MK_PRECISION_FLOAT, &size);
+    unsigned char *copy = exact_copy(blob, size);
+    patch_version(copy, NULL);
+    rechecksum(copy, size);
+    mk_asset a;
+    mk_error err;
+    char expected[64];
+    snprintf(expected, sizeof expected, "this runtime reads version %u (byte offset 8)", (unsigned)MK_FORMAT_VERSION);
+    CHECK(mk_asset_open(copy, size, &a, &err) == MK_ERROR_BAD_VERSION);
+    CHECK_MSG(strstr(err.message, expected) != NULL, "message: %s", err.message);
+    CHECK(err.offset == 8);
+    free(copy);
+    mk_raw_free(&raw);
+}
 
 /* A block table whose middle value points past the entries must be rejected before any
  * block's entries are read (ASan catches the read otherwise). */
@@ -251,6 +317,14 @@ static void test_targeted_corruptions(void)
     expect_corrupt(patch_data_offset, MK_ERROR_CORRUPT, "entry data offset");
     expect_corrupt(patch_overlapping_tracks, MK_ERROR_CORRUPT, "overlapping key ranges");
     expect_corrupt(patch_tiny_full_weight, MK_ERROR_CORRUPT, "subnormal full weight");
+    expect_corrupt_message(patch_header_reserved, MK_ERROR_CORRUPT, "header reserved", "reserved fields are not those");
+    expect_corrupt_message(patch_mesh_reserved, MK_ERROR_CORRUPT, "mesh reserved", "mesh 0: reserved");
+    expect_corrupt_message(patch_mesh_normals_without_flag, MK_ERROR_CORRUPT, "normals offset without flag", "normal or tangent offset is set");
+    expect_corrupt_message(patch_channel_reserved, MK_ERROR_CORRUPT, "channel reserved", "channel 0: reserved");
+    expect_corrupt_message(patch_clip_reserved, MK_ERROR_CORRUPT, "clip reserved", "clip 0: reserved");
+    expect_corrupt_message(patch_track_reserved, MK_ERROR_CORRUPT, "track reserved", "track 0: reserved");
+    expect_corrupt_message(patch_key_reserved, MK_ERROR_CORRUPT, "key reserved", "key 2: reserved");
+    expect_corrupt_message(patch_strings_start, MK_ERROR_CORRUPT, "string section start", "does not start and end");
 }
 
 static void test_alignment_and_arguments(void)
@@ -273,5 +347,5 @@ static void test_alignment_and_arguments(void)
 }
 
 CHECK_MAIN(CASE(test_valid_blob_opens), CASE(test_every_truncation), CASE(test_random_flips_fail_checksum),
-           CASE(test_random_flips_with_checksum), CASE(test_targeted_corruptions), CASE(test_block_table_checked_first),
+           CASE(test_random_flips_with_checksum), CASE(test_targeted_corruptions), CASE(test_version_message), CASE(test_block_table_checked_first),
            CASE(test_alignment_and_arguments))
