@@ -40,6 +40,8 @@ mk_result mk_read_blob(const mk_asset *asset, mk_raw_asset *out, mk_error *err);
 /* Whole file into arena memory (16-byte aligned, NUL appended past size). */
 mk_result mk_read_file(mk_arena *arena, const char *path, size_t max_size, void **data,
                        size_t *size, mk_error *err);
+/* Does path end with extension (lower case, with the dot), ignoring the path's case? */
+int mk_path_has_extension(const char *path, const char *extension);
 /* Writes to "<path>.tmp.<pid>" then renames over path: readers never see half a file. */
 mk_result mk_write_file_atomic(const char *path, const void *data, size_t size, mk_error *err);
 

@@ -1,5 +1,6 @@
-/* Whole-file reads into arena memory and atomic writes (temporary file + rename), so a
- * failed or interrupted write never leaves a half-written output behind. */
+/* Whole-file reads into arena memory, atomic writes (temporary file + rename), so a
+ * failed or interrupted write never leaves a half-written output behind, and the
+ * file-extension test shared by the importers and the CLI. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <stdio.h>
@@ -54,4 +55,16 @@ mk_result mk_write_file_atomic(const char *path, const void *data, size_t size, 
         return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%s: cannot rename into place: %s", path, strerror(e));
     }
     return MK_OK;
+}
+
+int mk_path_has_extension(const char *path, const char *extension)
+{
+    size_t n = strlen(path), k = strlen(extension);
+    if (k > n) return 0;
+    for (size_t i = 0; i < k; i++) {
+        char a = path[n - k + i], b = extension[i];
+        if (a >= 'A' && a <= 'Z') a = (char)(a - 'A' + 'a');
+        if (a != b) return 0;
+    }
+    return 1;
 }

@@ -4,21 +4,9 @@
 #include "format.h"
 #include "import.h"
 
-static int ends_with(const char *s, const char *suffix)
-{
-    size_t n = strlen(s), k = strlen(suffix);
-    if (k > n) return 0;
-    for (size_t i = 0; i < k; i++) {
-        char a = s[n - k + i], b = suffix[i];
-        if (a >= 'A' && a <= 'Z') a = (char)(a - 'A' + 'a');
-        if (a != b) return 0;
-    }
-    return 1;
-}
-
 mk_result mk_import_file(const char *path, const mk_import_options *options, mk_raw_asset *out, mk_error *err)
 {
-    if (ends_with(path, ".gltf") || ends_with(path, ".glb")) return mk_import_gltf(path, options, out, err);
+    if (mk_path_has_extension(path, ".gltf") || mk_path_has_extension(path, ".glb")) return mk_import_gltf(path, options, out, err);
     size_t max = options && options->max_input_size ? options->max_input_size : (size_t)4 << 30;
     void *data;
     size_t size;
@@ -31,7 +19,7 @@ mk_result mk_import_file(const char *path, const mk_import_options *options, mk_
     } else if (size >= 4 && memcmp(data, "glTF", 4) == 0) {
         mk_arena_release(&out->arena, data);
         return mk_import_gltf(path, options, out, err);
-    } else if (ends_with(path, ".fbx") || (size >= 18 && memcmp(data, "Kaydara FBX Binary", 18) == 0)) {
+    } else if (mk_path_has_extension(path, ".fbx") || (size >= 18 && memcmp(data, "Kaydara FBX Binary", 18) == 0)) {
         r = mk_import_fbx(data, size, options, out, err);
     } else {
         r = mk_error_set(err, MK_ERROR_UNSUPPORTED, 0, "%s: unknown file type (expected .morph, .fbx, .gltf or .glb)", path);

@@ -26,35 +26,46 @@ typedef struct conform_options {
 
 typedef struct counts { int passed, failed; } counts;
 
-static char *read_text(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    if (n < 0) { fclose(f); return NULL; }
-    rewind(f);
-    char *s = malloc((size_t)n + 1);
-    if (s && fread(s, 1, (size_t)n, f) != (size_t)n) { free(s); s = NULL; }
-    fclose(f);
-    if (s) { s[n] = 0; if (size) *size = (size_t)n; }
-    return s;
-}
+/* Reference files are read whole through mk_read_file (size limit, errors naming the file). */
+#define CONFORM_MAX_FILE ((size_t)1 << 30)
 
-static cJSON *read_json(const char *path)
+/* Parses a JSON file; on failure NULL and the reason in why. */
+static cJSON *read_json(const char *path, char *why, size_t why_size)
 {
-    char *text = read_text(path, NULL);
-    if (!text) return NULL;
-    cJSON *j = cJSON_Parse(text);
-    free(text);
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    void *text;
+    size_t size;
+    mk_error err;
+    cJSON *j = NULL;
+    if (mk_read_file(&arena, path, CONFORM_MAX_FILE, &text, &size, &err) != MK_OK) {
+        snprintf(why, why_size, "%s", err.message);
+    } else {
+        const char *end = NULL;
+        j = cJSON_ParseWithLengthOpts(text, size, &end, 0);
+        if (!j)
+            snprintf(why, why_size, "%.900s: JSON parse error at byte %zu", path,
+                     end ? (size_t)(end - (const char *)text) : (size_t)0);
+    }
+    mk_arena_free_all(&arena);
     return j;
 }
 
-/* Reference mesh positions from an OBJ: every 'v' line, in order (one per control point). */
-static float *read_obj_positions(const char *path, uint32_t *count)
+/* Reference mesh positions from an OBJ: every 'v' line, in order (one per control point).
+ * On failure NULL and the reason in why. */
+static float *read_obj_positions(const char *path, uint32_t *count, char *why, size_t why_size)
 {
-    char *text = read_text(path, NULL);
-    if (!text) return NULL;
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    void *data;
+    size_t size;
+    mk_error err;
+    if (mk_read_file(&arena, path, CONFORM_MAX_FILE, &data, &size, &err) != MK_OK) {
+        snprintf(why, why_size, "%s", err.message);
+        mk_arena_free_all(&arena);
+        return NULL;
+    }
+    char *text = data;                 /* mk_read_file appends a NUL */
     size_t cap = 1024, n = 0;
     float *p = malloc(cap * sizeof(float));
     for (char *line = strtok(text, "\n"); line && p; line = strtok(NULL, "\n")) {
@@ -69,7 +80,8 @@ static float *read_obj_positions(const char *path, uint32_t *count)
         }
         p[n++] = x; p[n++] = y; p[n++] = z;
     }
-    free(text);
+    mk_arena_free_all(&arena);
+    if (!p) snprintf(why, why_size, "%.900s: out of memory", path);
     *count = (uint32_t)(n / 3);
     return p;
 }
@@ -219,8 +231,8 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
     snprintf(path, sizeof path, "%s/%s", base_dir, file);
     if (!strcmp(kind, "obj")) {
         uint32_t count;
-        float *ref = read_obj_positions(path, &count);
-        if (!ref) { snprintf(res->failure, sizeof res->failure, "cannot read %.900s", path); free(weights); return; }
+        float *ref = read_obj_positions(path, &count, res->failure, sizeof res->failure);
+        if (!ref) { free(weights); return; }
         /* An OBJ frame holds the one deformed mesh: the asset's mesh with channels. */
         for (uint32_t i = 0; i < a->mesh_count; i++) {
             mk_mesh_info m;
@@ -231,8 +243,8 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
         free(weights);
         return;
     }
-    cJSON *ref = read_json(path);
-    if (!ref) { snprintf(res->failure, sizeof res->failure, "cannot read or parse %.900s", path); free(weights); return; }
+    cJSON *ref = read_json(path, res->failure, sizeof res->failure);
+    if (!ref) { free(weights); return; }
     const cJSON *meshes = cJSON_GetObjectItem(ref, "meshes");
     for (const cJSON *rm = meshes ? meshes->child : NULL; rm && !res->failure[0]; rm = rm->next) {
         const cJSON *chans = cJSON_GetObjectItem(rm, gltf ? "weights" : "channels");
@@ -336,8 +348,9 @@ int cmd_conform(int argc, char **argv)
         else { fprintf(stderr, "morphkit conform: unexpected argument '%s'\n", a); return usage(); }
     }
     if (!manifest) return usage();
-    cJSON *root = read_json(manifest);
-    if (!root) { fprintf(stderr, "morphkit conform: cannot read or parse %s\n", manifest); return 1; }
+    char why[1024];
+    cJSON *root = read_json(manifest, why, sizeof why);
+    if (!root) { fprintf(stderr, "morphkit conform: %s\n", why); return 1; }
     char base_dir[4096];
     snprintf(base_dir, sizeof base_dir, "%s", manifest);
     char *slash = strrchr(base_dir, '/');

@@ -15,12 +15,6 @@ static int usage(void)
     return 2;
 }
 
-static int ends_with(const char *s, const char *suffix)
-{
-    size_t n = strlen(s), k = strlen(suffix);
-    return n >= k && !strcmp(s + n - k, suffix);
-}
-
 /* "name=0.5,other=1" or "3=0.5": channel by name or index. */
 static int apply_weights(const mk_asset *a, const char *spec, float *weights)
 {
@@ -190,7 +184,7 @@ int cmd_play(int argc, char **argv)
         size_t text_size = 0;
         FILE *f = open_memstream(&text, &text_size);
         if (!f) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
-        if (ends_with(out, ".obj")) write_obj(f, a, pos, nrm);
+        if (mk_path_has_extension(out, ".obj")) write_obj(f, a, pos, nrm);
         else write_json(f, a, pos, nrm, space, time, clip, weights);
         fclose(f);
         mk_result r = mk_write_file_atomic(out, text, text_size, &err);

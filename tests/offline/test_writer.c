@@ -223,6 +223,17 @@ static void test_atomic_write(void)
     rmdir(dir);
 }
 
+static void test_path_has_extension(void)
+{
+    CHECK(mk_path_has_extension("a/b.glb", ".glb"));
+    CHECK(mk_path_has_extension("A/B.GLB", ".glb"));
+    CHECK(mk_path_has_extension("x.Obj", ".obj"));
+    CHECK(!mk_path_has_extension("x.obj.json", ".obj"));
+    CHECK(!mk_path_has_extension("glb", ".glb"));
+    CHECK(!mk_path_has_extension("", ".fbx"));
+    CHECK(mk_path_has_extension(".fbx", ".fbx"));
+}
+
 CHECK_MAIN(CASE(test_deterministic), CASE(test_round_trip_float), CASE(test_quantization_tolerance),
            CASE(test_validation_names_the_element), CASE(test_group_channels), CASE(test_fail_allocation_k),
-           CASE(test_memory_limit), CASE(test_atomic_write))
+           CASE(test_memory_limit), CASE(test_atomic_write), CASE(test_path_has_extension))
