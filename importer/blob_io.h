@@ -22,7 +22,8 @@ typedef struct mk_write_options {
 
 typedef struct mk_write_report {
     double max_position_error;  /* largest |stored - exact| component over all targets */
-    double max_normal_error;
+    double max_normal_error;    /* the same for normal and tangent deltas: not bounded by the */
+    double max_tangent_error;   /* tolerance; int16 of a unit-vector difference errs < 3.1e-5 */
     double tolerance_used;      /* the largest per-mesh tolerance that was applied */
     uint32_t quantized_targets, float_targets;
     uint64_t target_bytes;      /* bytes of block data (entries + deltas) */

@@ -132,7 +132,11 @@ static target_plan plan_target(const mk_raw_target *t, mk_precision precision, d
         double ne = quant_error(t->normals, n, p.normal_scale);
         if (ne > report->max_normal_error) report->max_normal_error = ne;
     }
-    if (t->tangents) p.tangent_scale = quant_scale(max_abs(t->tangents, n));
+    if (t->tangents) {
+        p.tangent_scale = quant_scale(max_abs(t->tangents, n));
+        double te = quant_error(t->tangents, n, p.tangent_scale);
+        if (te > report->max_tangent_error) report->max_tangent_error = te;
+    }
     report->quantized_targets++;
     return p;
 }

@@ -50,6 +50,8 @@ int cmd_import(int argc, char **argv)
            raw.channel_count, targets, raw.clip_count, size);
     printf("precision: %u int16 targets, %u float targets; max position quantization error %.3g (tolerance %.3g)\n",
            report.quantized_targets, report.float_targets, report.max_position_error, report.tolerance_used);
+    if (report.max_normal_error > 0 || report.max_tangent_error > 0)
+        printf("max normal quantization error %.3g, tangent %.3g\n", report.max_normal_error, report.max_tangent_error);
     mk_raw_free(&raw);
     return 0;
 }

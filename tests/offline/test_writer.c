@@ -223,6 +223,47 @@ static void test_atomic_write(void)
     rmdir(dir);
 }
 
+/* Normal and tangent deltas are quantized too: the report gives their error, which int16 of a
+ * unit-vector difference keeps below 3.1e-5, and read-back stays within it. */
+static void test_normal_tangent_error_reported(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_line(&raw, 200, 2, 1);
+    mk_raw_mesh *m = &raw.meshes[0];
+    m->tangents = mk_arena_array(&raw.arena, 4 * (size_t)m->vertex_count, sizeof(float));
+    for (uint32_t v = 0; v < m->vertex_count; v++) { m->tangents[4 * v] = 1; m->tangents[4 * v + 3] = 1; }
+    mk_raw_target *t = &raw.channels[0].targets[0];
+    t->tangents = mk_arena_array(&raw.arena, 3 * (size_t)t->count, sizeof(float));
+    for (uint32_t j = 0; j < t->count; j++) {
+        t->tangents[3 * j] = 0.8f * sinf(0.37f * (float)j) - 0.5f;
+        t->tangents[3 * j + 1] = 0.3f * cosf(0.11f * (float)j);
+    }
+    mk_write_options o = { .precision = MK_PRECISION_Q16 };
+    void *blob;
+    size_t size;
+    mk_write_report rep;
+    mk_error err;
+    CHECK(mk_write_blob(&raw, &o, &raw.arena, &blob, &size, &rep, &err) == MK_OK);
+    CHECK_MSG(rep.max_tangent_error > 0 && rep.max_tangent_error < 3.1e-5, "tangent error %g", rep.max_tangent_error);
+    CHECK_MSG(rep.max_normal_error > 0 && rep.max_normal_error < 3.1e-5, "normal error %g", rep.max_normal_error);
+    mk_asset a;
+    mk_raw_asset back;
+    mk_raw_init(&back, NULL);
+    CHECK(mk_asset_open(blob, size, &a, &err) == MK_OK);
+    CHECK(mk_read_blob(&a, &back, &err) == MK_OK);
+    const mk_raw_target *u = &back.channels[0].targets[0];
+    double worst = 0;
+    CHECK(u->tangents != NULL && u->count == t->count);
+    for (uint32_t j = 0; u->tangents && u->count == t->count && j < 3 * t->count; j++) {
+        double e = fabs((double)u->tangents[j] - t->tangents[j]);
+        worst = e > worst ? e : worst;
+    }
+    CHECK_MSG(worst > 0 && worst <= rep.max_tangent_error + 1e-9, "worst %g, reported %g", worst, rep.max_tangent_error);
+    mk_raw_free(&back);
+    mk_raw_free(&raw);
+}
+
 static void test_path_has_extension(void)
 {
     CHECK(mk_path_has_extension("a/b.glb", ".glb"));
@@ -236,4 +277,5 @@ static void test_path_has_extension(void)
 
 CHECK_MAIN(CASE(test_deterministic), CASE(test_round_trip_float), CASE(test_quantization_tolerance),
            CASE(test_validation_names_the_element), CASE(test_group_channels), CASE(test_fail_allocation_k),
-           CASE(test_memory_limit), CASE(test_atomic_write), CASE(test_path_has_extension))
+           CASE(test_memory_limit), CASE(test_atomic_write), CASE(test_normal_tangent_error_reported),
+           CASE(test_path_has_extension))
