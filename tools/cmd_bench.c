@@ -7,6 +7,9 @@
  * With FILE, plays its first clip at 100 evenly spaced times; without, builds a synthetic mesh
  * (default 1 000 000 vertices, 100 channels of which 20 % progressive, each target moving
  * `density` of the vertices in a few spatially coherent regions, `active` channels nonzero).
+ * The timed configurations (additive, positions only, sequential, and with --threads T > 1 in
+ * the text report also one thread, for thread_scaling) run round-robin, best pass of each, with
+ * copy-bandwidth samples between the rounds. --json prints exactly the keys above.
  */
 #define _GNU_SOURCE
 #include <math.h>
@@ -118,6 +121,53 @@ static mk_result build_synthetic(const bench_options *o, mk_raw_asset *raw, mk_e
 
 /* ---- timing harness ---- */
 
+/* Memory-copy bandwidth: copies of 256 MiB (read + write counted), best of all samples.
+ * Samples are taken between the evaluation passes as well as at the end, so the bound and
+ * the frame time come from the same stretch of time on a shared host. */
+typedef struct copy_probe {
+    char *a, *b;
+    size_t size;
+    double best_ns;
+    int flip;
+} copy_probe;
+
+static int copy_probe_init(copy_probe *p)
+{
+    p->size = (size_t)256 << 20;
+    p->a = malloc(p->size);
+    p->b = malloc(p->size);
+    p->best_ns = INFINITY;
+    p->flip = 0;
+    if (!p->a || !p->b) return 0;
+    memset(p->a, 1, p->size);
+    memset(p->b, 2, p->size);
+    return 1;
+}
+
+static void copy_probe_sample(copy_probe *p)
+{
+    if (!p || !p->a || !p->b) return;
+    double t0 = now_ns();
+    memcpy(p->flip ? p->a : p->b, p->flip ? p->b : p->a, p->size);
+    double t = now_ns() - t0;
+    p->flip = !p->flip;
+    volatile char sink = p->a[p->size / 2] + p->b[p->size / 3];
+    (void)sink;
+    if (t < p->best_ns) p->best_ns = t;
+}
+
+/* Bytes per ns, or 0 when the buffers could not be allocated. */
+static double copy_probe_bandwidth(const copy_probe *p)
+{
+    return isfinite(p->best_ns) ? 2.0 * (double)p->size / p->best_ns : 0;
+}
+
+static void copy_probe_free(copy_probe *p)
+{
+    free(p->a);
+    free(p->b);
+}
+
 typedef struct bench_ctx {
     const mk_asset *asset;
     uint32_t mesh;
@@ -126,10 +176,13 @@ typedef struct bench_ctx {
     int normals;
     float *positions, *out_normals;
     void **scratch;            /* one per thread */
-    uint32_t threads;
+    uint32_t threads;          /* threads in the pool */
+    uint32_t running;          /* threads evaluating this pass: 1 or `threads` */
     pthread_barrier_t start, done;
     atomic_uint next_chunk;    /* next range of the current mesh to evaluate */
     int quit;
+    copy_probe *probe;         /* sampled after each timed pass, or NULL */
+    uint64_t chunks[64][8];    /* chunks each thread evaluated (one cache line per thread) */
 } bench_ctx;
 
 typedef struct worker { bench_ctx *ctx; uint32_t index; } worker;
@@ -158,7 +211,7 @@ static void run_slice(bench_ctx *c, uint32_t index)
 {
     mk_mesh_info m;
     mk_mesh_get(c->asset, c->mesh, &m);
-    if (c->threads == 1) {
+    if (c->running == 1) {
         run_range(c, index, &m, 0, m.vertex_count);
         return;
     }
@@ -168,6 +221,7 @@ static void run_slice(bench_ctx *c, uint32_t index)
         if ((uint64_t)k * chunk >= m.vertex_count) return;
         uint32_t first = k * chunk, last = m.vertex_count - first < chunk ? m.vertex_count : first + chunk;
         run_range(c, index, &m, first, last);
+        c->chunks[index][0]++;
     }
 }
 
@@ -182,32 +236,68 @@ static void *worker_main(void *arg)
     }
 }
 
-/* Passes over the frames; each result is the best pass. The machines this runs on are shared,
- * and interference comes in bursts of a second or more, so more passes give steadier numbers. */
+/* Rounds over the configurations; each result is its best pass. The machines this runs on are
+ * shared, and interference comes in bursts of a second or more, so more passes give steadier
+ * numbers. */
 #define BENCH_PASSES 5
 
-/* Average ns per frame over the weight sets, all meshes, best of BENCH_PASSES passes. */
-static double time_frames(bench_ctx *c, const float *weight_sets, uint32_t frames, mk_stacking stacking, int normals)
+/* One pass over the frames with `running` threads (1 or the pool); ns per frame. */
+static double time_pass(bench_ctx *c, const float *weight_sets, uint32_t frames, uint32_t running)
 {
-    c->stacking = stacking;
-    c->normals = normals;
-    double best = INFINITY;
-    for (int pass = 0; pass < BENCH_PASSES; pass++) {
-        double t0 = now_ns();
-        for (uint32_t f = 0; f < frames; f++) {
-            c->weights = weight_sets + (size_t)f * c->asset->channel_count;
-            for (uint32_t mi = 0; mi < c->asset->mesh_count; mi++) {
-                c->mesh = mi;
-                atomic_store(&c->next_chunk, 0);
-                if (c->threads > 1) pthread_barrier_wait(&c->start);
-                run_slice(c, 0);
-                if (c->threads > 1) pthread_barrier_wait(&c->done);
-            }
+    c->running = running;
+    double t0 = now_ns();
+    for (uint32_t f = 0; f < frames; f++) {
+        c->weights = weight_sets + (size_t)f * c->asset->channel_count;
+        for (uint32_t mi = 0; mi < c->asset->mesh_count; mi++) {
+            c->mesh = mi;
+            atomic_store(&c->next_chunk, 0);
+            if (running > 1) pthread_barrier_wait(&c->start);
+            run_slice(c, 0);
+            if (running > 1) pthread_barrier_wait(&c->done);
         }
-        double t = (now_ns() - t0) / frames;
-        if (t < best) best = t;
     }
-    return best;
+    return (now_ns() - t0) / frames;
+}
+
+/* One measured configuration: threads running, stacking, normals; best ns per frame. */
+typedef struct timed_config {
+    uint32_t running;
+    mk_stacking stacking;
+    int normals;
+    double best;
+} timed_config;
+
+/* Times the configurations round-robin, BENCH_PASSES rounds, one pass of each per round, and
+ * keeps each one's best pass; a memory-copy sample follows each round. Interleaving means a
+ * burst of interference on the shared host (seconds long) costs each configuration one pass
+ * rather than all of one configuration's passes, and the ratios between them (thread scaling,
+ * sequential over additive, ratio to the copy bound) compare passes from the same stretch of
+ * time. The chunks each thread takes in pool passes are counted in c->chunks. */
+static void time_configs(bench_ctx *c, const float *weight_sets, uint32_t frames, timed_config *configs, int count)
+{
+    memset(c->chunks, 0, sizeof c->chunks);
+    for (int i = 0; i < count; i++) configs[i].best = INFINITY;
+    for (int pass = 0; pass < BENCH_PASSES; pass++) {
+        for (int i = 0; i < count; i++) {
+            c->stacking = configs[i].stacking;
+            c->normals = configs[i].normals;
+            double t = time_pass(c, weight_sets, frames, configs[i].running);
+            if (t < configs[i].best) configs[i].best = t;
+        }
+        copy_probe_sample(c->probe);
+    }
+}
+
+/* The smallest fraction of the pool passes' chunks one thread took: 1/T when the threads
+ * kept pace; near 0 when a core was taken from this process, which explains poor scaling. */
+static double least_thread_share(const bench_ctx *c)
+{
+    uint64_t total = 0, least = UINT64_MAX;
+    for (uint32_t t = 0; t < c->threads; t++) {
+        total += c->chunks[t][0];
+        if (c->chunks[t][0] < least) least = c->chunks[t][0];
+    }
+    return total ? (double)least / (double)total : 0;
 }
 
 /* Bytes a frame must touch: block tables and entry headers of the mesh, the data of entries
@@ -240,28 +330,6 @@ static double frame_bytes(const mk_asset *a, const float *weights, int normals)
         free(active);
     }
     return bytes;
-}
-
-/* Memory-copy bandwidth in bytes per ns (read + write counted), best of 5 copies of 256 MiB. */
-static double copy_bandwidth(void)
-{
-    size_t size = (size_t)256 << 20;
-    char *a = malloc(size), *b = malloc(size);
-    if (!a || !b) { free(a); free(b); return 0; }
-    memset(a, 1, size);
-    memset(b, 2, size);
-    double best = INFINITY;
-    for (int i = 0; i < 5; i++) {
-        double t0 = now_ns();
-        memcpy(i % 2 ? a : b, i % 2 ? b : a, size);
-        double t = now_ns() - t0;
-        if (t < best) best = t;
-    }
-    volatile char sink = a[size / 2] + b[size / 3];
-    (void)sink;
-    free(a);
-    free(b);
-    return 2.0 * (double)size / best;
 }
 
 /* The naive baseline: dense float deltas for every target, a loop over all vertices for
@@ -452,15 +520,27 @@ int cmd_bench(int argc, char **argv)
     }
     if (o.profile) {
         /* Profiling mode: nothing but evaluation (positions + normals), for perf/callgrind. */
-        for (uint32_t k = 0; k < o.profile; k++) time_frames(&ctx, weights, frames, MK_STACKING_ADDITIVE, 1);
+        timed_config profile = { o.threads, MK_STACKING_ADDITIVE, 1, 0 };
+        for (uint32_t k = 0; k < o.profile; k++) time_configs(&ctx, weights, frames, &profile, 1);
         printf("profiled %u x %u frames\n", o.profile, frames);
         return 0;
     }
-    /* Warm up once, then measure. */
-    time_frames(&ctx, weights, frames < 5 ? frames : 5, MK_STACKING_ADDITIVE, 1);
-    double ns = time_frames(&ctx, weights, frames, MK_STACKING_ADDITIVE, 1);
-    double ns_positions = time_frames(&ctx, weights, frames, MK_STACKING_ADDITIVE, 0);
-    double ns_sequential = time_frames(&ctx, weights, frames, MK_STACKING_SEQUENTIAL, 1);
+    /* Warm up once, then measure. With more than one thread the text report also times one
+     * thread in the same rounds, for the scaling (--json keeps its fixed keys). */
+    timed_config warm = { o.threads, MK_STACKING_ADDITIVE, 1, 0 };
+    time_configs(&ctx, weights, frames < 5 ? frames : 5, &warm, 1);
+    copy_probe probe;
+    if (copy_probe_init(&probe)) ctx.probe = &probe;
+    timed_config configs[4] = {
+        { o.threads, MK_STACKING_ADDITIVE, 1, 0 },
+        { o.threads, MK_STACKING_ADDITIVE, 0, 0 },
+        { o.threads, MK_STACKING_SEQUENTIAL, 1, 0 },
+        { 1, MK_STACKING_ADDITIVE, 1, 0 },
+    };
+    const int scaling = o.threads > 1 && !o.json;
+    time_configs(&ctx, weights, frames, configs, scaling ? 4 : 3);
+    double ns = configs[0].best, ns_positions = configs[1].best, ns_sequential = configs[2].best;
+    double ns_one = scaling ? configs[3].best : 0, least_share = least_thread_share(&ctx);
     if (o.threads > 1) {
         ctx.quit = 1;
         pthread_barrier_wait(&ctx.start);
@@ -469,7 +549,10 @@ int cmd_bench(int argc, char **argv)
     double bytes = 0;
     for (uint32_t f = 0; f < frames; f++) bytes += frame_bytes(a, weights + (size_t)f * a->channel_count, 1);
     bytes /= frames;
-    double bandwidth = copy_bandwidth();
+    for (int i = 0; i < 5; i++) copy_probe_sample(ctx.probe);
+    double bandwidth = copy_probe_bandwidth(&probe);
+    copy_probe_free(&probe);
+    ctx.probe = NULL;
     double bound_ns = bandwidth > 0 ? bytes / bandwidth : 0;
     double diff = 0;
     double naive_ns = naive_frames(&l, weights, frames < 20 ? frames : 20, &diff);
@@ -494,6 +577,12 @@ int cmd_bench(int argc, char **argv)
         printf("naive_ns                 %12.0f  (dense float loop; max |difference| %.3g)\n", naive_ns, diff);
         printf("speedup_vs_naive         %12.2f\n", naive_ns / ns);
         printf("sequential_over_additive %12.3f\n", ns_sequential / ns);
+        if (ns_one > 0) {
+            printf("thread_scaling           %12.2f  (1 thread %.0f ns, %u threads %.0f ns; passes alternating)\n",
+                   ns_one / ns, ns_one, o.threads, ns);
+            printf("least_thread_share       %12.2f  (of the %u-thread passes' chunks; %.2f is even)\n", least_share,
+                   o.threads, 1.0 / o.threads);
+        }
     }
     for (uint32_t t = 0; t < o.threads; t++) free(ctx.scratch[t]);
     free(ctx.scratch);

@@ -49,5 +49,6 @@ check "rewritten file opens" "$mk" info "$dir/re.morph"
 check "no temporary files left" sh -c "! ls '$dir' | grep -q '\.tmp\.'"
 check "bench runs (small)" sh -c "'$mk' bench --vertices 5000 --channels 10 --active 3 --frames 5 --json | python3 -c 'import json,sys; d=json.load(sys.stdin); assert set(d) == {\"ns_per_frame\",\"ns_per_frame_positions\",\"bytes_per_frame\",\"bound_ns\",\"ratio_to_bound\",\"naive_ns\",\"speedup_vs_naive\",\"sequential_over_additive\"}'"
 check "bench on a file" "$mk" bench "$dir/ex.morph" --frames 10
+check "bench --threads 2 reports in-process scaling" sh -c "'$mk' bench --vertices 20000 --channels 10 --active 3 --frames 5 --threads 2 | python3 -c 'import re,sys; t=sys.stdin.read(); m=re.search(r\"^thread_scaling +([0-9.]+)  \\(1 thread ([0-9]+) ns, 2 threads ([0-9]+) ns\", t, re.M); s=re.search(r\"^least_thread_share +([0-9.]+) \", t, re.M); assert m and float(m.group(1)) > 0 and int(m.group(2)) > 0 and int(m.group(3)) > 0; assert s and 0 <= float(s.group(1)) <= 0.5'"
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
