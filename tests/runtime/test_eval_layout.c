@@ -1,7 +1,8 @@
 /* Block storage against a reference computed straight from the raw model: masks with one or
  * many runs of moved vertices (bit 0, bit 63, single bits, whole blocks, blocks stored dense
- * with zeros), partial last blocks, normals and tangents; and the store modes (cached and
- * streaming stores write the same values for every range, stride and alignment). */
+ * with zeros), partial last blocks, normals and tangents, float and int16 data; the store
+ * modes (cached and streaming stores write the same values for every range, stride and
+ * alignment); and jobs over part of the mesh (the same bytes as the whole-mesh job). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,6 +17,12 @@ static uint64_t lcg(uint64_t *s)
 {
     *s = *s * 6364136223846793005ull + 1442695040888963407ull;
     return *s >> 33;
+}
+
+/* Uniform in [-amplitude, amplitude] in steps of amplitude / 1000. */
+static float symmetric(uint64_t *s, float amplitude)
+{
+    return (float)((int)(lcg(s) % 2001) - 1000) * (amplitude / 1000.0f);
 }
 
 /* Whether target t moves vertex v: hand-picked masks first, then random densities. */
@@ -72,8 +79,8 @@ static void build(mk_raw_asset *raw)
             if (!moves(t, v, &seed)) continue;
             tg->indices[n] = v;
             for (int k = 0; k < 3; k++) {
-                tg->positions[3 * n + k] = (float)((lcg(&seed) % 2001) - 1000) * 1e-4f;
-                tg->normals[3 * n + k] = (float)((lcg(&seed) % 2001) - 1000) * 2e-4f;
+                tg->positions[3 * n + k] = symmetric(&seed, 0.1f);
+                tg->normals[3 * n + k] = symmetric(&seed, 0.2f);
                 tg->tangents[3 * n + k] = k == 2 ? 0.3f : 0.0f;
             }
             n++;
@@ -141,10 +148,12 @@ static void unload(loaded *l)
     mk_raw_free(&l->raw);
 }
 
-static void test_masks_match_reference(void)
+/* tolerance: float storage is exact up to rounding; int16 errs by max|delta| / 65534 per
+ * target (deltas here are below 0.2, 24 targets with |w| <= 1), before renormalization. */
+static void masks_match_reference(mk_precision precision, double tolerance)
 {
     loaded l;
-    load(&l, MK_PRECISION_FLOAT);
+    load(&l, precision);
     /* The hand-picked masks really are stored as intended: block 1 of target 1 masked, with 21
      * moved vertices in three runs; block 0 of target 0 full. */
     const mk_blob_mesh *bm = &l.asset.meshes[0];
@@ -162,7 +171,7 @@ static void test_masks_match_reference(void)
     uint64_t seed = 5;
     for (int trial = 0; trial < 20; trial++) {
         for (int c = 0; c < TARGETS; c++)
-            w[c] = trial == 0 ? 1.0f : (lcg(&seed) % 3 == 0) ? 0.0f : (float)((lcg(&seed) % 2001) - 1000) * 1e-3f;
+            w[c] = trial == 0 ? 1.0f : (lcg(&seed) % 3 == 0) ? 0.0f : symmetric(&seed, 1.0f);
         reference(&l.raw, w, rp, rn, rt);
         mk_eval_job job = { .asset = &l.asset, .weights = w, .weight_count = TARGETS, .scratch = l.scratch,
                             .scratch_size = l.scratch_size, .positions = p, .positions_size = sizeof p,
@@ -175,11 +184,14 @@ static void test_masks_match_reference(void)
             worst_n = fmax(worst_n, fabs(n[i] - rn[i]));
         }
         for (int i = 0; i < 4 * VERTICES; i++) worst_t = fmax(worst_t, fabs(t[i] - rt[i]));
-        CHECK_MSG(worst_p < 1e-5 && worst_n < 1e-5 && worst_t < 1e-5, "trial %d: errors %g %g %g", trial, worst_p,
+        CHECK_MSG(worst_p < tolerance && worst_n < tolerance && worst_t < tolerance, "trial %d: errors %g %g %g", trial, worst_p,
                   worst_n, worst_t);
     }
     unload(&l);
 }
+
+static void test_masks_match_reference_float(void) { masks_match_reference(MK_PRECISION_FLOAT, 1e-5); }
+static void test_masks_match_reference_q16(void) { masks_match_reference(MK_PRECISION_Q16, 1e-4); }
 
 /* Evaluates [first, first + count) into out (+ offset bytes) with the given store mode. */
 static void eval_range(loaded *l, const float *w, mk_store_mode mode, uint32_t first, uint32_t count, size_t stride,
@@ -232,4 +244,54 @@ static void test_store_modes_write_the_same(void)
     unload(&l);
 }
 
-CHECK_MAIN(CASE(test_masks_match_reference), CASE(test_store_modes_write_the_same))
+/* A job over part of the mesh writes exactly the bytes the whole-mesh job writes for those
+ * vertices: ranges starting and ending inside blocks, every combination of optional outputs,
+ * both normal modes, every store mode; int16 data with normals and tangents, so the normal
+ * and tangent deltas of odd-sized entries start at 2-byte offsets. */
+static void test_subranges_match_whole_mesh(void)
+{
+    loaded l;
+    load(&l, MK_PRECISION_Q16);
+    float w[TARGETS];
+    for (int c = 0; c < TARGETS; c++) w[c] = 0.1f * (float)(c % 9) - 0.35f;
+    static float whole_p[3 * VERTICES], whole_n[3 * VERTICES], whole_t[4 * VERTICES];
+    static float p[3 * VERTICES], n[3 * VERTICES], t[4 * VERTICES];
+    const struct { uint32_t first, count; } ranges[] = { { 1, 1 }, { 63, 1 }, { 63, 2 }, { 5, 59 }, { 70, 200 },
+                                                        { 127, 130 }, { 250, 50 }, { 299, 1 }, { 0, VERTICES } };
+    mk_error err;
+    int cases = 0;
+    for (int normal_mode = MK_NORMALS_NLERP; normal_mode <= MK_NORMALS_SLERP; normal_mode++) {
+        mk_eval_job whole = { .asset = &l.asset, .weights = w, .weight_count = TARGETS, .scratch = l.scratch,
+                              .scratch_size = l.scratch_size, .normal_mode = (mk_normal_mode)normal_mode,
+                              .positions = whole_p, .positions_size = sizeof whole_p, .normals = whole_n,
+                              .normals_size = sizeof whole_n, .tangents = whole_t, .tangents_size = sizeof whole_t };
+        CHECK_MSG(mk_eval_run(&whole, &err) == MK_OK, "%s", err.message);
+        for (int mode = MK_STORE_AUTO; mode <= MK_STORE_STREAMING; mode++)
+            for (int outputs = 0; outputs < 4; outputs++)   /* bit 0 normals, bit 1 tangents */
+                for (size_t r = 0; r < sizeof ranges / sizeof ranges[0]; r++) {
+                    const uint32_t first = ranges[r].first, count = ranges[r].count;
+                    mk_eval_job job = whole;
+                    job.first_vertex = first;
+                    job.vertex_count = count;
+                    job.store_mode = (mk_store_mode)mode;
+                    job.positions_size = 12 * (size_t)count;
+                    job.positions = p;
+                    job.normals = outputs & 1 ? n : NULL;
+                    job.normals_size = 12 * (size_t)count;
+                    job.tangents = outputs & 2 ? t : NULL;
+                    job.tangents_size = 16 * (size_t)count;
+                    CHECK_MSG(mk_eval_run(&job, &err) == MK_OK, "%s", err.message);
+                    int same = !memcmp(p, whole_p + 3 * first, 12 * (size_t)count)
+                            && (!(outputs & 1) || !memcmp(n, whole_n + 3 * first, 12 * (size_t)count))
+                            && (!(outputs & 2) || !memcmp(t, whole_t + 4 * first, 16 * (size_t)count));
+                    CHECK_MSG(same, "range %u+%u normals %d store %d outputs %d differs", first, count, normal_mode,
+                              mode, outputs);
+                    cases++;
+                }
+    }
+    CHECK_EQ_INT(cases, 2 * 3 * 4 * 9);
+    unload(&l);
+}
+
+CHECK_MAIN(CASE(test_masks_match_reference_float), CASE(test_masks_match_reference_q16),
+           CASE(test_store_modes_write_the_same), CASE(test_subranges_match_whole_mesh))
