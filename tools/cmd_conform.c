@@ -191,6 +191,21 @@ done:
     free(nrm);
 }
 
+/* The frame's weights with mesh mi's channels replaced by a forced list (in the mesh's channel
+ * order; channels past the list keep their sampled weight). Caller frees; NULL when out of memory. */
+static float *with_forced_weights(const mk_asset *a, uint32_t mi, const float *weights, const cJSON *forced)
+{
+    float *w = malloc((a->channel_count + 1u) * sizeof(float));
+    if (!w) return NULL;
+    memcpy(w, weights, a->channel_count * sizeof(float));
+    mk_mesh_info m;
+    mk_mesh_get(a, mi, &m);
+    uint32_t k = 0;
+    for (const cJSON *v = forced->child; v && k < m.channel_count; v = v->next, k++)
+        w[m.first_channel + k] = (float)v->valuedouble;
+    return w;
+}
+
 static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame, const char *base_dir,
                       frame_result *res)
 {
@@ -234,10 +249,14 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
         float *ref = read_obj_positions(path, &count, res->failure, sizeof res->failure);
         if (!ref) { free(weights); return; }
         /* An OBJ frame holds the one deformed mesh: the asset's mesh with channels. */
-        for (uint32_t i = 0; i < a->mesh_count; i++) {
+        for (uint32_t i = 0; i < a->mesh_count && !res->failure[0]; i++) {
             mk_mesh_info m;
             mk_mesh_get(a, i, &m);
-            if (m.channel_count) compare_mesh(a, i, weights, ref, count, NULL, world, by_cp, l->report.max_position_error, res);
+            if (!m.channel_count) continue;
+            float *local = cJSON_IsArray(forced) ? with_forced_weights(a, i, weights, forced) : NULL;
+            if (cJSON_IsArray(forced) && !local) { snprintf(res->failure, sizeof res->failure, "out of memory"); break; }
+            compare_mesh(a, i, local ? local : weights, ref, count, NULL, world, by_cp, l->report.max_position_error, res);
+            free(local);
         }
         free(ref);
         free(weights);
@@ -258,19 +277,9 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
             }
             continue;
         }
-        float *local_weights = NULL;
-        const float *use = weights;
-        if (cJSON_IsArray(forced)) {
-            /* Forced weights: per channel of the matched mesh, in its channel order. */
-            local_weights = malloc((a->channel_count + 1u) * sizeof(float));
-            memcpy(local_weights, weights, a->channel_count * sizeof(float));
-            mk_mesh_info m;
-            mk_mesh_get(a, (uint32_t)mi, &m);
-            uint32_t k = 0;
-            for (const cJSON *w = forced->child; w && k < m.channel_count; w = w->next, k++)
-                local_weights[m.first_channel + k] = (float)w->valuedouble;
-            use = local_weights;
-        }
+        float *local_weights = cJSON_IsArray(forced) ? with_forced_weights(a, (uint32_t)mi, weights, forced) : NULL;
+        if (cJSON_IsArray(forced) && !local_weights) { snprintf(res->failure, sizeof res->failure, "out of memory"); break; }
+        const float *use = local_weights ? local_weights : weights;
         uint32_t count, ncount = 0;
         float *pos = json_float_array(cJSON_GetObjectItem(rm, "positions"), &count);
         float *nrm = json_float_array(cJSON_GetObjectItem(rm, "normals"), &ncount);
