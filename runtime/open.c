@@ -344,6 +344,10 @@ static mk_result validate_clips(validator *v, const mk_asset *a)
         if (!all_zero(c->reserved, 3))
             return fail(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": reserved fields are not zero");
     }
+    uint32_t tracks_used = a->clip_count ? a->clips[a->clip_count - 1].first_track + a->clips[a->clip_count - 1].track_count : 0;
+    if (tracks_used != a->track_count)
+        return fail(v->err, MK_ERROR_CORRUPT, NO_OFFSET, "clips cover ", tracks_used,
+                    " tracks; the track table has tracks no clip owns");
     for (uint32_t i = 0; i < a->track_count; i++) {
         const mk_blob_track *t = &a->tracks[i];
         uint64_t at = (uint64_t)((const uint8_t *)t - v->data);
@@ -372,6 +376,9 @@ static mk_result validate_clips(validator *v, const mk_asset *a)
                 return fail(v->err, MK_ERROR_CORRUPT, kat, "key ", t->first_key + k, ": key times are not strictly increasing");
         }
     }
+    uint32_t keys_used = a->track_count ? a->tracks[a->track_count - 1].first_key + a->tracks[a->track_count - 1].key_count : 0;
+    if (keys_used != a->key_count)
+        return fail(v->err, MK_ERROR_CORRUPT, NO_OFFSET, "tracks cover ", keys_used, " keys; the key table has keys no track owns");
     return MK_OK;
 }
 

@@ -261,6 +261,20 @@ static void patch_strings_start(unsigned char *b, mk_asset *a)
     *(char *)(uintptr_t)a->strings = 'x';
 }
 
+/* Clips must own every track and tracks every key, so no table entry goes unvalidated. */
+static void patch_unowned_track(unsigned char *b, mk_asset *a)
+{
+    (void)b;
+    ((mk_blob_clip *)(uintptr_t)&a->clips[a->clip_count - 1])->track_count--;
+}
+static void patch_unowned_key(unsigned char *b, mk_asset *a)
+{
+    (void)b;
+    mk_blob_track *t = (mk_blob_track *)(uintptr_t)a->tracks;   /* track 0 has 2 keys, track 1 one */
+    t[0].key_count--;
+    t[1].first_key--;              /* still tiled; the last key now has no track */
+}
+
 /* The version error says which version this runtime reads. */
 static void test_version_message(void)
 {
@@ -324,6 +338,8 @@ static void test_targeted_corruptions(void)
     expect_corrupt_message(patch_clip_reserved, MK_ERROR_CORRUPT, "clip reserved", "clip 0: reserved");
     expect_corrupt_message(patch_track_reserved, MK_ERROR_CORRUPT, "track reserved", "track 0: reserved");
     expect_corrupt_message(patch_key_reserved, MK_ERROR_CORRUPT, "key reserved", "key 2: reserved");
+    expect_corrupt_message(patch_unowned_track, MK_ERROR_CORRUPT, "track without clip", "tracks no clip owns");
+    expect_corrupt_message(patch_unowned_key, MK_ERROR_CORRUPT, "key without track", "keys no track owns");
     expect_corrupt_message(patch_strings_start, MK_ERROR_CORRUPT, "string section start", "does not start and end");
 }
 
