@@ -1,5 +1,5 @@
 /* morphkit bench [FILE] [--vertices N] [--channels C] [--active A] [--density D] [--threads T]
- *                [--frames F] [--json]
+ *                [--frames F] [--json] [--profile N]
  *
  * Measures evaluation speed against baselines run in the same process:
  *   bound_ns   the bytes one frame must touch, at the memory-copy bandwidth measured now
@@ -427,7 +427,7 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
 static int usage(void)
 {
     fprintf(stderr, "usage: morphkit bench [FILE] [--vertices N] [--channels C] [--active A] [--density D]\n"
-                    "       [--threads T] [--frames F] [--json]\n");
+                    "       [--threads T] [--frames F] [--json] [--profile N]\n");
     return 2;
 }
 
@@ -451,7 +451,7 @@ int cmd_bench(int argc, char **argv)
     }
     if (o.vertices < 64 || o.channels == 0 || o.active > o.channels || o.threads < 1 || o.threads > 64
         || o.frames == 0 || !(o.density > 0 && o.density <= 0.3)) {
-        fprintf(stderr, "morphkit bench: need --vertices >= 64, 1 <= --active <= --channels, 1 <= --threads <= 64, "
+        fprintf(stderr, "morphkit bench: need --vertices >= 64, 1 <= --channels, --active <= --channels, 1 <= --threads <= 64, "
                         "0 < --density <= 0.3\n");
         return 2;
     }
