@@ -4,9 +4,10 @@
  * Measures evaluation speed against baselines run in the same process:
  *   bound_ns   the bytes one frame must touch, at the memory-copy bandwidth measured now
  *   naive_ns   a straightforward dense float loop over all vertices and the active targets
- * With FILE, plays its first clip at 100 evenly spaced times; without, builds a synthetic mesh
- * (default 1 000 000 vertices, 100 channels of which 20 % progressive, each target moving
- * `density` of the vertices in a few spatially coherent regions, `active` channels nonzero).
+ * With FILE, plays its first clip at F evenly spaced times (--frames, default 100); without,
+ * builds a synthetic mesh (default 1 000 000 vertices, 100 channels of which 20 % progressive,
+ * each target moving `density` of the vertices in a few spatially coherent regions, `active`
+ * channels nonzero).
  * The timed configurations (additive, positions only, sequential, and with --threads T > 1 in
  * the text report also one thread, for thread_scaling) run round-robin, best pass of each, with
  * copy-bandwidth samples between the rounds. --json prints exactly the keys above.
@@ -181,7 +182,7 @@ typedef struct bench_ctx {
     pthread_barrier_t start, done;
     atomic_uint next_chunk;    /* next range of the current mesh to evaluate */
     int quit;
-    copy_probe *probe;         /* sampled after each timed pass, or NULL */
+    copy_probe *probe;         /* sampled after each round of timed passes, or NULL */
     uint64_t chunks[64][8];    /* chunks each thread evaluated (one cache line per thread) */
 } bench_ctx;
 
