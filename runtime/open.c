@@ -27,9 +27,13 @@ static void append_u64(char *buf, size_t *len, uint64_t v)
     while (n--) { tmp[0] = digits[n]; append(buf, len, tmp); }
 }
 
-/* Message: "<a><index><b>" plus " (byte offset N)" when offset is known. */
-static mk_result fail(mk_error *err, mk_result code, uint64_t offset, const char *a, uint64_t index,
-                      const char *b)
+#define NO_INDEX UINT64_MAX
+#define NO_OFFSET UINT64_MAX
+
+/* Message: "<a><i1><b><i2><c>" (an index of NO_INDEX is left out) plus " (byte offset N)"
+ * when the offset is known. */
+static mk_result fail_with(mk_error *err, mk_result code, uint64_t offset, const char *a, uint64_t i1,
+                           const char *b, uint64_t i2, const char *c)
 {
     if (!err) return code;
     size_t len = 0;
@@ -37,9 +41,11 @@ static mk_result fail(mk_error *err, mk_result code, uint64_t offset, const char
     err->offset = offset;
     err->message[0] = 0;
     append(err->message, &len, a);
-    if (index != UINT64_MAX) append_u64(err->message, &len, index);
+    if (i1 != NO_INDEX) append_u64(err->message, &len, i1);
     append(err->message, &len, b);
-    if (offset != UINT64_MAX) {
+    if (i2 != NO_INDEX) append_u64(err->message, &len, i2);
+    append(err->message, &len, c);
+    if (offset != NO_OFFSET) {
         append(err->message, &len, " (byte offset ");
         append_u64(err->message, &len, offset);
         append(err->message, &len, ")");
@@ -47,8 +53,11 @@ static mk_result fail(mk_error *err, mk_result code, uint64_t offset, const char
     return code;
 }
 
-#define NO_INDEX UINT64_MAX
-#define NO_OFFSET UINT64_MAX
+static mk_result fail(mk_error *err, mk_result code, uint64_t offset, const char *a, uint64_t index,
+                      const char *b)
+{
+    return fail_with(err, code, offset, a, index, b, NO_INDEX, "");
+}
 
 const char *mk_result_name(mk_result code)
 {
@@ -399,17 +408,9 @@ mk_result mk_asset_open(const void *data, size_t size, mk_asset *out, mk_error *
     a.header = (const mk_blob_header *)data;
     if (memcmp(a.header->magic, MK_MAGIC, 8) != 0)
         return fail(err, MK_ERROR_BAD_MAGIC, 0, "not a .morph blob (magic is not MORPHKIT)", NO_INDEX, "");
-    if (a.header->version != MK_FORMAT_VERSION) {
-        fail(err, MK_ERROR_BAD_VERSION, NO_OFFSET, "blob format version ", a.header->version,
-             " is not supported; this runtime reads version ");
-        if (err) {
-            size_t len = strlen(err->message);
-            append_u64(err->message, &len, MK_FORMAT_VERSION);
-            append(err->message, &len, " (byte offset 8)");
-            err->offset = 8;
-        }
-        return MK_ERROR_BAD_VERSION;
-    }
+    if (a.header->version != MK_FORMAT_VERSION)
+        return fail_with(err, MK_ERROR_BAD_VERSION, 8, "blob format version ", a.header->version,
+                         " is not supported; this runtime reads version ", MK_FORMAT_VERSION, "");
     if (a.header->header_size != sizeof(mk_blob_header) || a.header->flags != 0 || !all_zero(a.header->reserved, 6))
         return fail(err, MK_ERROR_CORRUPT, 12, "header size, flags or reserved fields", NO_INDEX,
                     " are not those of this version (64, 0, 0)");

@@ -145,9 +145,10 @@ static int copy_probe_init(copy_probe *p)
     return 1;
 }
 
+/* p is NULL when copy_probe_init failed (then nothing is sampled). */
 static void copy_probe_sample(copy_probe *p)
 {
-    if (!p || !p->a || !p->b) return;
+    if (!p) return;
     double t0 = now_ns();
     memcpy(p->flip ? p->a : p->b, p->flip ? p->b : p->a, p->size);
     double t = now_ns() - t0;

@@ -29,24 +29,26 @@ typedef struct counts { int passed, failed; } counts;
 /* Reference files are read whole through mk_read_file (size limit, errors naming the file). */
 #define CONFORM_MAX_FILE ((size_t)1 << 30)
 
+/* The whole file as NUL-terminated text in arena memory; on failure NULL and the reason in why. */
+static char *read_reference(mk_arena *arena, const char *path, size_t *size, char *why, size_t why_size)
+{
+    void *data;
+    mk_error err;
+    if (mk_read_file(arena, path, CONFORM_MAX_FILE, &data, size, &err) == MK_OK) return data;
+    snprintf(why, why_size, "%s", err.message);
+    return NULL;
+}
+
 /* Parses a JSON file; on failure NULL and the reason in why. */
 static cJSON *read_json(const char *path, char *why, size_t why_size)
 {
     mk_arena arena;
     mk_arena_init(&arena, NULL);
-    void *text;
     size_t size;
-    mk_error err;
-    cJSON *j = NULL;
-    if (mk_read_file(&arena, path, CONFORM_MAX_FILE, &text, &size, &err) != MK_OK) {
-        snprintf(why, why_size, "%s", err.message);
-    } else {
-        const char *end = NULL;
-        j = cJSON_ParseWithLengthOpts(text, size, &end, 0);
-        if (!j)
-            snprintf(why, why_size, "%.900s: JSON parse error at byte %zu", path,
-                     end ? (size_t)(end - (const char *)text) : (size_t)0);
-    }
+    const char *text = read_reference(&arena, path, &size, why, why_size), *end = NULL;
+    cJSON *j = text ? cJSON_ParseWithLengthOpts(text, size, &end, 0) : NULL;
+    if (text && !j)
+        snprintf(why, why_size, "%.900s: JSON parse error at byte %zu", path, end ? (size_t)(end - text) : (size_t)0);
     mk_arena_free_all(&arena);
     return j;
 }
@@ -57,15 +59,12 @@ static float *read_obj_positions(const char *path, uint32_t *count, char *why, s
 {
     mk_arena arena;
     mk_arena_init(&arena, NULL);
-    void *data;
     size_t size;
-    mk_error err;
-    if (mk_read_file(&arena, path, CONFORM_MAX_FILE, &data, &size, &err) != MK_OK) {
-        snprintf(why, why_size, "%s", err.message);
+    char *text = read_reference(&arena, path, &size, why, why_size);
+    if (!text) {
         mk_arena_free_all(&arena);
         return NULL;
     }
-    char *text = data;                 /* mk_read_file appends a NUL */
     size_t cap = 1024, n = 0;
     float *p = malloc(cap * sizeof(float));
     for (char *line = strtok(text, "\n"); line && p; line = strtok(NULL, "\n")) {
@@ -191,19 +190,16 @@ done:
     free(nrm);
 }
 
-/* The frame's weights with mesh mi's channels replaced by a forced list (in the mesh's channel
- * order; channels past the list keep their sampled weight). Caller frees; NULL when out of memory. */
-static float *with_forced_weights(const mk_asset *a, uint32_t mi, const float *weights, const cJSON *forced)
+/* A frame's forced weights, in mesh mi's channel order, replace that mesh's channel weights
+ * (channels past the list keep theirs). Meshes own disjoint channel ranges, so the frame's
+ * weight array can take them in place. */
+static void force_mesh_weights(const mk_asset *a, uint32_t mi, const cJSON *forced, float *weights)
 {
-    float *w = malloc((a->channel_count + 1u) * sizeof(float));
-    if (!w) return NULL;
-    memcpy(w, weights, a->channel_count * sizeof(float));
     mk_mesh_info m;
     mk_mesh_get(a, mi, &m);
     uint32_t k = 0;
-    for (const cJSON *v = forced->child; v && k < m.channel_count; v = v->next, k++)
-        w[m.first_channel + k] = (float)v->valuedouble;
-    return w;
+    for (const cJSON *v = cJSON_IsArray(forced) ? forced->child : NULL; v && k < m.channel_count; v = v->next, k++)
+        weights[m.first_channel + k] = (float)v->valuedouble;
 }
 
 static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame, const char *base_dir,
@@ -253,10 +249,8 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
             mk_mesh_info m;
             mk_mesh_get(a, i, &m);
             if (!m.channel_count) continue;
-            float *local = cJSON_IsArray(forced) ? with_forced_weights(a, i, weights, forced) : NULL;
-            if (cJSON_IsArray(forced) && !local) { snprintf(res->failure, sizeof res->failure, "out of memory"); break; }
-            compare_mesh(a, i, local ? local : weights, ref, count, NULL, world, by_cp, l->report.max_position_error, res);
-            free(local);
+            force_mesh_weights(a, i, forced, weights);
+            compare_mesh(a, i, weights, ref, count, NULL, world, by_cp, l->report.max_position_error, res);
         }
         free(ref);
         free(weights);
@@ -277,18 +271,15 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
             }
             continue;
         }
-        float *local_weights = cJSON_IsArray(forced) ? with_forced_weights(a, (uint32_t)mi, weights, forced) : NULL;
-        if (cJSON_IsArray(forced) && !local_weights) { snprintf(res->failure, sizeof res->failure, "out of memory"); break; }
-        const float *use = local_weights ? local_weights : weights;
+        force_mesh_weights(a, (uint32_t)mi, forced, weights);
         uint32_t count, ncount = 0;
         float *pos = json_float_array(cJSON_GetObjectItem(rm, "positions"), &count);
         float *nrm = json_float_array(cJSON_GetObjectItem(rm, "normals"), &ncount);
         if (!pos) snprintf(res->failure, sizeof res->failure, "reference mesh has no positions");
-        else compare_mesh(a, (uint32_t)mi, use, pos, count / 3, ncount == count ? nrm : NULL, world, by_cp,
+        else compare_mesh(a, (uint32_t)mi, weights, pos, count / 3, ncount == count ? nrm : NULL, world, by_cp,
                           l->report.max_position_error, res);
         free(pos);
         free(nrm);
-        free(local_weights);
     }
     if (!res->failure[0] && res->meshes_compared == 0)
         snprintf(res->failure, sizeof res->failure, "no reference mesh matched the import");

@@ -51,15 +51,14 @@ check "no temporary files left" sh -c "! ls '$dir' | grep -q '\.tmp\.'"
 # conform: an OBJ reference frame with forced weights (the frame's "weights", in the mesh's
 # channel order) is compared with those weights, not the clip's; wrong weights fail.
 "$mk" play "$dir/ex.morph" --weights bulge=0.25,bend=1 --space local -o "$dir/forced.obj" >/dev/null
-for w in "0.25, 1" "0, 0"; do
-  cat > "$dir/forced_$(echo "$w" | tr -d ' ,.').json" <<EOF_CASE
-{ "version": 1, "cases": [ { "name": "forced", "source": "ex.morph", "format": "fbx",
+forced_case() { # manifest path, forced weights
+  printf '{ "version": 1, "cases": [ { "name": "forced", "source": "ex.morph", "format": "fbx",
   "reference": { "kind": "obj", "space": "mesh-local", "match": "vertices", "tolerance": 1e-5 },
-  "frames": [ { "weights": [$w], "file": "forced.obj" } ] } ] }
-EOF_CASE
-done
-check "conform obj frame with forced weights" "$mk" conform "$dir/forced_0251.json" --precision float
-check_fails "conform obj frame with other forced weights fails" 1 "$mk" conform "$dir/forced_00.json" --precision float
+  "frames": [ { "weights": [%s], "file": "forced.obj" } ] } ] }\n' "$2" > "$1"; }
+forced_case "$dir/forced_right.json" "0.25, 1"
+forced_case "$dir/forced_wrong.json" "0, 0"
+check "conform obj frame with forced weights" "$mk" conform "$dir/forced_right.json" --precision float
+check_fails "conform obj frame with other forced weights fails" 1 "$mk" conform "$dir/forced_wrong.json" --precision float
 check "bench runs (small)" sh -c "'$mk' bench --vertices 5000 --channels 10 --active 3 --frames 5 --json | python3 -c 'import json,sys; d=json.load(sys.stdin); assert set(d) == {\"ns_per_frame\",\"ns_per_frame_positions\",\"bytes_per_frame\",\"bound_ns\",\"ratio_to_bound\",\"naive_ns\",\"speedup_vs_naive\",\"sequential_over_additive\"}'"
 check "bench on a file" "$mk" bench "$dir/ex.morph" --frames 10
 check "bench --threads 2 reports in-process scaling" sh -c "'$mk' bench --vertices 20000 --channels 10 --active 3 --frames 5 --threads 2 | python3 -c 'import re,sys; t=sys.stdin.read(); m=re.search(r\"^thread_scaling +([0-9.]+)  \\(1 thread ([0-9]+) ns, 2 threads ([0-9]+) ns\", t, re.M); s=re.search(r\"^least_thread_share +([0-9.]+) \", t, re.M); assert m and float(m.group(1)) > 0 and int(m.group(2)) > 0 and int(m.group(3)) > 0; assert s and 0 <= float(s.group(1)) <= 0.5'"
