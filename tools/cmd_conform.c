@@ -1,6 +1,6 @@
 /* morphkit conform CASES.json [--case SUBSTRING] [--precision float|q16] [--normal-tolerance DEG]
  *
- * For each case of a manifest (format: ../shared/corpus/README.md): imports the source in
+ * For each case of a manifest: imports the source in
  * memory, writes it as a blob with the chosen precision, opens it with the runtime, and for
  * every reference frame samples the clip (or applies forced weights), evaluates every mesh
  * and compares with the reference: max position error (world or mesh-local space, matched
@@ -55,7 +55,7 @@ static cJSON *read_json(const char *path, char *why, size_t why_size)
 
 /* Reference mesh positions from an OBJ: every 'v' line, in order (one per control point).
  * On failure NULL and the reason in why. */
-static float *read_obj_positions(const char *path, uint32_t *count, char *why, size_t why_size)
+static double *read_obj_positions(const char *path, uint32_t *count, char *why, size_t why_size)
 {
     mk_arena arena;
     mk_arena_init(&arena, NULL);
@@ -66,14 +66,14 @@ static float *read_obj_positions(const char *path, uint32_t *count, char *why, s
         return NULL;
     }
     size_t cap = 1024, n = 0;
-    float *p = malloc(cap * sizeof(float));
+    double *p = malloc(cap * sizeof(double));
     for (char *line = strtok(text, "\n"); line && p; line = strtok(NULL, "\n")) {
         if (line[0] != 'v' || line[1] != ' ') continue;
-        float x, y, z;
-        if (sscanf(line + 2, "%f %f %f", &x, &y, &z) != 3) continue;
+        double x, y, z;
+        if (sscanf(line + 2, "%lf %lf %lf", &x, &y, &z) != 3) continue;
         if (n + 3 > cap) {
             cap *= 2;
-            float *q = realloc(p, cap * sizeof(float));
+            double *q = realloc(p, cap * sizeof(double));
             if (!q) { free(p); p = NULL; break; }
             p = q;
         }
@@ -85,15 +85,23 @@ static float *read_obj_positions(const char *path, uint32_t *count, char *why, s
     return p;
 }
 
-static float *json_float_array(const cJSON *array, uint32_t *count)
+static double *json_double_array(const cJSON *array, uint32_t *count)
 {
     int n = cJSON_GetArraySize(array);
     if (!cJSON_IsArray(array) || n <= 0) { *count = 0; return NULL; }
-    float *p = malloc((size_t)n * sizeof(float));
+    double *p = malloc((size_t)n * sizeof(double));
     int i = 0;
-    for (const cJSON *e = array->child; e && p; e = e->next) p[i++] = (float)e->valuedouble;
+    for (const cJSON *e = array->child; e && p; e = e->next) p[i++] = e->valuedouble;
     *count = (uint32_t)n;
     return p;
+}
+
+/* Half the spacing of float32 values around |x|: the rounding error of storing x as float. */
+static double float32_half_ulp(double x)
+{
+    int exponent;
+    frexp(x, &exponent);  /* 2^(exponent-1) <= |x| < 2^exponent */
+    return x > 0 ? ldexp(1.0, exponent - 25) : 0.0;
 }
 
 static double max_column_norm(const float *w)
@@ -144,8 +152,8 @@ static int find_mesh_for(const mk_asset *a, const cJSON *ref_mesh, int gltf)
 }
 
 /* Compares one mesh; updates result. ref_pos has 3 floats per control point or vertex. */
-static void compare_mesh(const mk_asset *a, uint32_t mi, const float *weights, const float *ref_pos, uint32_t ref_count,
-                         const float *ref_nrm, int world, int by_control_point, double quant_error, frame_result *res)
+static void compare_mesh(const mk_asset *a, uint32_t mi, const float *weights, const double *ref_pos, uint32_t ref_count,
+                         const double *ref_nrm, int world, int by_control_point, double quant_error, frame_result *res)
 {
     mk_mesh_info m;
     mk_mesh_get(a, mi, &m);
@@ -164,26 +172,31 @@ static void compare_mesh(const mk_asset *a, uint32_t mi, const float *weights, c
     }
     if (world) frame_to_world(m.world, pos, nrm, m.vertex_count);
     double scale = world ? max_column_norm(m.world) : 1.0;
-    double allowed_extra = quant_error * scale * coefficient_sum(a, &m, weights);
-    if (allowed_extra > res->allowed) res->allowed = allowed_extra;
+    double allowed_extra = quant_error * scale * coefficient_sum(a, &m, weights), largest = 0;
     for (uint32_t v = 0; v < m.vertex_count; v++) {
         uint32_t r = by_control_point ? m.control_points[v] : v;
         for (int d = 0; d < 3; d++) {
-            double e = fabs((double)pos[3 * v + (uint32_t)d] - (double)ref_pos[3 * r + (uint32_t)d]);
+            double ref = ref_pos[3 * r + (uint32_t)d], e = fabs((double)pos[3 * v + (uint32_t)d] - ref);
+            if (fabs(ref) > largest) largest = fabs(ref);
             if (!(e <= res->position_error)) res->position_error = e;   /* NaN propagates as failure */
         }
         if (ref_nrm && nrm) {
-            const float *rn = &ref_nrm[3 * r], *n = &nrm[3 * v];
-            double rl = sqrt((double)rn[0] * rn[0] + (double)rn[1] * rn[1] + (double)rn[2] * rn[2]);
+            const double *rn = &ref_nrm[3 * r];
+            const float *n = &nrm[3 * v];
+            double rl = sqrt(rn[0] * rn[0] + rn[1] * rn[1] + rn[2] * rn[2]);
             double nl = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
             if (rl > 1e-12) {
-                double dot = ((double)n[0] * rn[0] + (double)n[1] * rn[1] + (double)n[2] * rn[2]) / (rl * nl);
+                double dot = (n[0] * rn[0] + n[1] * rn[1] + n[2] * rn[2]) / (rl * nl);
                 dot = dot > 1 ? 1 : dot < -1 ? -1 : dot;
                 double angle = acos(dot) * 180.0 / 3.14159265358979323846;
                 if (!(angle <= res->normal_error_deg)) res->normal_error_deg = angle;  /* NaN fails closed */
             }
         }
     }
+    /* Results are float32: nothing can be closer to the reference than half a float32 ulp of
+     * its coordinates, so that much is allowed on top of the case's tolerance. */
+    allowed_extra += float32_half_ulp(largest);
+    if (allowed_extra > res->allowed) res->allowed = allowed_extra;
     res->meshes_compared++;
 done:
     free(pos);
@@ -220,12 +233,13 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
     if (!weights) { snprintf(res->failure, sizeof res->failure, "out of memory"); return; }
     const cJSON *time = cJSON_GetObjectItem(frame, "time"), *clip = cJSON_GetObjectItem(frame, "clip"),
                 *forced = cJSON_GetObjectItem(frame, "weights");
-    /* glTF frames name their animation ("clip"); without one they show the default weights.
-     * FBX frames are in the file's first animation stack; a frame with time null was made by
-     * ufbx_evaluate_scene with the scene's default animation (the first stack) at t = 0, so an
-     * animated weight there overrides the static DeformPercent (blender_279_*_7400_binary:
-     * its positions show the animated weight 0 although its "channels" list the static 1). */
-    int32_t clip_index = cJSON_IsNumber(clip) ? clip->valueint : !gltf && a->clip_count ? 0 : -1;
+    /* A frame with "time": null, or with forced "weights", shows the file's static state: the
+     * channels' default weights (FBX DeformPercent, glTF mesh weights), no animation applied.
+     * Otherwise its time is in the named "clip" (a glTF animation index); FBX frames name none
+     * and use the file's first animation stack; a glTF frame that names none is static. */
+    int32_t clip_index = -1;
+    if (cJSON_IsNumber(time) && !forced)
+        clip_index = cJSON_IsNumber(clip) ? clip->valueint : !gltf && a->clip_count ? 0 : -1;
     mk_error err;
     if (clip_index >= (int32_t)a->clip_count) {
         snprintf(res->failure, sizeof res->failure, "frame needs clip %d, import has %u clips", clip_index, a->clip_count);
@@ -242,7 +256,7 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
     snprintf(path, sizeof path, "%s/%s", base_dir, file);
     if (!strcmp(kind, "obj")) {
         uint32_t count;
-        float *ref = read_obj_positions(path, &count, res->failure, sizeof res->failure);
+        double *ref = read_obj_positions(path, &count, res->failure, sizeof res->failure);
         if (!ref) { free(weights); return; }
         /* An OBJ frame holds the one deformed mesh: the asset's mesh with channels. */
         for (uint32_t i = 0; i < a->mesh_count && !res->failure[0]; i++) {
@@ -273,8 +287,8 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
         }
         force_mesh_weights(a, (uint32_t)mi, forced, weights);
         uint32_t count, ncount = 0;
-        float *pos = json_float_array(cJSON_GetObjectItem(rm, "positions"), &count);
-        float *nrm = json_float_array(cJSON_GetObjectItem(rm, "normals"), &ncount);
+        double *pos = json_double_array(cJSON_GetObjectItem(rm, "positions"), &count);
+        double *nrm = json_double_array(cJSON_GetObjectItem(rm, "normals"), &ncount);
         if (!pos) snprintf(res->failure, sizeof res->failure, "reference mesh has no positions");
         else compare_mesh(a, (uint32_t)mi, weights, pos, count / 3, ncount == count ? nrm : NULL, world, by_cp,
                           l->report.max_position_error, res);
