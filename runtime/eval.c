@@ -123,7 +123,7 @@ static size_t stride_or(size_t stride, size_t fallback) { return stride ? stride
 static uint32_t job_vertex_count(const mk_eval_job *job)
 {
     const mk_blob_mesh *m = &job->asset->meshes[job->mesh];
-    return job->vertex_count ? job->vertex_count : m->vertex_count - job->first_vertex;
+    return job->vertex_count == MK_VERTICES_TO_END ? m->vertex_count - job->first_vertex : job->vertex_count;
 }
 
 mk_result mk_eval_validate(const mk_eval_job *job, mk_error *err)
@@ -132,8 +132,8 @@ mk_result mk_eval_validate(const mk_eval_job *job, mk_error *err)
     const mk_asset *a = job->asset;
     if (job->mesh >= a->mesh_count) return job_fail(err, MK_ERROR_OUT_OF_RANGE, "eval job: mesh index out of range");
     const mk_blob_mesh *m = &a->meshes[job->mesh];
-    if (job->first_vertex >= m->vertex_count
-        || (job->vertex_count && job->vertex_count > m->vertex_count - job->first_vertex))
+    if (job->first_vertex > m->vertex_count
+        || (job->vertex_count != MK_VERTICES_TO_END && job->vertex_count > m->vertex_count - job->first_vertex))
         return job_fail(err, MK_ERROR_OUT_OF_RANGE, "eval job: vertex range exceeds the mesh");
     if (job->weight_count != m->channel_count)
         return job_fail(err, MK_ERROR_OUT_OF_RANGE, "eval job: weight_count differs from the mesh's channel count");
@@ -516,7 +516,7 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
 mk_result mk_eval_run(const mk_eval_job *job, mk_error *err)
 {
     mk_result r = mk_eval_validate(job, err);
-    if (r != MK_OK) return r;
+    if (r != MK_OK || job_vertex_count(job) == 0) return r;
     const mk_asset *a = job->asset;
     const mk_blob_mesh *m = &a->meshes[job->mesh];
     mk_stacking stacking = job->stacking == MK_STACKING_ASSET ? (mk_stacking)m->stacking : job->stacking;

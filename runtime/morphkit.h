@@ -192,11 +192,14 @@ typedef enum mk_store_mode {
 } mk_store_mode;
 #define MK_STREAM_MIN_BYTES ((size_t)8 << 20)
 
+/* mk_eval_job.vertex_count for "from first_vertex to the end of the mesh". */
+#define MK_VERTICES_TO_END UINT32_MAX
+
 typedef struct mk_eval_job {
     const mk_asset *asset;
     uint32_t mesh;
     uint32_t first_vertex;        /* vertex range [first_vertex, first_vertex + vertex_count) */
-    uint32_t vertex_count;        /* 0 means "to the end of the mesh" */
+    uint32_t vertex_count;        /* vertices to evaluate (0: none); MK_VERTICES_TO_END: the rest of the mesh */
     const float *weights;         /* one per channel of the mesh (mesh-local channel order) */
     uint32_t weight_count;        /* must equal the mesh's channel count */
     mk_stacking stacking;         /* MK_STACKING_ASSET (0) uses the blob's per-mesh setting */

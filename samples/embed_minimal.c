@@ -52,7 +52,7 @@ int main(int argc, char **argv)
             size_t scratch_size = mk_eval_scratch_size(&asset, m);
             void *scratch = aligned_alloc(16, (scratch_size + 15) & ~(size_t)15);
             mk_eval_job job = {
-                .asset = &asset, .mesh = m,
+                .asset = &asset, .mesh = m, .vertex_count = MK_VERTICES_TO_END,
                 .weights = weights + mesh.first_channel, .weight_count = mesh.channel_count,
                 .scratch = scratch, .scratch_size = scratch_size,
                 .positions = vertices, .positions_stride = stride, .positions_size = stride * mesh.vertex_count,

@@ -27,7 +27,7 @@ mk_result frame_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *wei
     void *scratch = aligned_alloc(16, (scratch_size + 15) & ~(size_t)15);
     if (!scratch) return MK_ERROR_OUT_OF_MEMORY;
     mk_eval_job job = {
-        .asset = asset, .mesh = mesh, .weights = weights + m.first_channel, .weight_count = m.channel_count,
+        .asset = asset, .mesh = mesh, .vertex_count = MK_VERTICES_TO_END, .weights = weights + m.first_channel, .weight_count = m.channel_count,
         .stacking = stacking, .normal_mode = normals_mode, .scratch = scratch, .scratch_size = scratch_size,
         .positions = positions, .positions_size = (size_t)m.vertex_count * 12,
         .normals = m.has_normals ? normals : NULL, .normals_size = (size_t)m.vertex_count * 12,

@@ -669,7 +669,7 @@ static void twist_180_auto_inbetweens_play_back_within_tolerance(void)
     double worst = 0;
     for (int step = 0; step <= 100; step++) {
         float w = (float)step / 100;
-        mk_eval_job job = { .asset = &asset, .mesh = 0, .weights = &w, .weight_count = 1,
+        mk_eval_job job = { .asset = &asset, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = &w, .weight_count = 1,
                             .scratch = scratch, .scratch_size = scratch_size,
                             .positions = out, .positions_size = 3 * m->vertex_count * sizeof(float) };
         r = mk_eval_run(&job, &err);

@@ -61,6 +61,7 @@ int ft_eval_control_points(const mk_raw_asset *raw, uint32_t mesh, int32_t clip,
     memset(&job, 0, sizeof job);
     job.asset = &asset;
     job.mesh = mesh;
+    job.vertex_count = MK_VERTICES_TO_END;
     job.weights = w + m.first_channel;
     job.weight_count = m.channel_count;
     job.scratch = scratch;

@@ -35,7 +35,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             mk_mesh_info info;
             mk_mesh_get(&a, m, &info);
             if (info.vertex_count > 2048 || mk_eval_scratch_size(&a, m) > sizeof scratch) continue;
-            mk_eval_job j = { .asset = &a, .mesh = m, .weights = weights + info.first_channel,
+            mk_eval_job j = { .asset = &a, .mesh = m, .vertex_count = MK_VERTICES_TO_END, .weights = weights + info.first_channel,
                               .weight_count = info.channel_count, .normal_mode = (mk_normal_mode)(size & 1),
                               .scratch = scratch, .scratch_size = sizeof scratch, .positions = out,
                               .positions_size = sizeof out, .normals = info.has_normals ? out_n : NULL,

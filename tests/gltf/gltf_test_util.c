@@ -85,6 +85,7 @@ int gt_eval(const gt_model *m, uint32_t mesh, const float *weights, float *posit
     memset(&e, 0, sizeof e);
     e.asset = &m->asset;
     e.mesh = mesh;
+    e.vertex_count = MK_VERTICES_TO_END;
     e.weights = weights + info.first_channel;
     e.weight_count = info.channel_count;
     e.scratch = scratch;

@@ -47,7 +47,7 @@ static mk_result open_and_use(const unsigned char *blob, size_t size)
         if (m.vertex_count > 4096 || mk_eval_scratch_size(&a, mi) > sizeof scratch) continue;
         for (int v = 0; v < 4; v++) {
             for (uint32_t c = 0; c < a.channel_count; c++) weights[c] = values[(c + (uint32_t)v) % 4];
-            mk_eval_job j = { .asset = &a, .mesh = mi, .weights = weights + m.first_channel, .weight_count = m.channel_count,
+            mk_eval_job j = { .asset = &a, .mesh = mi, .vertex_count = MK_VERTICES_TO_END, .weights = weights + m.first_channel, .weight_count = m.channel_count,
                               .normal_mode = (mk_normal_mode)(v & 1), .scratch = scratch, .scratch_size = sizeof scratch,
                               .positions = out, .positions_size = sizeof out,
                               .normals = m.has_normals ? out_n : NULL, .normals_size = sizeof out_n,

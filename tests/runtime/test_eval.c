@@ -26,7 +26,7 @@ static mk_result eval_quad(setup *s, const float w[4], mk_stacking stacking, mk_
                            float *t)
 {
     _Alignas(16) unsigned char scratch[1024];
-    mk_eval_job job = { .asset = &s->asset, .mesh = 0, .weights = w, .weight_count = 4, .stacking = stacking,
+    mk_eval_job job = { .asset = &s->asset, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = w, .weight_count = 4, .stacking = stacking,
                         .normal_mode = mode, .scratch = scratch, .scratch_size = sizeof scratch,
                         .positions = p, .positions_size = 48, .normals = n, .normals_size = 48,
                         .tangents = t, .tangents_size = 64 };
@@ -203,7 +203,7 @@ static void test_ranges_and_strides(void)
     float *whole = malloc(1000 * 12), *whole_n = malloc(1000 * 12);
     float *inter = malloc(1000 * 32);          /* interleaved: pos(12) pad(4) normal(12) pad(4) */
     for (int stacking = 1; stacking <= 2; stacking++) {
-        mk_eval_job job = { .asset = &a, .mesh = 0, .weights = w, .weight_count = 12, .stacking = (mk_stacking)stacking,
+        mk_eval_job job = { .asset = &a, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = w, .weight_count = 12, .stacking = (mk_stacking)stacking,
                             .scratch = scratch, .scratch_size = scratch_size, .positions = whole,
                             .positions_size = 12000, .normals = whole_n, .normals_size = 12000 };
         CHECK(mk_eval_run(&job, &err) == MK_OK);
@@ -232,7 +232,7 @@ static void test_ranges_and_strides(void)
     mk_asset fa;
     CHECK(mk_asset_open(fblob, fsize, &fa, &err) == MK_OK);
     float *exact = malloc(1000 * 12);
-    mk_eval_job job = { .asset = &fa, .mesh = 0, .weights = w, .weight_count = 12, .scratch = scratch,
+    mk_eval_job job = { .asset = &fa, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = w, .weight_count = 12, .scratch = scratch,
                         .scratch_size = scratch_size, .positions = exact, .positions_size = 12000 };
     CHECK(mk_eval_run(&job, &err) == MK_OK);
     job.asset = &a;

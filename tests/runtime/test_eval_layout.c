@@ -173,7 +173,7 @@ static void masks_match_reference(mk_precision precision, double tolerance)
         for (int c = 0; c < TARGETS; c++)
             w[c] = trial == 0 ? 1.0f : (lcg(&seed) % 3 == 0) ? 0.0f : symmetric(&seed, 1.0f);
         reference(&l.raw, w, rp, rn, rt);
-        mk_eval_job job = { .asset = &l.asset, .weights = w, .weight_count = TARGETS, .scratch = l.scratch,
+        mk_eval_job job = { .asset = &l.asset, .vertex_count = MK_VERTICES_TO_END, .weights = w, .weight_count = TARGETS, .scratch = l.scratch,
                             .scratch_size = l.scratch_size, .positions = p, .positions_size = sizeof p,
                             .normals = n, .normals_size = sizeof n, .tangents = t, .tangents_size = sizeof t };
         mk_error err;
@@ -261,7 +261,7 @@ static void test_subranges_match_whole_mesh(void)
     mk_error err;
     int cases = 0;
     for (int normal_mode = MK_NORMALS_NLERP; normal_mode <= MK_NORMALS_SLERP; normal_mode++) {
-        mk_eval_job whole = { .asset = &l.asset, .weights = w, .weight_count = TARGETS, .scratch = l.scratch,
+        mk_eval_job whole = { .asset = &l.asset, .vertex_count = MK_VERTICES_TO_END, .weights = w, .weight_count = TARGETS, .scratch = l.scratch,
                               .scratch_size = l.scratch_size, .normal_mode = (mk_normal_mode)normal_mode,
                               .positions = whole_p, .positions_size = sizeof whole_p, .normals = whole_n,
                               .normals_size = sizeof whole_n, .tangents = whole_t, .tangents_size = sizeof whole_t };

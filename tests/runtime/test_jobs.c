@@ -25,8 +25,8 @@ static void setup(void)
 static mk_eval_job valid_eval(void)
 {
     setup();
-    mk_eval_job j = { .asset = &asset, .mesh = 0, .weights = weights, .weight_count = 4, .scratch = scratch,
-                      .scratch_size = sizeof scratch, .positions = pos, .positions_size = 48, .normals = nrm,
+    mk_eval_job j = { .asset = &asset, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = weights,
+                      .weight_count = 4, .scratch = scratch, .scratch_size = sizeof scratch, .positions = pos, .positions_size = 48, .normals = nrm,
                       .normals_size = 48, .tangents = tan4, .tangents_size = 64 };
     return j;
 }
@@ -47,7 +47,8 @@ static void test_invalid_eval_jobs(void)
     CHECK(mk_eval_run(NULL, NULL) == MK_ERROR_INVALID_ARGUMENT);
     j = valid_eval(); j.asset = NULL; expect(j, MK_ERROR_INVALID_ARGUMENT, "asset NULL");
     j = valid_eval(); j.mesh = 2; expect(j, MK_ERROR_OUT_OF_RANGE, "mesh out of range");
-    j = valid_eval(); j.first_vertex = 4; expect(j, MK_ERROR_OUT_OF_RANGE, "first vertex past end");
+    j = valid_eval(); j.first_vertex = 5; expect(j, MK_ERROR_OUT_OF_RANGE, "first vertex past end");
+    j = valid_eval(); j.first_vertex = 1; j.vertex_count = 4; expect(j, MK_ERROR_OUT_OF_RANGE, "count past end");
     j = valid_eval(); j.first_vertex = 2; j.vertex_count = 3; expect(j, MK_ERROR_OUT_OF_RANGE, "range past end");
     j = valid_eval(); j.weight_count = 3; expect(j, MK_ERROR_OUT_OF_RANGE, "weight count");
     j = valid_eval(); j.weights = NULL; expect(j, MK_ERROR_INVALID_ARGUMENT, "weights NULL");
@@ -71,6 +72,28 @@ static void test_invalid_eval_jobs(void)
     /* The exact size is enough: stride * (n - 1) + element. */
     j = valid_eval(); j.positions_stride = 16; j.positions_size = 16 * 3 + 12; expect(j, MK_OK, "exact strided size");
     j = valid_eval(); j.scratch_size = mk_eval_scratch_size(&asset, 0); expect(j, MK_OK, "queried scratch size");
+}
+
+/* vertex_count 0 is an empty range: it writes nothing, wherever it starts (a job splitter
+ * that produces an empty slice must not evaluate the whole mesh); MK_VERTICES_TO_END from
+ * the last vertex is empty too. */
+static void test_empty_ranges_write_nothing(void)
+{
+    static const uint32_t firsts[] = { 0, 2, 4 };
+    for (int k = 0; k < 3; k++)
+        for (int to_end = 0; to_end < 2; to_end++) {
+            if (to_end && firsts[k] != 4) continue;
+            mk_eval_job j = valid_eval();
+            j.first_vertex = firsts[k];
+            j.vertex_count = to_end ? MK_VERTICES_TO_END : 0;
+            for (int i = 0; i < 64; i++) pos[i] = nrm[i] = tan4[i] = -7.0f;
+            j.positions_size = j.normals_size = j.tangents_size = 0;
+            mk_error err;
+            CHECK_MSG(mk_eval_run(&j, &err) == MK_OK, "empty range at %u: %s", firsts[k], err.message);
+            int untouched = 1;
+            for (int i = 0; i < 64; i++) untouched &= pos[i] == -7.0f && nrm[i] == -7.0f && tan4[i] == -7.0f;
+            CHECK_MSG(untouched, "empty range at %u wrote output", firsts[k]);
+        }
 }
 
 static mk_sample_job valid_sample(void)
@@ -121,5 +144,5 @@ static void test_queries_reject_bad_indices(void)
     CHECK(mk_eval_scratch_size(&asset, 9) == 0);
 }
 
-CHECK_MAIN(CASE(test_valid_job_runs), CASE(test_invalid_eval_jobs), CASE(test_invalid_sample_jobs),
+CHECK_MAIN(CASE(test_valid_job_runs), CASE(test_invalid_eval_jobs), CASE(test_empty_ranges_write_nothing), CASE(test_invalid_sample_jobs),
            CASE(test_queries_reject_bad_indices))

@@ -52,7 +52,7 @@ static void test_runtime_allocates_nothing(void)
         mk_sample_job s = { .asset = &a, .clip = 0, .time = 0.02f * (float)frame, .weights = w, .weight_count = 5,
                             .cursors = cursors, .cursor_count = 2, .loop = frame & 1 };
         ok &= mk_sample_run(&s, &err) == MK_OK;
-        mk_eval_job j = { .asset = &a, .mesh = 0, .weights = w, .weight_count = 4,
+        mk_eval_job j = { .asset = &a, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = w, .weight_count = 4,
                           .stacking = (mk_stacking)(1 + frame % 2), .normal_mode = (mk_normal_mode)((frame / 2) % 2),
                           .scratch = scratch, .scratch_size = sizeof scratch, .positions = p, .positions_size = sizeof p,
                           .normals = n, .normals_size = sizeof n, .tangents = t, .tangents_size = sizeof t };
