@@ -38,12 +38,47 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
 /* Reads an opened blob back into a raw model (dequantized). out must be mk_raw_init'ed. */
 mk_result mk_read_blob(const mk_asset *asset, mk_raw_asset *out, mk_error *err);
 
-/* Whole file into arena memory (16-byte aligned, NUL appended past size). */
+/* Whole file into arena memory (16-byte aligned, NUL appended past size). Pipes and devices
+ * are read to their end. A directory or an empty file is an error saying so. */
 mk_result mk_read_file(mk_arena *arena, const char *path, size_t max_size, void **data,
                        size_t *size, mk_error *err);
 /* Does path end with extension (lower case, with the dot), ignoring the path's case? */
 int mk_path_has_extension(const char *path, const char *extension);
-/* Writes to "<path>.tmp.<pid>" then renames over path: readers never see half a file. */
-mk_result mk_write_file_atomic(const char *path, const void *data, size_t size, mk_error *err);
+
+/* ---- Outputs ----
+ * An output is checked before anything is read or computed (mk_output_check), then written
+ * with the others of the same command (mk_write_outputs):
+ *   - a regular file, new or existing, is replaced atomically: a temporary file beside it,
+ *     flushed, renamed over it (an existing file keeps its permission bits);
+ *   - a symbolic link is followed to the file it names (also a dangling one), which is
+ *     replaced as above: the link stays a link;
+ *   - a device or FIFO is opened and written directly (no rename);
+ *   - a directory or a socket is an error, as is a missing or unwritable folder;
+ *   - an output that is the same file (device and inode) as an input is refused.
+ * Several outputs are all or nothing: if one fails, none is left changed. */
+typedef enum mk_output_kind {
+    MK_OUTPUT_NEW_FILE = 0,
+    MK_OUTPUT_REPLACE_FILE,
+    MK_OUTPUT_STREAM               /* device or FIFO: written in place */
+} mk_output_kind;
+
+typedef struct mk_output {
+    const char *path;              /* as the user gave it */
+    const void *data;              /* set before mk_write_outputs */
+    size_t size;
+    /* Filled by mk_output_check. */
+    mk_output_kind kind;
+    uint32_t mode;                 /* permission bits of a replaced file */
+    char target[4096];             /* path with symbolic links followed: the file written */
+    char temp[4200], backup[4200]; /* used while writing */
+} mk_output;
+
+/* Decides how out->path will be written and refuses it early (see above). inputs (may be
+ * NULL entries) are the files the command reads. */
+mk_result mk_output_check(mk_output *out, const char *const *inputs, uint32_t input_count, mk_error *err);
+/* Writes checked outputs, all or none. */
+mk_result mk_write_outputs(mk_output *outputs, uint32_t count, mk_error *err);
+/* mk_output_check (no inputs) + mk_write_outputs for one file. */
+mk_result mk_write_file(const char *path, const void *data, size_t size, mk_error *err);
 
 #endif

@@ -1,60 +1,282 @@
-/* Whole-file reads into arena memory, atomic writes (temporary file + rename), so a
- * failed or interrupted write never leaves a half-written output behind, and the
- * file-extension test shared by the importers and the CLI. */
+/* Whole-file reads into arena memory, and output writing that never loses data: a regular
+ * file is replaced atomically (temporary file beside it, flushed, renamed), a symbolic link is
+ * followed (the file it points at is replaced, the link stays a link), a device, FIFO or
+ * socket is written directly, a directory is an error, and several outputs are written all
+ * together or not at all. Also the file-extension test shared by the importers and the CLI. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include "blob_io.h"
 
-mk_result mk_read_file(mk_arena *arena, const char *path, size_t max_size, void **data, size_t *size, mk_error *err)
+static mk_result io_error(mk_error *err, const char *path, const char *what, int e)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%s: cannot open: %s", path, strerror(errno));
-    if (fseek(f, 0, SEEK_END) != 0) { fclose(f); return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%s: cannot seek", path); }
-    long n = ftell(f);
-    if (n < 0) { fclose(f); return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%s: cannot tell size (not a regular file?)", path); }
-    if (max_size && (unsigned long)n > max_size) {
-        fclose(f);
-        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "%s: %ld bytes exceeds the limit of %zu bytes", path, n, max_size);
+    return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: %s: %s", path, what, strerror(e));
+}
+
+/* Reads everything from fd, growing the buffer (pipes and devices have no size up front). */
+static mk_result read_stream(mk_arena *arena, int fd, const char *path, size_t max_size, uint8_t **data, size_t *size,
+                             mk_error *err)
+{
+    size_t cap = 1 << 16, n = 0;
+    uint8_t *p = mk_arena_alloc(arena, cap + 1);
+    if (!p) return mk_error_oom(err, "reading a file");
+    for (;;) {
+        if (n == cap) {
+            if (max_size && cap >= max_size)
+                return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "%.200s: more than the limit of %zu bytes", path, max_size);
+            uint8_t *q = mk_arena_realloc(arena, p, cap + 1, 2 * cap + 1);
+            if (!q) return mk_error_oom(err, "reading a file");
+            p = q;
+            cap *= 2;
+        }
+        ssize_t got = read(fd, p + n, cap - n);
+        if (got < 0 && errno == EINTR) continue;
+        if (got < 0) return io_error(err, path, "read failed", errno);
+        if (got == 0) break;
+        n += (size_t)got;
     }
-    rewind(f);
-    uint8_t *p = mk_arena_alloc(arena, (size_t)n + 1);
-    if (!p) { fclose(f); return mk_error_oom(err, "reading a file"); }
-    size_t got = fread(p, 1, (size_t)n, f);
-    int failed = ferror(f);
-    fclose(f);
-    if (failed || got != (size_t)n) {
-        mk_arena_release(arena, p);
-        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%s: read %zu of %ld bytes", path, got, n);
-    }
+    if (max_size && n > max_size)
+        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "%.200s: %zu bytes exceeds the limit of %zu bytes", path, n, max_size);
     p[n] = 0;
     *data = p;
-    *size = (size_t)n;
+    *size = n;
     return MK_OK;
 }
 
-mk_result mk_write_file_atomic(const char *path, const void *data, size_t size, mk_error *err)
+mk_result mk_read_file(mk_arena *arena, const char *path, size_t max_size, void **data, size_t *size, mk_error *err)
 {
-    char tmp[4096];
-    int n = snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
-    if (n < 0 || (size_t)n >= sizeof tmp) return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%s: path too long", path);
-    FILE *f = fopen(tmp, "wb");
-    if (!f) return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%s: cannot create: %s", tmp, strerror(errno));
-    size_t put = size ? fwrite(data, 1, size, f) : 0;
-    int failed = put != size || fflush(f) != 0 || fsync(fileno(f)) != 0;
-    failed |= fclose(f) != 0;
-    if (failed) {
-        remove(tmp);
-        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%s: write failed (disk full?)", path);
+    int fd = open(path, O_RDONLY | O_NOCTTY);
+    if (fd < 0) return io_error(err, path, "cannot open", errno);
+    struct stat st;
+    mk_result r = MK_OK;
+    uint8_t *p = NULL;
+    size_t n = 0;
+    if (fstat(fd, &st) != 0) {
+        r = io_error(err, path, "cannot read its status", errno);
+    } else if (S_ISDIR(st.st_mode)) {
+        r = mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: is a directory, not a file", path);
+    } else if (!S_ISREG(st.st_mode)) {
+        r = read_stream(arena, fd, path, max_size, &p, &n, err);
+    } else if (max_size && (uint64_t)st.st_size > max_size) {
+        r = mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "%.200s: %lld bytes exceeds the limit of %zu bytes", path,
+                         (long long)st.st_size, max_size);
+    } else if ((uint64_t)st.st_size >= SIZE_MAX) {
+        r = mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "%.200s: too large for this machine", path);
+    } else {
+        n = (size_t)st.st_size;
+        p = mk_arena_alloc(arena, n + 1);
+        if (!p) r = mk_error_oom(err, "reading a file");
+        size_t got = 0;
+        while (r == MK_OK && got < n) {
+            ssize_t k = read(fd, p + got, n - got);
+            if (k < 0 && errno == EINTR) continue;
+            if (k < 0) r = io_error(err, path, "read failed", errno);
+            else if (k == 0) r = mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: read %zu of %zu bytes (file shrank?)", path, got, n);
+            else got += (size_t)k;
+        }
+        if (p) p[n] = 0;
     }
-    if (rename(tmp, path) != 0) {
-        int e = errno;
-        remove(tmp);
-        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%s: cannot rename into place: %s", path, strerror(e));
+    close(fd);
+    if (r == MK_OK && n == 0) r = mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: empty file", path);
+    if (r != MK_OK) {
+        if (p) mk_arena_release(arena, p);
+        return r;
     }
+    *data = p;
+    *size = n;
     return MK_OK;
+}
+
+/* ---- outputs ---- */
+
+/* dir of path into out ("." for a bare name, "/" for "/name"). */
+static void dir_of(const char *path, char *out, size_t size)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash) { snprintf(out, size, "."); return; }
+    size_t n = slash == path ? 1 : (size_t)(slash - path);
+    snprintf(out, size, "%.*s", (int)n, path);
+}
+
+/* Follows path's symbolic links (also dangling ones) to the file that would be written. */
+static mk_result resolve_links(const char *path, char *target, size_t size, mk_error *err)
+{
+    if ((size_t)snprintf(target, size, "%s", path) >= size)
+        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: path too long", path);
+    for (int hops = 0; hops < 40; hops++) {
+        struct stat st;
+        if (lstat(target, &st) != 0 || !S_ISLNK(st.st_mode)) return MK_OK;
+        char link[PATH_MAX], joined[PATH_MAX];
+        ssize_t n = readlink(target, link, sizeof link - 1);
+        if (n < 0) return io_error(err, path, "cannot read the symbolic link", errno);
+        link[n] = 0;
+        if (link[0] == '/') {
+            snprintf(joined, sizeof joined, "%s", link);
+        } else {
+            char dir[PATH_MAX];
+            dir_of(target, dir, sizeof dir);
+            if ((size_t)snprintf(joined, sizeof joined, "%s/%s", dir, link) >= sizeof joined)
+                return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: link target path too long", path);
+        }
+        snprintf(target, size, "%s", joined);
+    }
+    return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: too many levels of symbolic links", path);
+}
+
+mk_result mk_output_check(mk_output *out, const char *const *inputs, uint32_t input_count, mk_error *err)
+{
+    const char *path = out->path;
+    if (!path || !path[0]) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "empty output path");
+    mk_result r = resolve_links(path, out->target, sizeof out->target, err);
+    if (r != MK_OK) return r;
+    struct stat st;
+    int exists = stat(out->target, &st) == 0;
+    if (!exists && errno != ENOENT) return io_error(err, path, "cannot write", errno);
+    if (exists) {
+        for (uint32_t i = 0; i < input_count; i++) {
+            struct stat in;
+            if (inputs[i] && stat(inputs[i], &in) == 0 && in.st_dev == st.st_dev && in.st_ino == st.st_ino)
+                return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
+                                    "refusing to overwrite the input %.200s (it is the same file as the output %.200s)",
+                                    inputs[i], path);
+        }
+        if (S_ISDIR(st.st_mode))
+            return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: is a directory; give a file name", path);
+        if (!S_ISREG(st.st_mode)) {
+            if (S_ISSOCK(st.st_mode))
+                return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: is a socket; cannot write to it", path);
+            if (access(out->target, W_OK) != 0) return io_error(err, path, "cannot write", errno);
+            out->kind = MK_OUTPUT_STREAM;
+            return MK_OK;
+        }
+    }
+    char dir[PATH_MAX];
+    dir_of(out->target, dir, sizeof dir);
+    struct stat ds;
+    if (stat(dir, &ds) != 0)
+        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: cannot create it: folder %.200s: %s", path, dir, strerror(errno));
+    if (!S_ISDIR(ds.st_mode))
+        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: cannot create it: %.200s is not a folder", path, dir);
+    if (access(dir, W_OK) != 0)
+        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: cannot write in folder %.200s: %s", path, dir, strerror(errno));
+    out->kind = exists ? MK_OUTPUT_REPLACE_FILE : MK_OUTPUT_NEW_FILE;
+    out->mode = exists ? (uint32_t)(st.st_mode & 07777) : 0;
+    return MK_OK;
+}
+
+static int write_all(int fd, const void *data, size_t size)
+{
+    const uint8_t *p = data;
+    while (size) {
+        ssize_t k = write(fd, p, size);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return -1;
+        p += k;
+        size -= (size_t)k;
+    }
+    return 0;
+}
+
+/* A new file "<target><suffix>.<pid>.<n>" created exclusively (the umask applies). */
+static int create_beside(const char *target, const char *suffix, char *name, size_t size)
+{
+    for (int n = 0; n < 1000; n++) {
+        if ((size_t)snprintf(name, size, "%s%s.%ld.%d", target, suffix, (long)getpid(), n) >= size) {
+            errno = ENAMETOOLONG;
+            return -1;
+        }
+        int fd = open(name, O_WRONLY | O_CREAT | O_EXCL, 0666);
+        if (fd >= 0 || errno != EEXIST) return fd;
+    }
+    return -1;
+}
+
+static void sync_dir_of(const char *target)
+{
+    char dir[PATH_MAX];
+    dir_of(target, dir, sizeof dir);
+    int fd = open(dir, O_RDONLY);
+    if (fd >= 0) {
+        (void)fsync(fd);
+        close(fd);
+    }
+}
+
+mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
+{
+    mk_result r = MK_OK;
+    uint32_t written = 0, renamed = 0;
+    for (uint32_t i = 0; i < count; i++) outs[i].temp[0] = outs[i].backup[0] = 0;
+    /* 1. Every file's bytes into a temporary file beside its target. */
+    for (; written < count && r == MK_OK; written++) {
+        mk_output *o = &outs[written];
+        if (o->kind == MK_OUTPUT_STREAM) continue;
+        int fd = create_beside(o->target, ".tmp", o->temp, sizeof o->temp);
+        if (fd < 0) { r = io_error(err, o->path, "cannot create a temporary file beside it", errno); o->temp[0] = 0; break; }
+        int failed = write_all(fd, o->data, o->size) != 0;
+        int e = errno;
+        if (!failed && o->kind == MK_OUTPUT_REPLACE_FILE) (void)fchmod(fd, (mode_t)o->mode);
+        if (!failed && fsync(fd) != 0) { failed = 1; e = errno; }
+        if (close(fd) != 0 && !failed) { failed = 1; e = errno; }
+        if (failed) r = io_error(err, o->path, "write failed", e);
+    }
+    /* 2. Streams (devices, FIFOs) are written directly; they cannot be taken back, so they
+     * come after everything that can fail before them and before anything is renamed. */
+    for (uint32_t i = 0; i < count && r == MK_OK; i++) {
+        mk_output *o = &outs[i];
+        if (o->kind != MK_OUTPUT_STREAM) continue;
+        int fd = open(o->target, O_WRONLY | O_NOCTTY);
+        if (fd < 0) { r = io_error(err, o->path, "cannot open", errno); break; }
+        int failed = write_all(fd, o->data, o->size) != 0;
+        int e = errno;
+        if (close(fd) != 0 && !failed) { failed = 1; e = errno; }
+        if (failed) r = io_error(err, o->path, "write failed", e);
+    }
+    /* 3. Renames into place; a replaced file keeps a hard-linked backup until all succeeded,
+     * so a failed rename puts every earlier output back as it was. */
+    for (; renamed < count && r == MK_OK; renamed++) {
+        mk_output *o = &outs[renamed];
+        if (o->kind == MK_OUTPUT_STREAM) continue;
+        if (o->kind == MK_OUTPUT_REPLACE_FILE && count > 1) {
+            int fd = create_beside(o->target, ".bak", o->backup, sizeof o->backup);
+            if (fd >= 0) {
+                close(fd);
+                if (unlink(o->backup) != 0 || link(o->target, o->backup) != 0) o->backup[0] = 0;
+            } else {
+                o->backup[0] = 0;
+            }
+        }
+        if (rename(o->temp, o->target) != 0) { r = io_error(err, o->path, "cannot rename into place", errno); break; }
+        o->temp[0] = 0;
+    }
+    if (r != MK_OK) {
+        for (uint32_t i = 0; i < renamed; i++) {
+            mk_output *o = &outs[i];
+            if (o->kind == MK_OUTPUT_STREAM) continue;
+            if (o->backup[0]) rename(o->backup, o->target);
+            else if (o->kind == MK_OUTPUT_NEW_FILE) unlink(o->target);
+            o->backup[0] = 0;
+        }
+    }
+    for (uint32_t i = 0; i < count; i++) {
+        if (outs[i].temp[0]) unlink(outs[i].temp);
+        if (outs[i].backup[0]) unlink(outs[i].backup);
+        if (r == MK_OK && outs[i].kind != MK_OUTPUT_STREAM) sync_dir_of(outs[i].target);
+    }
+    return r;
+}
+
+mk_result mk_write_file(const char *path, const void *data, size_t size, mk_error *err)
+{
+    mk_output out = { .path = path, .data = data, .size = size };
+    mk_result r = mk_output_check(&out, NULL, 0, err);
+    return r != MK_OK ? r : mk_write_outputs(&out, 1, err);
 }
 
 int mk_path_has_extension(const char *path, const char *extension)

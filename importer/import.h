@@ -9,6 +9,8 @@ typedef struct mk_import_options {
     int keep_shape_normals;        /* FBX: 0 = use shape normals only when present and non-zero (default) */
     const char *channels_sidecar;  /* glTF: path of a sidecar JSON grouping targets into channels, or NULL */
     size_t max_input_size;         /* bytes; 0 = 4 GiB */
+    int keep_plain_meshes;         /* mk_import_file: 0 = meshes without morph targets are dropped
+                                    * (with a warning naming each); 1 = kept (bakers start from them) */
 } mk_import_options;
 
 /* Binary or ASCII FBX from memory. Warnings go to out->warnings. */

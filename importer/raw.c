@@ -149,6 +149,24 @@ mk_result mk_raw_group_channels(mk_raw_asset *raw, mk_error *err)
     return MK_OK;
 }
 
+void mk_raw_drop_plain_meshes(mk_raw_asset *raw, const char *what)
+{
+    uint32_t kept = 0;
+    for (uint32_t m = 0; m < raw->mesh_count; m++) {
+        int has_channels = 0;
+        for (uint32_t c = 0; c < raw->channel_count && !has_channels; c++) has_channels = raw->channels[c].mesh == m;
+        if (!has_channels) {
+            mk_raw_warn(raw, "mesh '%s' has no morph targets; %s", raw->meshes[m].name ? raw->meshes[m].name : "",
+                        what ? what : "skipped");
+            continue;
+        }
+        for (uint32_t c = 0; c < raw->channel_count; c++)
+            if (raw->channels[c].mesh == m) raw->channels[c].mesh = kept;
+        raw->meshes[kept++] = raw->meshes[m];
+    }
+    raw->mesh_count = kept;
+}
+
 static int finite_array(const float *p, size_t n)
 {
     for (size_t i = 0; i < n; i++)

@@ -103,6 +103,10 @@ void mk_raw_sort_targets(mk_raw_asset *raw);
 /* Orders channels by mesh (stable) and remaps tracks, so the asset is ready to write. */
 mk_result mk_raw_group_channels(mk_raw_asset *raw, mk_error *err);
 
+/* Removes the meshes that have no channel (remapping channel mesh indices), with one warning
+ * per mesh: "mesh 'NAME' has no morph targets; <what>" (what NULL: "skipped"). */
+void mk_raw_drop_plain_meshes(mk_raw_asset *raw, const char *what);
+
 /* Checks everything the writer and runtime rely on: counts, indices in range, strictly
  * increasing sparse indices and key times, finite values, nonzero and strictly increasing
  * full weights, channel grouping. The error names the element (mesh/channel/target/key). */

@@ -168,10 +168,16 @@ int mk_clip_get(const mk_asset *asset, uint32_t clip, mk_clip_info *out);
 /* Track k of a clip: which channel it animates and its keys. */
 int mk_track_get(const mk_asset *asset, uint32_t clip, uint32_t track, uint32_t *channel,
                  const mk_key **keys, uint32_t *key_count);
-/* Index of the mesh/channel/clip with that name, or -1. */
+/* Index of the first mesh/channel/clip with that name (in asset order), or -1. Names need not
+ * be unique: a glTF mesh's weights belong to the whole mesh, so each of its primitives (one
+ * morphkit mesh each, same node) has a channel of the same name, and all of them must get the
+ * same weight; different nodes may also reuse names. Use mk_find_channels to get them all. */
 int32_t mk_find_mesh(const mk_asset *asset, const char *name);
 int32_t mk_find_channel(const mk_asset *asset, const char *name);
 int32_t mk_find_clip(const mk_asset *asset, const char *name);
+/* Every channel named `name`, in asset order: writes the first `capacity` indices to out (may
+ * be NULL with capacity 0) and returns how many there are. */
+uint32_t mk_find_channels(const mk_asset *asset, const char *name, uint32_t *out, uint32_t capacity);
 
 /* ---- Evaluation job ---- */
 

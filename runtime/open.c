@@ -527,6 +527,17 @@ int32_t mk_find_channel(const mk_asset *a, const char *name)
     return -1;
 }
 
+uint32_t mk_find_channels(const mk_asset *a, const char *name, uint32_t *out, uint32_t capacity)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; a && name && i < a->channel_count; i++)
+        if (strcmp(string_at(a, a->channels[i].name), name) == 0) {
+            if (out && n < capacity) out[n] = i;
+            n++;
+        }
+    return n;
+}
+
 int32_t mk_find_clip(const mk_asset *a, const char *name)
 {
     for (uint32_t i = 0; a && name && i < a->clip_count; i++)

@@ -99,7 +99,7 @@ int main(int argc, char **argv)
     void *blob;
     size_t size;
     mk_write_report report;
-    if (mk_write_blob(&raw, NULL, &raw.arena, &blob, &size, &report, &err) || mk_write_file_atomic(argv[1], blob, size, &err)) {
+    if (mk_write_blob(&raw, NULL, &raw.arena, &blob, &size, &report, &err) || mk_write_file(argv[1], blob, size, &err)) {
         fprintf(stderr, "make_example: %s\n", err.message);
         return 1;
     }

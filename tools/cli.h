@@ -1,29 +1,57 @@
-/* The morphkit command-line program: one verb per file (cmd_*.c), thin over the libraries. */
+/* The morphkit command-line program: one verb per file (cmd_*.c), thin over the libraries.
+ * Each verb declares its command line as a cli_verb (cli_args.h). */
 #ifndef MK_CLI_H
 #define MK_CLI_H
 
 #include <stdio.h>
 #include "blob_io.h"
+#include "cli_args.h"
 #include "import.h"
 
-/* Each verb gets argv starting at the verb itself; returns the process exit status. */
-int cmd_info(int argc, char **argv);
-int cmd_play(int argc, char **argv);
-int cmd_import(int argc, char **argv);
-int cmd_export(int argc, char **argv);
-int cmd_bake(int argc, char **argv);
-int cmd_conform(int argc, char **argv);
-int cmd_bench(int argc, char **argv);
+extern const cli_verb cli_verb_import, cli_verb_info, cli_verb_play, cli_verb_bake, cli_verb_export,
+    cli_verb_conform, cli_verb_bench;
 
 /* Loads any supported input (.morph, .fbx, .gltf, .glb) into a raw model. */
 mk_result cli_load_raw(const char *path, const mk_import_options *options, mk_raw_asset *raw,
                        mk_error *err);
-/* Prints the warnings of a raw model to stderr ("warning: ..."), then "N warnings". */
+/* Prints the warnings of a raw model to stderr ("warning: ..."); nothing when there are none. */
 void cli_print_warnings(const mk_raw_asset *raw);
-/* Parses --precision float|q16 and --stacking additive|sequential values; -1 when invalid. */
-int cli_parse_precision(const char *s);
-int cli_parse_stacking(const char *s);
-/* Prints "morphkit <verb>: <error message>" to stderr; returns 1 (or 2 for usage errors). */
+/* Prints "morphkit <verb>: <error message>" to stderr; returns 1 (2 for invalid arguments). */
 int cli_fail(const char *verb, const mk_error *err);
+
+/* ---- outputs ---- */
+
+/* One output of a command: a file written with the rules of blob_io.h, or standard output
+ * ("-"). */
+typedef struct cli_output {
+    mk_output file;
+    int to_stdout;
+} cli_output;
+
+/* Checks an output path before any work: "-" is standard output where allow_stdout; a file
+ * name must end in one of `extensions` (NULL-terminated; not checked for devices and FIFOs),
+ * whose content is described by `what` ("a .morph blob"); the output must not be one of
+ * the inputs. Returns -1 when fine, else the exit status after printing the error. */
+int cli_output_check(const cli_verb *verb, cli_output *out, const char *option, const char *path,
+                     const char *const *extensions, const char *what, int allow_stdout,
+                     const char *const *inputs, uint32_t input_count);
+/* Writes the outputs all or none (standard output last). Returns 0 or the exit status. */
+int cli_write_outputs(const cli_verb *verb, cli_output *outs, uint32_t count);
+
+/* ---- progress ---- */
+
+/* Progress lines on stderr for long work: only when stderr is a terminal and not quiet;
+ * a stage prints once it has run for half a second, then at most once per tenth. */
+typedef struct cli_progress {
+    int enabled;
+    char stage[256];
+    int last_tenth;
+    double stage_start;
+} cli_progress;
+
+void cli_progress_init(cli_progress *p, int quiet);
+/* fraction in [0, 1]; a negative fraction announces a stage right away (one line). */
+void cli_progress_update(cli_progress *p, const char *stage, double fraction);
+double cli_now_seconds(void);
 
 #endif

@@ -1,5 +1,7 @@
 /* Shared helpers of the verbs. */
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 #include "cli.h"
 
 mk_result cli_load_raw(const char *path, const mk_import_options *options, mk_raw_asset *raw, mk_error *err)
@@ -14,27 +16,82 @@ void cli_print_warnings(const mk_raw_asset *raw)
     uint32_t shown = raw->warning_count < MK_RAW_MAX_WARNINGS ? raw->warning_count : MK_RAW_MAX_WARNINGS;
     for (uint32_t i = 0; i < shown && raw->warnings; i++) fprintf(stderr, "warning: %s\n", raw->warnings[i].message);
     if (raw->warning_count > shown) fprintf(stderr, "warning: ... %u more\n", raw->warning_count - shown);
-    fprintf(stderr, "%u warning%s\n", raw->warning_count, raw->warning_count == 1 ? "" : "s");
-}
-
-int cli_parse_precision(const char *s)
-{
-    if (!s) return -1;
-    if (!strcmp(s, "float")) return MK_PRECISION_FLOAT;
-    if (!strcmp(s, "q16")) return MK_PRECISION_Q16;
-    return -1;
-}
-
-int cli_parse_stacking(const char *s)
-{
-    if (!s) return -1;
-    if (!strcmp(s, "additive")) return MK_STACKING_ADDITIVE;
-    if (!strcmp(s, "sequential")) return MK_STACKING_SEQUENTIAL;
-    return -1;
 }
 
 int cli_fail(const char *verb, const mk_error *err)
 {
-    fprintf(stderr, "morphkit %s: %s (%s)\n", verb, err->message, mk_result_name(err->code));
-    return err->code == MK_ERROR_INVALID_ARGUMENT ? 2 : 1;
+    fprintf(stderr, "morphkit %s: %s\n", verb, err->message);
+    return err->code == MK_ERROR_INVALID_ARGUMENT ? CLI_EXIT_USAGE : CLI_EXIT_FAILURE;
+}
+
+int cli_output_check(const cli_verb *verb, cli_output *out, const char *option, const char *path,
+                     const char *const *extensions, const char *what, int allow_stdout,
+                     const char *const *inputs, uint32_t input_count)
+{
+    memset(out, 0, sizeof *out);
+    out->file.path = path;
+    if (!strcmp(path, "-")) {
+        if (!allow_stdout) return cli_usage_error(verb, "%s -: %s cannot go to standard output; name a file", option, what);
+        out->to_stdout = 1;
+        return -1;
+    }
+    mk_error err;
+    if (mk_output_check(&out->file, inputs, input_count, &err) != MK_OK) return cli_fail(verb->name, &err);
+    if (out->file.kind == MK_OUTPUT_STREAM || !extensions) return -1;
+    for (const char *const *e = extensions; *e; e++)
+        if (mk_path_has_extension(path, *e)) return -1;
+    char list[128] = "";
+    for (const char *const *e = extensions; *e; e++)
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", e == extensions ? "" : " or ", *e);
+    return cli_usage_error(verb, "%s %s: %s writes %s, so the name must end in %s", option, path, verb->name, what, list);
+}
+
+int cli_write_outputs(const cli_verb *verb, cli_output *outs, uint32_t count)
+{
+    mk_output files[8];
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < count && n < 8; i++)
+        if (!outs[i].to_stdout) files[n++] = outs[i].file;
+    mk_error err;
+    if (n && mk_write_outputs(files, n, &err) != MK_OK) return cli_fail(verb->name, &err);
+    for (uint32_t i = 0; i < count; i++) {
+        if (!outs[i].to_stdout) continue;
+        if (fwrite(outs[i].file.data, 1, outs[i].file.size, stdout) != outs[i].file.size || fflush(stdout) != 0) {
+            fprintf(stderr, "morphkit %s: writing to standard output failed\n", verb->name);
+            return CLI_EXIT_FAILURE;
+        }
+    }
+    return 0;
+}
+
+double cli_now_seconds(void)
+{
+    struct timespec ts;
+    timespec_get(&ts, TIME_UTC);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void cli_progress_init(cli_progress *p, int quiet)
+{
+    memset(p, 0, sizeof *p);
+    p->enabled = !quiet && isatty(STDERR_FILENO);
+    p->last_tenth = -1;
+}
+
+void cli_progress_update(cli_progress *p, const char *stage, double fraction)
+{
+    if (!p->enabled) return;
+    if (fraction < 0) {  /* announce a stage that reports no fractions */
+        fprintf(stderr, "  %s ...\n", stage);
+        return;
+    }
+    int tenth = (int)(fraction * 10);
+    if (strncmp(p->stage, stage, sizeof p->stage - 1) != 0) {
+        snprintf(p->stage, sizeof p->stage, "%s", stage);
+        p->last_tenth = -1;
+        p->stage_start = cli_now_seconds();
+    }
+    if (tenth <= p->last_tenth || cli_now_seconds() - p->stage_start < 0.5) return;
+    p->last_tenth = tenth;
+    fprintf(stderr, "  %s: %3d%%\n", stage, tenth * 10);
 }

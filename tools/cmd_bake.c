@@ -1,49 +1,49 @@
-/* morphkit bake IN.morph|IN.fbx|IN.gltf --recipe RECIPE.json -o OUT.morph
- *                [--precision float|q16] [--quiet]
- * Applies a bake recipe (docs/baking.md) and writes the asset with the baked channels added.
- * Nothing is written when the recipe or any channel fails. */
+/* morphkit bake: applies a bake recipe (docs/baking.md) and writes the asset with the baked
+ * channels added. Nothing is written when the recipe or any channel fails. */
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include "bake.h"
 #include "cli.h"
 
-static int usage(void)
-{
-    fprintf(stderr, "usage: morphkit bake IN.morph|IN.fbx|IN.gltf --recipe RECIPE.json -o OUT.morph\n"
-                    "       [--precision float|q16] [--quiet]\n");
-    return 2;
-}
+typedef struct bake_args {
+    const char *input, *output, *recipe;
+    int precision, quiet, all_meshes;
+} bake_args;
+
+static int run_bake(void *p);
+
+static const cli_option options[] = {
+    { "--recipe", "RECIPE.json", CLI_STRING, offsetof(bake_args, recipe),
+      "The bake recipe: which deformers make which channels (docs/baking.md). Paths in it are relative to its folder.",
+      NULL, NULL, 0, 0, 1, 0 },
+    { "-o", "OUT.morph", CLI_STRING, offsetof(bake_args, output), "The blob to write (a path ending in .morph, or a device/FIFO).",
+      NULL, NULL, 0, 0, 1, 0 },
+    { "--precision", "P", CLI_CHOICE, offsetof(bake_args, precision), "How deltas are stored (as for 'morphkit import').", "q16",
+      "q16|float", 0, 0, 0, 0 },
+    { "--all-meshes", NULL, CLI_FLAG, offsetof(bake_args, all_meshes),
+      "Also write meshes that end up without channels (by default they are left out).", NULL, NULL, 0, 0, 0, 0 },
+    { "--quiet", NULL, CLI_FLAG, offsetof(bake_args, quiet), "No progress lines and no solver details (results are still printed).",
+      NULL, NULL, 0, 0, 0, 0 },
+};
+
+const cli_verb cli_verb_bake = {
+    "bake", "IN --recipe RECIPE.json -o OUT.morph [options]", "bake deformers (FFD, bend, cage, Laplacian, ...) into channels",
+    "Reads IN (meshes with or without morph targets), applies the recipe's deformers and writes the asset with the baked "
+    "channels added, each with adaptive in-betweens placed so playback stays within the recipe's tolerance.",
+    "IN", "A .morph blob, or any file 'morphkit import' reads.", offsetof(bake_args, input), 1,
+    options, sizeof options / sizeof options[0], sizeof(bake_args), run_bake,
+};
 
 typedef struct bake_ui {
     int quiet;
-    char stage[256];
-    int last_tenth;
-    double stage_start;
+    cli_progress progress;
 } bake_ui;
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    timespec_get(&ts, TIME_UTC);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* Progress on stderr for long bakes only: a stage prints once it has run for half a second,
- * then at most one line per tenth, so short bakes stay silent and logs stay small. */
 static void on_progress(void *user, const char *stage, double fraction)
 {
     bake_ui *ui = user;
-    if (ui->quiet) return;
-    int tenth = (int)(fraction * 10);
-    if (strncmp(ui->stage, stage, sizeof ui->stage - 1) != 0) {
-        snprintf(ui->stage, sizeof ui->stage, "%s", stage);
-        ui->last_tenth = -1;
-        ui->stage_start = now_seconds();
-    }
-    if (tenth <= ui->last_tenth || now_seconds() - ui->stage_start < 0.5) return;
-    ui->last_tenth = tenth;
-    fprintf(stderr, "  %s: %3d%%\n", stage, tenth * 10);
+    cli_progress_update(&ui->progress, stage, fraction);
 }
 
 static void on_channel(void *user, const mk_bake_channel_report *c)
@@ -74,59 +74,53 @@ static void dir_of(const char *path, char *out, size_t size)
     out[n] = 0;
 }
 
-int cmd_bake(int argc, char **argv)
+static int run_bake(void *p)
 {
-    const char *in = NULL, *out = NULL, *recipe_path = NULL;
-    mk_write_options wo = { 0 };
-    bake_ui ui = { 0, "", -1, 0 };
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "-o") && v) { out = v; i++; }
-        else if (!strcmp(a, "--recipe") && v) { recipe_path = v; i++; }
-        else if (!strcmp(a, "--precision") && v) {
-            int p = cli_parse_precision(v);
-            if (p < 0) return usage();
-            wo.precision = (mk_precision)p;
-            i++;
-        }
-        else if (!strcmp(a, "--quiet")) ui.quiet = 1;
-        else if (!strcmp(a, "--help")) { usage(); return 0; }
-        else if (a[0] != '-' && !in) in = a;
-        else { fprintf(stderr, "morphkit bake: unexpected argument '%s'\n", a); return usage(); }
-    }
-    if (!in || !out || !recipe_path) return usage();
+    bake_args *a = p;
+    const cli_verb *verb = &cli_verb_bake;
+    static const char *const extensions[] = { ".morph", NULL };
+    const char *inputs[] = { a->input, a->recipe };
+    cli_output out;
+    int status = cli_output_check(verb, &out, "-o", a->output, extensions, "a .morph blob", 0, inputs, 2);
+    if (status >= 0) return status;
 
+    bake_ui ui = { .quiet = a->quiet };
+    cli_progress_init(&ui.progress, a->quiet);
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err;
-    mk_import_options io = { 0 };
-    mk_result r = cli_load_raw(in, &io, &raw, &err);
-    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail("bake", &err); }
+    mk_import_options io = { .keep_plain_meshes = 1 };  /* a plain mesh is a baker's natural input */
+    mk_result r = cli_load_raw(a->input, &io, &raw, &err);
+    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail(verb->name, &err); }
     void *recipe = NULL;
     size_t recipe_size = 0;
-    r = mk_read_file(&raw.arena, recipe_path, (size_t)64 << 20, &recipe, &recipe_size, &err);
-    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail("bake", &err); }
+    r = mk_read_file(&raw.arena, a->recipe, (size_t)64 << 20, &recipe, &recipe_size, &err);
+    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail(verb->name, &err); }
 
     char dir[4096];
-    dir_of(recipe_path, dir, sizeof dir);
+    dir_of(a->recipe, dir, sizeof dir);
     mk_bake_options bo = { .base_dir = dir, .progress = on_progress, .channel_done = on_channel, .user = &ui };
     mk_bake_report report;
-    uint32_t warnings_before = raw.warning_count;
     r = mk_bake_recipe_ex(&raw, recipe, recipe_size, &bo, &report, &err);
-    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail("bake", &err); }
-    if (!ui.quiet || raw.warning_count > warnings_before) cli_print_warnings(&raw);
+    if (r != MK_OK) { cli_print_warnings(&raw); mk_raw_free(&raw); return cli_fail(verb->name, &err); }
+    if (!a->all_meshes) mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");
+    cli_print_warnings(&raw);
 
     void *blob = NULL;
     size_t size = 0;
     mk_write_report wr;
+    mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16 };
     r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &wr, &err);
-    if (r == MK_OK) r = mk_write_file_atomic(out, blob, size, &err);
-    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail("bake", &err); }
-    printf("%s -> %s: %u channels baked, %u targets, max playback error %.3g x diagonal, %zu bytes\n",
-           in, out, report.channels_added, report.targets_added, report.max_error, size);
-    if (!ui.quiet)
+    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail(verb->name, &err); }
+    out.file.data = blob;
+    out.file.size = size;
+    status = cli_write_outputs(verb, &out, 1);
+    if (status == 0) {
+        printf("%s -> %s: %u channels baked, %u targets, max playback error %.3g x diagonal, %zu bytes\n",
+               a->input, a->output, report.channels_added, report.targets_added, report.max_error, size);
         printf("precision: %u int16 targets, %u float targets; max position quantization error %.3g\n",
                wr.quantized_targets, wr.float_targets, wr.max_position_error);
+    }
     mk_raw_free(&raw);
-    return 0;
+    return status;
 }

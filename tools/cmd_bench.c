@@ -14,11 +14,13 @@
  */
 #define _GNU_SOURCE
 #include <math.h>
+#include <stddef.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 #include "asset_load.h"
 #include "format.h"
 #include "frame.h"
@@ -184,6 +186,7 @@ typedef struct bench_ctx {
     atomic_uint next_chunk;    /* next range of the current mesh to evaluate */
     int quit;
     copy_probe *probe;         /* sampled after each round of timed passes, or NULL */
+    cli_progress *progress;
     uint64_t chunks[64][8];    /* chunks each thread evaluated (one cache line per thread) */
 } bench_ctx;
 
@@ -287,6 +290,7 @@ static void time_configs(bench_ctx *c, const float *weight_sets, uint32_t frames
             if (t < configs[i].best) configs[i].best = t;
         }
         copy_probe_sample(c->probe);
+        if (c->progress) cli_progress_update(c->progress, "timing passes", (double)(pass + 1) / BENCH_PASSES);
     }
 }
 
@@ -426,42 +430,85 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
     return total;
 }
 
-static int usage(void)
+typedef struct bench_args {
+    const char *file;
+    uint64_t vertices, channels, active, threads, frames, profile;
+    double density;
+    int json, quiet;
+} bench_args;
+
+static int run_bench(void *p);
+
+static const cli_option options[] = {
+    { "--vertices", "N", CLI_UINT, offsetof(bench_args, vertices), "Synthetic mesh size, in vertices.", "1000000", NULL, 64,
+      100000000, 0, 0 },
+    { "--channels", "C", CLI_UINT, offsetof(bench_args, channels),
+      "Synthetic channels (one in five progressive, with an in-between at 0.5).", "100", NULL, 1, 100000, 0, 0 },
+    { "--active", "A", CLI_UINT, offsetof(bench_args, active), "Synthetic channels with a nonzero weight in each frame (<= C).",
+      "30", NULL, 0, 100000, 0, 0 },
+    { "--density", "D", CLI_NUMBER, offsetof(bench_args, density),
+      "Fraction of the vertices each synthetic target moves (in a few coherent regions).", "0.1", NULL, 1e-6, 0.3, 0, 0 },
+    { "--threads", "T", CLI_UINT, offsetof(bench_args, threads),
+      "Evaluation threads (ranges of 256 blocks taken from a shared counter).", "1", NULL, 1, 64, 0, 0 },
+    { "--frames", "F", CLI_UINT, offsetof(bench_args, frames),
+      "Weight sets per pass (with FILE: its first clip at F evenly spaced times).", "100", NULL, 1, 100000, 0, 0 },
+    { "--json", NULL, CLI_FLAG, offsetof(bench_args, json), "Print one JSON object with the measured keys only.", NULL, NULL,
+      0, 0, 0, 0 },
+    { "--profile", "N", CLI_UINT, offsetof(bench_args, profile),
+      "Profiling mode: only N rounds of evaluation (for perf or callgrind), no baselines.", NULL, NULL, 1, 1000000, 0, 0 },
+    { "--quiet", NULL, CLI_FLAG, offsetof(bench_args, quiet), "No progress lines.", NULL, NULL, 0, 0, 0, 0 },
+};
+
+const cli_verb cli_verb_bench = {
+    "bench", "[FILE] [options]", "measure evaluation speed against baselines run in the same process",
+    "Times the runtime's evaluation (positions + normals, positions only, sequential stacking) and prints it with ratios "
+    "against baselines measured in the same run: the memory-copy bound for the bytes a frame touches, and a naive dense "
+    "loop. Without FILE a synthetic asset is built (--vertices, --channels, --active, --density).",
+    "FILE", "An asset to play instead of the synthetic one (its first clip).", offsetof(bench_args, file), 0,
+    options, sizeof options / sizeof options[0], sizeof(bench_args), run_bench,
+};
+
+/* Bytes of memory the machine has, or 0 when unknown. */
+static double machine_memory(void)
 {
-    fprintf(stderr, "usage: morphkit bench [FILE] [--vertices N] [--channels C] [--active A] [--density D]\n"
-                    "       [--threads T] [--frames F] [--json] [--profile N]\n");
-    return 2;
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    return pages > 0 && page > 0 ? (double)pages * (double)page : 0;
 }
 
-int cmd_bench(int argc, char **argv)
+/* What the synthetic benchmark will allocate, roughly: the raw model and its blob (base
+ * arrays, triangles, target deltas), the naive baseline's copy and dense arrays of the active
+ * targets, the outputs and the copy probe. */
+static double synthetic_bytes(const bench_options *o)
 {
-    bench_options o = { 1000000, 100, 30, 1, 100, 0, 0.10, 0 };
-    const char *file = NULL;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--vertices") && v) { o.vertices = (uint32_t)strtoul(v, NULL, 10); i++; }
-        else if (!strcmp(a, "--channels") && v) { o.channels = (uint32_t)strtoul(v, NULL, 10); i++; }
-        else if (!strcmp(a, "--active") && v) { o.active = (uint32_t)strtoul(v, NULL, 10); i++; }
-        else if (!strcmp(a, "--density") && v) { o.density = atof(v); i++; }
-        else if (!strcmp(a, "--threads") && v) { o.threads = (uint32_t)strtoul(v, NULL, 10); i++; }
-        else if (!strcmp(a, "--frames") && v) { o.frames = (uint32_t)strtoul(v, NULL, 10); i++; }
-        else if (!strcmp(a, "--profile") && v) { o.profile = (uint32_t)strtoul(v, NULL, 10); i++; }
-        else if (!strcmp(a, "--json")) o.json = 1;
-        else if (!strcmp(a, "--help")) { usage(); return 0; }
-        else if (a[0] != '-' && !file) file = a;
-        else { fprintf(stderr, "morphkit bench: unexpected argument '%s'\n", a); return usage(); }
+    double n = (double)o->vertices, targets = 1.2 * (double)o->channels;
+    double base = n * (24 + 24 + 24 + 24 + 24);
+    double deltas = targets * o->density * n * 28.0 * 3;
+    double dense = 1.2 * (double)o->active * n * 24.0;
+    return base + deltas + dense + (double)(512u << 20);
+}
+
+static int run_bench(void *p)
+{
+    bench_args *args = p;
+    const cli_verb *verb = &cli_verb_bench;
+    bench_options o = { (uint32_t)args->vertices, (uint32_t)args->channels, (uint32_t)args->active, (uint32_t)args->threads,
+                        (uint32_t)args->frames, (uint32_t)args->profile, args->density, args->json };
+    const char *file = args->file;
+    if (o.active > o.channels) return cli_usage_error(verb, "--active %u is more than --channels %u", o.active, o.channels);
+    if (!file) {
+        double need = synthetic_bytes(&o), have = machine_memory();
+        if (have > 0 && need > 0.8 * have)
+            return cli_usage_error(verb, "the synthetic asset needs about %.1f GB, more than this machine's %.1f GB allows; "
+                                   "lower --vertices, --channels, --active or --density", need / 1e9, have / 1e9);
     }
-    if (o.vertices < 64 || o.channels == 0 || o.active > o.channels || o.threads < 1 || o.threads > 64
-        || o.frames == 0 || !(o.density > 0 && o.density <= 0.3)) {
-        fprintf(stderr, "morphkit bench: need --vertices >= 64, 1 <= --channels, --active <= --channels, 1 <= --threads <= 64, "
-                        "0 < --density <= 0.3\n");
-        return 2;
-    }
+    cli_progress progress;
+    cli_progress_init(&progress, args->quiet || args->json);
     loaded_asset l;
     mk_error err;
     memset(&l, 0, sizeof l);
     mk_result r;
     double t_build = now_ns();
+    cli_progress_update(&progress, file ? "loading the asset" : "building the synthetic asset", -1);
     if (file) {
         r = load_asset(file, NULL, NULL, &l, &err);
     } else {
@@ -470,7 +517,7 @@ int cmd_bench(int argc, char **argv)
         if (!r) r = mk_write_blob(&l.raw, NULL, &l.raw.arena, &l.blob, &l.blob_size, &l.report, &err);
         if (!r) r = mk_asset_open(l.blob, l.blob_size, &l.asset, &err);
     }
-    if (r) { loaded_asset_free(&l); return cli_fail("bench", &err); }
+    if (r) { loaded_asset_free(&l); return cli_fail(verb->name, &err); }
     t_build = now_ns() - t_build;
     const mk_asset *a = &l.asset;
 
@@ -498,6 +545,7 @@ int cmd_bench(int argc, char **argv)
     memset(&ctx, 0, sizeof ctx);
     ctx.asset = a;
     ctx.threads = o.threads;
+    ctx.progress = &progress;
     size_t max_vertices = 0, max_scratch = 0;
     for (uint32_t mi = 0; mi < a->mesh_count; mi++) {
         mk_mesh_info m;
@@ -557,6 +605,7 @@ int cmd_bench(int argc, char **argv)
     ctx.probe = NULL;
     double bound_ns = bandwidth > 0 ? bytes / bandwidth : 0;
     double diff = 0;
+    cli_progress_update(&progress, "naive baseline", -1);
     double naive_ns = naive_frames(&l, weights, frames < 20 ? frames : 20, &diff);
 
     if (o.json) {

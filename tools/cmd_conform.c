@@ -1,18 +1,10 @@
-/* morphkit conform CASES.json [--case SUBSTRING] [--precision float|q16] [--normal-tolerance DEG]
- *
- * For each case of a manifest: imports the source in
- * memory, writes it as a blob with the chosen precision, opens it with the runtime, and for
- * every reference frame samples the clip (or applies forced weights), evaluates every mesh
- * and compares with the reference: max position error (world or mesh-local space, matched
- * per control point or per vertex) and, where the reference has normals, the max angle
- * between directions. One line per frame, then "N passed, N failed". Exit 0 only if all
- * frames passed.
+/* morphkit conform: playback checked against reference frames made by other software.
  *
  * With q16 precision the allowed error is the case tolerance plus the quantization bound the
- * writer reports, propagated through the frame's channel coefficients and the world scale.
- */
+ * writer reports, propagated through the frame's channel coefficients and the world scale. */
 #include <cjson/cJSON.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include "asset_load.h"
@@ -104,6 +96,13 @@ static double float32_half_ulp(double x)
     return x > 0 ? ldexp(1.0, exponent - 25) : 0.0;
 }
 
+/* A manifest path: relative to the manifest's folder unless absolute. */
+static void join_path(char *out, size_t size, const char *base_dir, const char *path)
+{
+    if (path[0] == '/') snprintf(out, size, "%s", path);
+    else snprintf(out, size, "%s/%s", base_dir, path);
+}
+
 static double max_column_norm(const float *w)
 {
     double m = 0;
@@ -129,7 +128,7 @@ static double coefficient_sum(const mk_asset *a, const mk_mesh_info *m, const fl
 
 typedef struct frame_result {
     double position_error, normal_error_deg, allowed;
-    int meshes_compared;
+    int meshes_compared, normals_compared;
     char failure[1024];
 } frame_result;
 
@@ -190,6 +189,7 @@ static void compare_mesh(const mk_asset *a, uint32_t mi, const float *weights, c
                 dot = dot > 1 ? 1 : dot < -1 ? -1 : dot;
                 double angle = acos(dot) * 180.0 / 3.14159265358979323846;
                 if (!(angle <= res->normal_error_deg)) res->normal_error_deg = angle;  /* NaN fails closed */
+                res->normals_compared = 1;
             }
         }
     }
@@ -253,7 +253,7 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
     }
 
     char path[4096];
-    snprintf(path, sizeof path, "%s/%s", base_dir, file);
+    join_path(path, sizeof path, base_dir, file);
     if (!strcmp(kind, "obj")) {
         uint32_t count;
         double *ref = read_obj_positions(path, &count, res->failure, sizeof res->failure);
@@ -276,13 +276,14 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
     for (const cJSON *rm = meshes ? meshes->child : NULL; rm && !res->failure[0]; rm = rm->next) {
         const cJSON *chans = cJSON_GetObjectItem(rm, gltf ? "weights" : "channels");
         int has_morph = cJSON_GetArraySize(chans) > 0;
+        /* A reference mesh without channels is not compared: references evaluate whole scenes
+         * (node animation, skinning), and such a mesh is not imported by default. */
+        if (!has_morph) continue;
         int mi = find_mesh_for(a, rm, gltf);
         if (mi < 0) {
-            if (has_morph) {
-                const char *label = cJSON_GetStringValue(cJSON_GetObjectItem(rm, gltf ? "label" : "node"));
-                snprintf(res->failure, sizeof res->failure, "reference mesh '%s' with morph channels is not in the import",
-                         label ? label : "?");
-            }
+            const char *label = cJSON_GetStringValue(cJSON_GetObjectItem(rm, gltf ? "label" : "node"));
+            snprintf(res->failure, sizeof res->failure, "reference mesh '%s' with morph channels is not in the import",
+                     label ? label : "?");
             continue;
         }
         force_mesh_weights(a, (uint32_t)mi, forced, weights);
@@ -301,30 +302,44 @@ static void run_frame(const loaded_asset *l, const cJSON *cs, const cJSON *frame
     free(weights);
 }
 
-static void run_case(const cJSON *cs, const char *base_dir, const conform_options *opt, counts *total)
+static int case_matches(const cJSON *cs, const char *filter)
+{
+    const char *name = cJSON_GetStringValue(cJSON_GetObjectItem(cs, "name"));
+    const char *source = cJSON_GetStringValue(cJSON_GetObjectItem(cs, "source"));
+    return !filter || (name && strstr(name, filter)) || (source && strstr(source, filter));
+}
+
+static const char *frame_label(const cJSON *frame)
+{
+    const char *file = cJSON_GetStringValue(cJSON_GetObjectItem(frame, "file"));
+    const char *slash = file ? strrchr(file, '/') : NULL;
+    return slash ? slash + 1 : file ? file : "?";
+}
+
+static void run_case(const cJSON *cs, const char *base_dir, const conform_options *opt, int name_width, int frame_width,
+                     counts *total)
 {
     const char *name = cJSON_GetStringValue(cJSON_GetObjectItem(cs, "name"));
     const char *source = cJSON_GetStringValue(cJSON_GetObjectItem(cs, "source"));
     const cJSON *frames = cJSON_GetObjectItem(cs, "frames");
-    double tolerance = cJSON_GetNumberValue(cJSON_GetObjectItem(cJSON_GetObjectItem(cs, "reference"), "tolerance"));
-    if (!name || !source || !cJSON_IsArray(frames)) {
-        printf("%-48s FAIL malformed case entry\n", name ? name : "?");
+    const cJSON *tol = cJSON_GetObjectItem(cJSON_GetObjectItem(cs, "reference"), "tolerance");
+    if (!name || !source || !cJSON_IsArray(frames) || !cJSON_IsNumber(tol) || !(tol->valuedouble >= 0)) {
+        printf("%-*s FAIL malformed case entry (needs name, source, reference.tolerance >= 0 and frames[])\n", name_width,
+               name ? name : "?");
         total->failed++;
         return;
     }
-    if (opt->filter && !strstr(name, opt->filter) && !strstr(source, opt->filter)) return;
+    double tolerance = tol->valuedouble;
     char path[4096];
-    snprintf(path, sizeof path, "%s/%s", base_dir, source);
+    join_path(path, sizeof path, base_dir, source);
     mk_write_options wo = { .precision = opt->precision };
     loaded_asset l;
     mk_error err;
     mk_result r = load_asset(path, NULL, &wo, &l, &err);
     for (const cJSON *frame = frames->child; frame; frame = frame->next) {
-        const char *file = cJSON_GetStringValue(cJSON_GetObjectItem(frame, "file"));
-        const char *short_name = file ? strrchr(file, '/') : NULL;
-        short_name = short_name ? short_name + 1 : file ? file : "?";
+        const char *label = frame_label(frame);
         if (r != MK_OK) {
-            printf("%-48s %-22s FAIL import: %s\n", name, short_name, err.message);
+            printf("%-*s %-*s FAIL import: %s\n", name_width, name, frame_width, label, err.message);
             total->failed++;
             continue;
         }
@@ -333,8 +348,11 @@ static void run_case(const cJSON *cs, const char *base_dir, const conform_option
         run_frame(&l, cs, frame, base_dir, &res);
         double allowed = tolerance + res.allowed;
         int ok = !res.failure[0] && res.position_error <= allowed && res.normal_error_deg <= opt->normal_tolerance_deg;
-        printf("%-48s %-22s pos %.3g (<= %.3g) normal %.3g deg  %s", name, short_name, res.position_error, allowed,
-               res.normal_error_deg, ok ? "ok" : "FAIL");
+        char normal[64];
+        if (res.normals_compared) snprintf(normal, sizeof normal, "%.3g deg", res.normal_error_deg);
+        else snprintf(normal, sizeof normal, "-");
+        printf("%-*s %-*s pos %-9.3g (<= %-9.3g) normal %-10s %s", name_width, name, frame_width, label,
+               res.position_error, allowed, normal, ok ? "ok" : "FAIL");
         if (res.failure[0]) printf(" %s", res.failure);
         printf("\n");
         if (ok) total->passed++; else total->failed++;
@@ -342,37 +360,74 @@ static void run_case(const cJSON *cs, const char *base_dir, const conform_option
     loaded_asset_free(&l);
 }
 
-static int usage(void)
-{
-    fprintf(stderr, "usage: morphkit conform CASES.json [--case SUBSTRING] [--precision float|q16] [--normal-tolerance DEG]\n");
-    return 2;
-}
+typedef struct conform_args {
+    const char *manifest, *filter;
+    int precision;
+    double normal_tolerance;
+} conform_args;
 
-int cmd_conform(int argc, char **argv)
+static int run_conform(void *p);
+
+static const cli_option options[] = {
+    { "--case", "SUBSTRING", CLI_STRING, offsetof(conform_args, filter),
+      "Only the cases whose name or source path contains SUBSTRING (an error when none does).", NULL, NULL, 0, 0, 0, 0 },
+    { "--precision", "P", CLI_CHOICE, offsetof(conform_args, precision),
+      "How sources are written before playback: q16 (the allowed error grows by the writer's reported quantization bound) "
+      "or float.", "q16", "q16|float", 0, 0, 0, 0 },
+    { "--normal-tolerance", "DEG", CLI_NUMBER, offsetof(conform_args, normal_tolerance),
+      "Largest angle, in degrees, between a normal and the reference's (where the reference has normals).", "1", NULL, 0, 180,
+      0, 0 },
+};
+
+const cli_verb cli_verb_conform = {
+    "conform", "CASES.json [options]", "check playback against reference frames made by other software",
+    "For each case of the manifest CASES.json: imports its source, writes it with the chosen precision, opens it with the "
+    "runtime and, for every reference frame, samples the clip (or the static state, or forced weights), evaluates every "
+    "mesh with channels and compares positions (and normals where the reference has them). One line per frame, then "
+    "'N passed, N failed'. Exit status 1 when a frame fails.",
+    "CASES.json", "The manifest; paths in it are relative to its folder.", offsetof(conform_args, manifest), 1,
+    options, sizeof options / sizeof options[0], sizeof(conform_args), run_conform,
+};
+
+static int run_conform(void *p)
 {
-    const char *manifest = NULL;
-    conform_options opt = { NULL, MK_PRECISION_Q16, 1.0 };
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--case") && v) { opt.filter = v; i++; }
-        else if (!strcmp(a, "--precision") && v) { int p = cli_parse_precision(v); if (p < 0) return usage(); opt.precision = (mk_precision)p; i++; }
-        else if (!strcmp(a, "--normal-tolerance") && v) { opt.normal_tolerance_deg = atof(v); i++; }
-        else if (!strcmp(a, "--help")) { usage(); return 0; }
-        else if (a[0] != '-' && !manifest) manifest = a;
-        else { fprintf(stderr, "morphkit conform: unexpected argument '%s'\n", a); return usage(); }
-    }
-    if (!manifest) return usage();
+    conform_args *args = p;
+    conform_options opt = { args->filter, args->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16, args->normal_tolerance };
     char why[1024];
-    cJSON *root = read_json(manifest, why, sizeof why);
-    if (!root) { fprintf(stderr, "morphkit conform: %s\n", why); return 1; }
+    cJSON *root = read_json(args->manifest, why, sizeof why);
+    if (!root) { fprintf(stderr, "morphkit conform: %s\n", why); return CLI_EXIT_FAILURE; }
+    const cJSON *cases = cJSON_GetObjectItem(root, "cases");
+    if (!cJSON_IsObject(root) || !cJSON_IsArray(cases)) {
+        fprintf(stderr, "morphkit conform: %s: not a conformance manifest (expected an object with a \"cases\" array)\n",
+                args->manifest);
+        cJSON_Delete(root);
+        return CLI_EXIT_FAILURE;
+    }
     char base_dir[4096];
-    snprintf(base_dir, sizeof base_dir, "%s", manifest);
+    snprintf(base_dir, sizeof base_dir, "%s", args->manifest);
     char *slash = strrchr(base_dir, '/');
     if (slash) *slash = 0; else strcpy(base_dir, ".");
+    int name_width = 8, frame_width = 8, matched = 0;
+    for (const cJSON *cs = cases->child; cs; cs = cs->next) {
+        if (!case_matches(cs, opt.filter)) continue;
+        matched++;
+        const char *name = cJSON_GetStringValue(cJSON_GetObjectItem(cs, "name"));
+        if (name && (int)strlen(name) > name_width) name_width = (int)strlen(name);
+        const cJSON *frames = cJSON_GetObjectItem(cs, "frames");
+        for (const cJSON *f = cJSON_IsArray(frames) ? frames->child : NULL; f; f = f->next)
+            if ((int)strlen(frame_label(f)) > frame_width) frame_width = (int)strlen(frame_label(f));
+    }
+    if (!matched) {
+        if (opt.filter) fprintf(stderr, "morphkit conform: --case '%s' matches none of the %d cases of %s\n", opt.filter,
+                                cJSON_GetArraySize(cases), args->manifest);
+        else fprintf(stderr, "morphkit conform: %s has no cases\n", args->manifest);
+        cJSON_Delete(root);
+        return CLI_EXIT_FAILURE;
+    }
     counts total = { 0, 0 };
-    const cJSON *cases = cJSON_GetObjectItem(root, "cases");
-    for (const cJSON *cs = cases ? cases->child : NULL; cs; cs = cs->next) run_case(cs, base_dir, &opt, &total);
+    for (const cJSON *cs = cases->child; cs; cs = cs->next)
+        if (case_matches(cs, opt.filter)) run_case(cs, base_dir, &opt, name_width, frame_width, &total);
     cJSON_Delete(root);
     printf("%d passed, %d failed\n", total.passed, total.failed);
-    return total.failed || total.passed == 0 ? 1 : 0;
+    return total.failed || total.passed == 0 ? CLI_EXIT_FAILURE : CLI_EXIT_OK;
 }

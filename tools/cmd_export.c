@@ -1,65 +1,92 @@
-/* morphkit export FILE -o OUT.glb|OUT.gltf [--sidecar PATH | --no-sidecar] [--channels SIDECAR.json]
- *
- * Writes meshes, morph targets (baked ones included) and weight clips as glTF 2.0, so any glTF
- * viewer plays the result, plus the channel sidecar (default: OUT without its extension +
- * ".channels.json") so `morphkit import OUT.glb --channels OUT.channels.json` restores
- * progressive channels. Behaviour: docs/importing-gltf.md. */
+/* morphkit export: meshes, morph targets (baked ones included) and weight clips as glTF 2.0,
+ * so any glTF viewer plays the result, plus the channel sidecar that lets
+ * `morphkit import OUT.glb --channels OUT.channels.json` restore progressive channels.
+ * Behaviour: docs/importing-gltf.md. */
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include "cli.h"
 #include "gltf_import.h"
 
-static int usage(void)
-{
-    fprintf(stderr, "usage: morphkit export FILE.morph|FILE.fbx|FILE.gltf|FILE.glb -o OUT.glb|OUT.gltf\n"
-                    "       [--sidecar PATH | --no-sidecar] [--channels SIDECAR.json]\n");
-    return 2;
-}
+typedef struct export_args {
+    const char *input, *output, *sidecar, *channels;
+    int no_sidecar;
+} export_args;
 
-int cmd_export(int argc, char **argv)
-{
-    const char *in = NULL, *out = NULL, *sidecar = NULL;
-    int no_sidecar = 0;
-    mk_import_options io = { 0 };
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "-o") && v) { out = v; i++; }
-        else if (!strcmp(a, "--sidecar") && v) { sidecar = v; i++; }
-        else if (!strcmp(a, "--no-sidecar")) no_sidecar = 1;
-        else if (!strcmp(a, "--channels") && v) { io.channels_sidecar = v; i++; }
-        else if (!strcmp(a, "--help")) { usage(); return 0; }
-        else if (a[0] != '-' && !in) in = a;
-        else { fprintf(stderr, "morphkit export: unexpected argument '%s'\n", a); return usage(); }
-    }
-    if (!in || !out) return usage();
+static int run_export(void *p);
 
+static const cli_option options[] = {
+    { "-o", "OUT.glb|OUT.gltf", CLI_STRING, offsetof(export_args, output),
+      "The glTF to write: .glb (binary) or .gltf (JSON with the buffer embedded).", NULL, NULL, 0, 0, 1, 0 },
+    { "--sidecar", "PATH", CLI_STRING, offsetof(export_args, sidecar),
+      "Where to write the channel sidecar (JSON). Default: OUT without its extension + .channels.json.", NULL, NULL, 0, 0, 0, 0 },
+    { "--no-sidecar", NULL, CLI_FLAG, offsetof(export_args, no_sidecar),
+      "Write no sidecar (a re-import then sees one channel per glTF target).", NULL, NULL, 0, 0, 0, 0 },
+    { "--channels", "SIDECAR.json", CLI_STRING, offsetof(export_args, channels),
+      "glTF input only: the sidecar that groups the input's targets into channels.", NULL, NULL, 0, 0, 0, 0 },
+};
+
+const cli_verb cli_verb_export = {
+    "export", "FILE -o OUT.glb|OUT.gltf [options]", "write an asset as glTF 2.0 (plus a channel sidecar)",
+    "Writes FILE's meshes, morph targets and weight clips as glTF 2.0. A progressive channel becomes one glTF target "
+    "per in-between with weight tracks that reproduce morphkit's playback; the channel sidecar records the grouping so "
+    "a re-import restores the channels. The glTF and the sidecar are written both or neither.",
+    "FILE", "A .morph blob, or any file 'morphkit import' reads.", offsetof(export_args, input), 1,
+    options, sizeof options / sizeof options[0], sizeof(export_args), run_export,
+};
+
+static int run_export(void *p)
+{
+    export_args *a = p;
+    const cli_verb *verb = &cli_verb_export;
+    if (a->no_sidecar && a->sidecar) return cli_usage_error(verb, "--sidecar and --no-sidecar contradict each other");
+    int gltf_input = mk_path_has_extension(a->input, ".gltf") || mk_path_has_extension(a->input, ".glb");
+    if (a->channels && !gltf_input)
+        return cli_usage_error(verb, "--channels: channel sidecars apply to glTF input only (%s is not .gltf or .glb)", a->input);
     /* Default sidecar: OUT.glb -> OUT.channels.json, next to the glTF. */
-    char *default_sidecar = NULL;
-    if (!sidecar && !no_sidecar) {
-        size_t n = strlen(out);
-        const char *dot = strrchr(out, '.'), *slash = strrchr(out, '/');
-        size_t stem = dot && (!slash || dot > slash) ? (size_t)(dot - out) : n;
-        default_sidecar = malloc(stem + sizeof ".channels.json");
-        if (!default_sidecar) { fprintf(stderr, "morphkit export: out of memory\n"); return 1; }
-        memcpy(default_sidecar, out, stem);
-        strcpy(default_sidecar + stem, ".channels.json");
-        sidecar = default_sidecar;
+    char default_sidecar[4200];
+    if (!a->sidecar && !a->no_sidecar) {
+        const char *dot = strrchr(a->output, '.'), *slash = strrchr(a->output, '/');
+        size_t stem = dot && (!slash || dot > slash) ? (size_t)(dot - a->output) : strlen(a->output);
+        snprintf(default_sidecar, sizeof default_sidecar, "%.*s.channels.json", (int)stem, a->output);
+        a->sidecar = default_sidecar;
     }
-    if (no_sidecar) sidecar = NULL;
+    static const char *const gltf_ext[] = { ".glb", ".gltf", NULL }, *const json_ext[] = { ".json", NULL };
+    const char *inputs[] = { a->input, a->channels, a->output };
+    cli_output outs[2];
+    int status = cli_output_check(verb, &outs[0], "-o", a->output, gltf_ext, "glTF", 0, inputs, 2);
+    if (status >= 0) return status;
+    uint32_t count = 1;
+    if (a->sidecar) {
+        status = cli_output_check(verb, &outs[1], "--sidecar", a->sidecar, json_ext, "a JSON channel sidecar", 0, inputs, 3);
+        if (status >= 0) return status;
+        count = 2;
+        if (!strcmp(outs[0].file.target, outs[1].file.target))
+            return cli_usage_error(verb, "--sidecar %s is the same file as -o %s", a->sidecar, a->output);
+    }
+    mk_gltf_container container = mk_path_has_extension(a->output, ".gltf") ? MK_GLTF_JSON : MK_GLTF_GLB;
 
+    mk_import_options io = { .channels_sidecar = a->channels };
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err;
     mk_gltf_export_report rep;
-    mk_result r = cli_load_raw(in, &io, &raw, &err);
+    void *gltf = NULL;
+    char *sidecar = NULL;
+    size_t gltf_size = 0, sidecar_size = 0;
+    mk_result r = cli_load_raw(a->input, &io, &raw, &err);
     cli_print_warnings(&raw);
-    if (r == MK_OK) r = mk_export_gltf(&raw, out, sidecar, &rep, &err);
-    if (r != MK_OK) {
-        mk_raw_free(&raw);
-        free(default_sidecar);
-        return cli_fail("export", &err);
-    }
-    printf("%s -> %s: %u meshes, %u glTF targets, %u clips\n", in, out, rep.meshes, rep.targets, rep.clips);
+    if (r == MK_OK)
+        r = mk_export_gltf_memory(&raw, container, &raw.arena, &gltf, &gltf_size, count == 2 ? &sidecar : NULL,
+                                  &sidecar_size, &rep, &err);
+    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail(verb->name, &err); }
+    outs[0].file.data = gltf;
+    outs[0].file.size = gltf_size;
+    outs[1].file.data = sidecar;
+    outs[1].file.size = sidecar_size;
+    status = cli_write_outputs(verb, outs, count);
+    if (status) { mk_raw_free(&raw); return status; }
+    printf("%s -> %s: %u meshes, %u glTF targets, %u clips\n", a->input, a->output, rep.meshes, rep.targets, rep.clips);
     if (rep.progressive_channels)
         printf("note: %u progressive (in-between) channel%s exported as one glTF target per in-between, with weight\n"
                "      tracks that reproduce morphkit's piecewise-linear playback\n",
@@ -74,9 +101,9 @@ int cmd_export(int argc, char **argv)
     if (rep.fixed_normals)
         printf("note: %u zero-length base normal%s/tangents replaced by face normals (glTF requires unit vectors)\n",
                rep.fixed_normals, rep.fixed_normals == 1 ? "" : "s");
-    if (sidecar)
-        printf("channel sidecar: %s (re-import with: morphkit import %s --channels %s -o OUT.morph)\n", sidecar, out, sidecar);
+    if (count == 2)
+        printf("channel sidecar: %s (re-import with: morphkit import %s --channels %s -o OUT.morph)\n", a->sidecar, a->output,
+               a->sidecar);
     mk_raw_free(&raw);
-    free(default_sidecar);
     return 0;
 }

@@ -1,57 +1,93 @@
-/* morphkit import FILE -o OUT.morph [--stacking additive|sequential] [--precision float|q16]
- *                 [--tolerance D] [--channels SIDECAR.json] */
+/* morphkit import: any source file into a .morph blob. */
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include "cli.h"
 
-static int usage(void)
-{
-    fprintf(stderr, "usage: morphkit import FILE.fbx|FILE.gltf|FILE.glb -o OUT.morph [--stacking additive|sequential]\n"
-                    "       [--precision float|q16] [--tolerance D] [--channels SIDECAR.json]\n");
-    return 2;
-}
+typedef struct import_args {
+    const char *input, *output, *channels;
+    int stacking, precision, stacking_given, quiet, all_meshes;
+    double tolerance;
+} import_args;
 
-int cmd_import(int argc, char **argv)
+static int run_import(void *p);
+
+static const cli_option options[] = {
+    { "-o", "OUT.morph", CLI_STRING, offsetof(import_args, output), "The blob to write (a path ending in .morph, or a device/FIFO).",
+      NULL, NULL, 0, 0, 1, 0 },
+    { "--stacking", "MODE", CLI_CHOICE, offsetof(import_args, stacking),
+      "Channel stacking stored for every mesh (docs/semantics.md). Default: additive; for a .morph input, the stored one (which this option replaces).",
+      NULL, "additive|sequential", 0, 0, 0, offsetof(import_args, stacking_given) },
+    { "--precision", "P", CLI_CHOICE, offsetof(import_args, precision),
+      "How deltas are stored: q16 (int16 with a per-target scale; a target that would exceed --tolerance falls back to float) or float (lossless float32).",
+      "q16", "q16|float", 0, 0, 0, 0 },
+    { "--tolerance", "D", CLI_NUMBER, offsetof(import_args, tolerance),
+      "Largest quantization error of a position, in mesh units. Default: 1e-4 x each mesh's bounding-box diagonal.",
+      NULL, NULL, 1e-30, 1e30, 0, 0 },
+    { "--channels", "SIDECAR.json", CLI_STRING, offsetof(import_args, channels),
+      "glTF input only: a channel sidecar (written by 'morphkit export') that groups targets into progressive channels.",
+      NULL, NULL, 0, 0, 0, 0 },
+    { "--all-meshes", NULL, CLI_FLAG, offsetof(import_args, all_meshes),
+      "Also keep meshes without morph targets (by default only meshes with targets are imported).", NULL, NULL, 0, 0, 0, 0 },
+    { "--quiet", NULL, CLI_FLAG, offsetof(import_args, quiet), "No progress lines (results are still printed).",
+      NULL, NULL, 0, 0, 0, 0 },
+};
+
+const cli_verb cli_verb_import = {
+    "import", "FILE -o OUT.morph [options]", "convert an FBX or glTF file into a .morph blob",
+    "Imports FILE (.fbx binary or ASCII, .gltf, .glb, or a .morph blob to re-encode) with every mesh's blend shape "
+    "channels, in-between targets, target normals and weight clips, and writes it as a validated .morph blob.",
+    "FILE", "The source: .fbx, .gltf, .glb or .morph.", offsetof(import_args, input), 1,
+    options, sizeof options / sizeof options[0], sizeof(import_args), run_import,
+};
+
+static int run_import(void *p)
 {
-    const char *in = NULL, *out = NULL;
-    mk_import_options io = { 0 };
-    mk_write_options wo = { 0 };
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "-o") && v) { out = v; i++; }
-        else if (!strcmp(a, "--stacking") && v) { int s = cli_parse_stacking(v); if (s < 0) return usage(); io.stacking = (mk_stacking)s; i++; }
-        else if (!strcmp(a, "--precision") && v) { int p = cli_parse_precision(v); if (p < 0) return usage(); wo.precision = (mk_precision)p; i++; }
-        else if (!strcmp(a, "--tolerance") && v) {
-            char *end;
-            wo.tolerance = strtof(v, &end);
-            if (*end || !(wo.tolerance > 0)) { fprintf(stderr, "morphkit import: --tolerance needs a positive number\n"); return 2; }
-            i++;
-        }
-        else if (!strcmp(a, "--channels") && v) { io.channels_sidecar = v; i++; }
-        else if (!strcmp(a, "--help")) { usage(); return 0; }
-        else if (a[0] != '-' && !in) in = a;
-        else { fprintf(stderr, "morphkit import: unexpected argument '%s'\n", a); return usage(); }
-    }
-    if (!in || !out) return usage();
+    import_args *a = p;
+    const cli_verb *verb = &cli_verb_import;
+    int is_gltf = mk_path_has_extension(a->input, ".gltf") || mk_path_has_extension(a->input, ".glb");
+    if (a->channels && !is_gltf)
+        return cli_usage_error(verb, "--channels: channel sidecars apply to glTF input only (%s is not .gltf or .glb)", a->input);
+    const char *inputs[] = { a->input, a->channels };
+    static const char *const extensions[] = { ".morph", NULL };
+    cli_output out;
+    int status = cli_output_check(verb, &out, "-o", a->output, extensions, "a .morph blob", 0, inputs, 2);
+    if (status >= 0) return status;
+
+    mk_import_options io = { .channels_sidecar = a->channels, .keep_plain_meshes = a->all_meshes };
+    if (a->stacking_given) io.stacking = a->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
+    mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16, .tolerance = (float)a->tolerance };
+    /* Progress only for inputs big enough to take a while. */
+    struct stat st;
+    cli_progress progress;
+    cli_progress_init(&progress, a->quiet || stat(a->input, &st) != 0 || st.st_size < ((off_t)16 << 20));
+    cli_progress_update(&progress, "importing", -1);
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err;
-    mk_result r = cli_load_raw(in, &io, &raw, &err);
+    mk_result r = cli_load_raw(a->input, &io, &raw, &err);
     cli_print_warnings(&raw);
     void *blob = NULL;
     size_t size = 0;
     mk_write_report report;
+    cli_progress_update(&progress, "writing the blob", -1);
     if (r == MK_OK) r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &report, &err);
-    if (r == MK_OK) r = mk_write_file_atomic(out, blob, size, &err);
-    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail("import", &err); }
-    uint32_t targets = 0;
-    for (uint32_t c = 0; c < raw.channel_count; c++) targets += raw.channels[c].target_count;
-    printf("%s -> %s: %u meshes, %u channels, %u targets, %u clips, %zu bytes\n", in, out, raw.mesh_count,
-           raw.channel_count, targets, raw.clip_count, size);
-    printf("precision: %u int16 targets, %u float targets; max position quantization error %.3g (tolerance %.3g)\n",
-           report.quantized_targets, report.float_targets, report.max_position_error, report.tolerance_used);
-    if (report.max_normal_error > 0 || report.max_tangent_error > 0)
-        printf("max normal quantization error %.3g, tangent %.3g\n", report.max_normal_error, report.max_tangent_error);
+    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail(verb->name, &err); }
+    out.file.data = blob;
+    out.file.size = size;
+    status = cli_write_outputs(verb, &out, 1);
+    if (status == 0) {
+        uint32_t targets = 0;
+        for (uint32_t c = 0; c < raw.channel_count; c++) targets += raw.channels[c].target_count;
+        printf("%s -> %s: %u meshes, %u channels, %u targets, %u clips, %zu bytes, %u warning%s\n", a->input, a->output,
+               raw.mesh_count, raw.channel_count, targets, raw.clip_count, size, raw.warning_count,
+               raw.warning_count == 1 ? "" : "s");
+        printf("precision: %u int16 targets, %u float targets; max position quantization error %.3g (tolerance %.3g)\n",
+               report.quantized_targets, report.float_targets, report.max_position_error, report.tolerance_used);
+        if (report.max_normal_error > 0 || report.max_tangent_error > 0)
+            printf("max normal quantization error %.3g, tangent %.3g\n", report.max_normal_error, report.max_tangent_error);
+    }
     mk_raw_free(&raw);
-    return 0;
+    return status;
 }

@@ -1,6 +1,8 @@
 /* morphkit info FILE [--json]: meshes, channels with in-betweens and full weights, clips,
  * sizes, precision and the quantization error bound. Any input works; non-.morph inputs are
  * imported and written in memory with the default options first. */
+#include <stddef.h>
+#include <stdlib.h>
 #include <string.h>
 #include "asset_load.h"
 #include "format.h"
@@ -27,62 +29,62 @@ static void precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *float
     }
 }
 
-static void print_text(const loaded_asset *l, const char *path)
+static void print_text(FILE *f, const loaded_asset *l, const char *path)
 {
     const mk_asset *a = &l->asset;
     uint32_t nq, nf;
     double bound;
     precision_of(a, &nq, &nf, &bound);
-    printf("%s: %zu bytes, format v%u\n", path, l->blob_size, MK_FORMAT_VERSION);
+    fprintf(f, "%s: %zu bytes, format v%u\n", path, l->blob_size, MK_FORMAT_VERSION);
     if (l->imported) {
-        printf("source: %s%s%s\n", l->raw.source_format[0] ? l->raw.source_format : "?",
+        fprintf(f, "source: %s%s%s\n", l->raw.source_format[0] ? l->raw.source_format : "?",
                l->raw.source_creator[0] ? ", creator " : "", l->raw.source_creator);
-        if (l->raw.unit_scale > 0) printf("unit scale: %g cm per unit\n", (double)l->raw.unit_scale);
-        if (l->raw.up_axis >= 0) printf("up axis: %c\n", "XYZ"[l->raw.up_axis % 3]);
-        printf("import warnings: %u\n", l->raw.warning_count);
+        if (l->raw.unit_scale > 0) fprintf(f, "unit scale: %g cm per unit\n", (double)l->raw.unit_scale);
+        if (l->raw.up_axis >= 0) fprintf(f, "up axis: %c\n", "XYZ"[l->raw.up_axis % 3]);
+        fprintf(f, "import warnings: %u\n", l->raw.warning_count);
     }
-    printf("precision: %u quantized (int16) targets, %u float targets; max quantization error <= %.3g\n", nq, nf, bound);
+    fprintf(f, "precision: %u quantized (int16) targets, %u float targets; max quantization error <= %.3g\n", nq, nf, bound);
     for (uint32_t i = 0; i < a->mesh_count; i++) {
         mk_mesh_info m;
         mk_mesh_get(a, i, &m);
-        printf("mesh %u '%s': %u vertices (%u control points), %u triangles, %s%s%s stacking",
+        fprintf(f, "mesh %u '%s': %u vertices (%u control points), %u triangles, %s%s%s stacking",
                i, m.name, m.vertex_count, m.control_point_count, m.triangle_count,
                m.has_normals ? "normals, " : "", m.has_tangents ? "tangents, " : "",
                m.stacking == MK_STACKING_SEQUENTIAL ? "sequential" : "additive");
-        if (m.gltf_node >= 0) printf(", glTF node %d mesh %d primitive %d", m.gltf_node, m.gltf_mesh, m.gltf_primitive);
-        printf("\n  target data: %llu bytes in %llu block entries\n",
+        if (m.gltf_node >= 0) fprintf(f, ", glTF node %d mesh %d primitive %d", m.gltf_node, m.gltf_mesh, m.gltf_primitive);
+        fprintf(f, "\n  target data: %llu bytes in %llu block entries\n",
                (unsigned long long)a->meshes[i].target_data_size, (unsigned long long)a->meshes[i].entry_count);
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
             mk_channel_info ch;
             mk_channel_get(a, c, &ch);
-            printf("  channel %u '%s': default %g, %u target%s%s\n", c, ch.name, (double)ch.default_weight,
+            fprintf(f, "  channel %u '%s': default %g, %u target%s%s\n", c, ch.name, (double)ch.default_weight,
                    ch.target_count, ch.target_count == 1 ? "" : "s", ch.target_count > 1 ? " (progressive)" : "");
             for (uint32_t k = 0; k < ch.target_count; k++) {
                 mk_target_info t;
                 mk_target_get(a, c, k, &t);
-                printf("    target '%s': full weight %g, %u vertices, %s%s%s\n", t.name, (double)t.full_weight,
+                fprintf(f, "    target '%s': full weight %g, %u vertices, %s%s%s\n", t.name, (double)t.full_weight,
                        t.moved_vertices, t.quantized ? "int16" : "float", t.has_normals ? ", normals" : "",
                        t.has_tangents ? ", tangents" : "");
             }
-            if (ch.origin[0]) printf("    baked from recipe: %s\n", ch.origin);
+            if (ch.origin[0]) fprintf(f, "    baked from recipe: %s\n", ch.origin);
         }
     }
     for (uint32_t i = 0; i < a->clip_count; i++) {
         mk_clip_info c;
         mk_clip_get(a, i, &c);
-        printf("clip %u '%s': start %g s, duration %g s, %u tracks\n", i, c.name, (double)c.start, (double)c.duration,
+        fprintf(f, "clip %u '%s': start %g s, duration %g s, %u tracks\n", i, c.name, (double)c.start, (double)c.duration,
                c.track_count);
     }
 }
 
-static void print_json(const loaded_asset *l, const char *path)
+static void print_json(FILE *f, const loaded_asset *l, const char *path)
 {
     const mk_asset *a = &l->asset;
     uint32_t nq, nf;
     double bound;
     precision_of(a, &nq, &nf, &bound);
     json_writer w;
-    json_begin(&w, stdout, 1);
+    json_begin(&w, f, 1);
     json_object(&w, NULL);
     json_string(&w, "file", path);
     json_int(&w, "bytes", (long long)l->blob_size);
@@ -158,21 +160,50 @@ static void print_json(const loaded_asset *l, const char *path)
     json_end_object(&w);
 }
 
-int cmd_info(int argc, char **argv)
+typedef struct info_args {
+    const char *input, *output;
+    int json;
+} info_args;
+
+static int run_info(void *p);
+
+static const cli_option options[] = {
+    { "--json", NULL, CLI_FLAG, offsetof(info_args, json), "Print JSON (one object: file facts, meshes, channels, targets, clips) instead of text.",
+      NULL, NULL, 0, 0, 0, 0 },
+    { "-o", "OUT", CLI_STRING, offsetof(info_args, output), "Where to write the description: a file, or - for standard output.",
+      "-", NULL, 0, 0, 0, 0 },
+};
+
+const cli_verb cli_verb_info = {
+    "info", "FILE [--json] [-o OUT]", "describe an asset: meshes, channels, in-betweens, clips, sizes",
+    "Describes FILE: its meshes (vertices, control points, triangles, normals, tangents, stacking), channels with their "
+    "in-between targets and full weights, clips, byte sizes, precision and the quantization error bound. A file that is "
+    "not a .morph blob is imported and written in memory with the default options first.",
+    "FILE", "A .morph blob, or any file 'morphkit import' reads.", offsetof(info_args, input), 1,
+    options, sizeof options / sizeof options[0], sizeof(info_args), run_info,
+};
+
+static int run_info(void *p)
 {
-    const char *path = NULL;
-    int as_json = 0;
-    for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--json")) as_json = 1;
-        else if (!strcmp(argv[i], "--help")) { printf("usage: morphkit info FILE [--json]\n"); return 0; }
-        else if (argv[i][0] == '-' || path) { fprintf(stderr, "morphkit info: unexpected argument '%s'\n", argv[i]); return 2; }
-        else path = argv[i];
-    }
-    if (!path) { fprintf(stderr, "usage: morphkit info FILE [--json]\n"); return 2; }
+    info_args *a = p;
+    const cli_verb *verb = &cli_verb_info;
+    cli_output out;
+    const char *inputs[] = { a->input };
+    int status = cli_output_check(verb, &out, "-o", a->output, NULL, "a description", 1, inputs, 1);
+    if (status >= 0) return status;
     loaded_asset l;
     mk_error err;
-    if (load_asset(path, NULL, NULL, &l, &err)) { loaded_asset_free(&l); return cli_fail("info", &err); }
-    if (as_json) print_json(&l, path); else print_text(&l, path);
+    if (load_asset(a->input, NULL, NULL, &l, &err)) { loaded_asset_free(&l); return cli_fail(verb->name, &err); }
+    char *text = NULL;
+    size_t size = 0;
+    FILE *f = open_memstream(&text, &size);
+    if (!f) { loaded_asset_free(&l); fprintf(stderr, "morphkit info: out of memory\n"); return CLI_EXIT_FAILURE; }
+    if (a->json) print_json(f, &l, a->input); else print_text(f, &l, a->input);
+    fclose(f);
+    out.file.data = text;
+    out.file.size = size;
+    status = cli_write_outputs(verb, &out, 1);
+    free(text);
     loaded_asset_free(&l);
-    return 0;
+    return status;
 }

@@ -1,46 +1,12 @@
-/* morphkit play FILE [--clip NAME|INDEX] [--time T] [--weights NAME=V,...]
- *   [--stacking additive|sequential] [--normals nlerp|slerp] [--space world|local] -o OUT.json|OUT.obj
- * Evaluates one frame through the runtime and writes it: JSON shaped like the corpus's
- * reference frames (meshes[] with name, positions, normals), or OBJ. */
+/* morphkit play: one frame through the runtime, written as JSON shaped like the conformance
+ * reference frames (meshes[] with name, positions, normals) or as OBJ. */
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include "asset_load.h"
 #include "frame.h"
 #include "json_write.h"
-
-static int usage(void)
-{
-    fprintf(stderr, "usage: morphkit play FILE [--clip NAME|INDEX] [--time T] [--weights NAME=V,...]\n"
-                    "       [--stacking additive|sequential] [--normals nlerp|slerp] [--space world|local] -o OUT.json|OUT.obj\n");
-    return 2;
-}
-
-/* "name=0.5,other=1" or "3=0.5": channel by name or index. */
-static int apply_weights(const mk_asset *a, const char *spec, float *weights)
-{
-    char buf[4096];
-    if (strlen(spec) >= sizeof buf) return 0;
-    strcpy(buf, spec);
-    for (char *item = strtok(buf, ","); item; item = strtok(NULL, ",")) {
-        char *eq = strrchr(item, '=');
-        if (!eq) { fprintf(stderr, "morphkit play: --weights item '%s' needs NAME=VALUE\n", item); return 0; }
-        *eq = 0;
-        char *end;
-        float v = strtof(eq + 1, &end);
-        if (*end || eq[1] == 0) { fprintf(stderr, "morphkit play: bad weight value '%s'\n", eq + 1); return 0; }
-        int32_t c = mk_find_channel(a, item);
-        if (c < 0) {
-            long idx = strtol(item, &end, 10);
-            if (*end || idx < 0 || idx >= (long)a->channel_count) {
-                fprintf(stderr, "morphkit play: no channel named '%s'\n", item);
-                return 0;
-            }
-            c = (int32_t)idx;
-        }
-        weights[c] = v;
-    }
-    return 1;
-}
+#include "weights_arg.h"
 
 static void write_json(FILE *f, const mk_asset *a, float **pos, float **nrm, const char *space, double time, int32_t clip,
                        const float *weights)
@@ -107,103 +73,143 @@ static void write_obj(FILE *f, const mk_asset *a, float **pos, float **nrm)
     }
 }
 
-int cmd_play(int argc, char **argv)
+typedef struct play_args {
+    const char *input, *output, *clip, *weights;
+    double time;
+    int time_given, stacking, stacking_given, normals, space, format, format_given;
+} play_args;
+
+static int run_play(void *p);
+
+static const cli_option options[] = {
+    { "-o", "OUT", CLI_STRING, offsetof(play_args, output),
+      "Where to write the frame: a .json or .obj file, a device/FIFO, or - for standard output.", NULL, NULL, 0, 0, 1, 0 },
+    { "--format", "F", CLI_CHOICE, offsetof(play_args, format),
+      "Output format. Default: obj when -o ends in .obj, else json.", NULL, "json|obj", 0, 0, 0,
+      offsetof(play_args, format_given) },
+    { "--clip", "NAME|INDEX", CLI_STRING, offsetof(play_args, clip),
+      "The clip to sample. Default: the first clip when --time is given, else none (the default weights).", NULL, NULL, 0, 0, 0, 0 },
+    { "--time", "T", CLI_NUMBER, offsetof(play_args, time), "Sampling time in seconds on the clip's time line.", NULL, NULL,
+      -1e9, 1e9, 0, offsetof(play_args, time_given) },
+    { "--weights", "NAME=V,...", CLI_STRING, offsetof(play_args, weights),
+      "Channel weights (1 = 100 %) set after the clip is sampled, by channel name, NODE/CHANNEL or index. A name sets that "
+      "channel on every primitive of its node.", NULL, NULL, 0, 0, 0, 0 },
+    { "--stacking", "MODE", CLI_CHOICE, offsetof(play_args, stacking),
+      "Channel stacking. Default: each mesh's stored stacking.", NULL, "additive|sequential", 0, 0, 0,
+      offsetof(play_args, stacking_given) },
+    { "--normals", "MODE", CLI_CHOICE, offsetof(play_args, normals), "How normal changes combine (docs/semantics.md).", "nlerp",
+      "nlerp|slerp", 0, 0, 0, 0 },
+    { "--space", "S", CLI_CHOICE, offsetof(play_args, space),
+      "Coordinates of the output: world (each mesh's node transform at rest applied) or local (mesh space).", "world",
+      "world|local", 0, 0, 0, 0 },
+};
+
+const cli_verb cli_verb_play = {
+    "play", "FILE -o OUT [options]", "evaluate one frame and write it as JSON or OBJ",
+    "Evaluates one frame of FILE through the runtime (a clip at a time, or the default weights, then any --weights) and "
+    "writes every mesh's positions and normals: JSON shaped like the conformance reference frames, or OBJ.",
+    "FILE", "A .morph blob, or any file 'morphkit import' reads.", offsetof(play_args, input), 1,
+    options, sizeof options / sizeof options[0], sizeof(play_args), run_play,
+};
+
+/* The clip named or numbered by arg, or -1 after printing the error. */
+static int32_t find_clip(const cli_verb *verb, const mk_asset *a, const char *arg)
 {
-    const char *in = NULL, *out = NULL, *clip_arg = NULL, *weights_arg = NULL, *space = "world";
-    double time = 0;
-    int have_time = 0;
-    mk_stacking stacking = MK_STACKING_ASSET;
-    mk_normal_mode nmode = MK_NORMALS_NLERP;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "-o") && v) { out = v; i++; }
-        else if (!strcmp(a, "--clip") && v) { clip_arg = v; i++; }
-        else if (!strcmp(a, "--time") && v) {
-            char *end;
-            time = strtod(v, &end);
-            if (*end) return usage();
-            have_time = 1;
-            i++;
-        }
-        else if (!strcmp(a, "--weights") && v) { weights_arg = v; i++; }
-        else if (!strcmp(a, "--stacking") && v) { int s = cli_parse_stacking(v); if (s < 0) return usage(); stacking = (mk_stacking)s; i++; }
-        else if (!strcmp(a, "--normals") && v) {
-            if (!strcmp(v, "nlerp")) nmode = MK_NORMALS_NLERP;
-            else if (!strcmp(v, "slerp")) nmode = MK_NORMALS_SLERP;
-            else return usage();
-            i++;
-        }
-        else if (!strcmp(a, "--space") && v) {
-            if (strcmp(v, "world") && strcmp(v, "local")) return usage();
-            space = v;
-            i++;
-        }
-        else if (!strcmp(a, "--help")) { usage(); return 0; }
-        else if (a[0] != '-' && !in) in = a;
-        else { fprintf(stderr, "morphkit play: unexpected argument '%s'\n", a); return usage(); }
+    int32_t clip = mk_find_clip(a, arg);
+    if (clip >= 0) return clip;
+    char *end;
+    long idx = strtol(arg, &end, 10);
+    if (!*end && end != arg && idx >= 0 && idx < (long)a->clip_count) return (int32_t)idx;
+    char names[600] = "";
+    for (uint32_t c = 0; c < a->clip_count; c++) {
+        mk_clip_info ci;
+        mk_clip_get(a, c, &ci);
+        size_t n = strlen(names);
+        if (n + strlen(ci.name) + 8 < sizeof names) snprintf(names + n, sizeof names - n, "%s'%s'", n ? ", " : "", ci.name);
     }
-    if (!in || !out) return usage();
+    cli_usage_error(verb, "--clip: no clip '%s'; the clips are %s", arg, a->clip_count ? names : "(none: no animation)");
+    return -1;
+}
+
+static int run_play(void *p)
+{
+    play_args *args = p;
+    const cli_verb *verb = &cli_verb_play;
+    static const char *const extensions[] = { ".json", ".obj", NULL };
+    cli_output out;
+    const char *inputs[] = { args->input };
+    int status = cli_output_check(verb, &out, "-o", args->output, extensions, "a frame as JSON or OBJ", 1, inputs, 1);
+    if (status >= 0) return status;
+    int obj = args->format_given ? args->format == 1 : mk_path_has_extension(args->output, ".obj");
+    if (args->format_given && !out.to_stdout && out.file.kind != MK_OUTPUT_STREAM
+        && !mk_path_has_extension(args->output, obj ? ".obj" : ".json"))
+        return cli_usage_error(verb, "-o %s: --format %s needs a name ending in %s", args->output, obj ? "obj" : "json",
+                               obj ? ".obj" : ".json");
+    const char *space = args->space ? "local" : "world";
+    mk_stacking stacking = !args->stacking_given ? MK_STACKING_ASSET : args->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
+    mk_normal_mode nmode = args->normals ? MK_NORMALS_SLERP : MK_NORMALS_NLERP;
+
     loaded_asset l;
     mk_error err;
-    if (load_asset(in, NULL, NULL, &l, &err)) { loaded_asset_free(&l); return cli_fail("play", &err); }
+    if (load_asset(args->input, NULL, NULL, &l, &err)) { loaded_asset_free(&l); return cli_fail(verb->name, &err); }
     const mk_asset *a = &l.asset;
     int32_t clip = -1;
-    if (clip_arg) {
-        clip = mk_find_clip(a, clip_arg);
-        if (clip < 0) {
-            char *end;
-            long idx = strtol(clip_arg, &end, 10);
-            if (*end || idx < 0 || idx >= (long)a->clip_count) {
-                fprintf(stderr, "morphkit play: no clip '%s' (the asset has %u clips)\n", clip_arg, a->clip_count);
-                loaded_asset_free(&l);
-                return 2;
-            }
-            clip = (int32_t)idx;
+    if (args->clip) {
+        clip = find_clip(verb, a, args->clip);
+        if (clip < 0) { loaded_asset_free(&l); return CLI_EXIT_USAGE; }
+    } else if (args->time_given) {
+        if (!a->clip_count) {
+            loaded_asset_free(&l);
+            return cli_usage_error(verb, "--time: %s has no clip to sample", args->input);
         }
-    } else if (have_time && a->clip_count) {
         clip = 0;
     }
     float *weights = calloc(a->channel_count + 1u, sizeof(float));
     float **pos = calloc(a->mesh_count + 1u, sizeof(float *)), **nrm = calloc(a->mesh_count + 1u, sizeof(float *));
-    int status = 0;
+    char *text = NULL, why[1024];
+    size_t text_size = 0;
     if (!weights || !pos || !nrm) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
-    if (frame_weights(a, clip, time, weights, &err)) { status = cli_fail("play", &err); goto done; }
-    if (weights_arg && !apply_weights(a, weights_arg, weights)) { status = 2; goto done; }
+    if (frame_weights(a, clip, args->time, weights, &err)) { status = cli_fail(verb->name, &err); goto done; }
+    if (args->weights && weights_arg_apply(a, args->weights, weights, why, sizeof why) != 0) {
+        status = cli_usage_error(verb, "--weights: %s", why);
+        goto done;
+    }
     for (uint32_t i = 0; i < a->mesh_count; i++) {
         mk_mesh_info m;
         mk_mesh_get(a, i, &m);
         pos[i] = malloc(12u * (size_t)m.vertex_count);
         nrm[i] = m.has_normals ? malloc(12u * (size_t)m.vertex_count) : NULL;
         if (!pos[i] || (m.has_normals && !nrm[i])) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
-        if (frame_eval_mesh(a, i, weights, stacking, nmode, pos[i], nrm[i], &err)) { status = cli_fail("play", &err); goto done; }
-        if (!strcmp(space, "world")) frame_to_world(m.world, pos[i], nrm[i], m.vertex_count);
+        if (frame_eval_mesh(a, i, weights, stacking, nmode, pos[i], nrm[i], &err)) { status = cli_fail(verb->name, &err); goto done; }
+        if (!args->space) frame_to_world(m.world, pos[i], nrm[i], m.vertex_count);
     }
-    {
-        /* Atomic output: render to memory, then temp file + rename. */
-        char *text = NULL;
-        size_t text_size = 0;
-        FILE *f = open_memstream(&text, &text_size);
-        if (!f) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
-        if (mk_path_has_extension(out, ".obj")) write_obj(f, a, pos, nrm);
-        else write_json(f, a, pos, nrm, space, time, clip, weights);
-        fclose(f);
-        mk_result r = mk_write_file_atomic(out, text, text_size, &err);
-        free(text);
-        if (r) { status = cli_fail("play", &err); goto done; }
-    }
-    printf("%s: %s frame of %u mesh%s written to %s\n", in, clip >= 0 ? "animated" : "rest-pose", a->mesh_count,
-           a->mesh_count == 1 ? "" : "es", out);
+    FILE *f = open_memstream(&text, &text_size);
+    if (!f) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
+    if (obj) write_obj(f, a, pos, nrm);
+    else write_json(f, a, pos, nrm, space, args->time, clip, weights);
+    fclose(f);
+    out.file.data = text;
+    out.file.size = text_size;
+    status = cli_write_outputs(verb, &out, 1);
+    if (status) goto done;
+    /* What was played; on stderr when the frame itself went to standard output. */
+    FILE *report = out.to_stdout ? stderr : stdout;
     if (clip >= 0) {
         mk_clip_info ci;
         mk_clip_get(a, (uint32_t)clip, &ci);
-        printf("clip '%s' at %g s\n", ci.name, time);
+        fprintf(report, "%s: clip '%s' at %g s%s", args->input, ci.name, args->time, args->weights ? ", then --weights" : "");
+    } else {
+        fprintf(report, "%s: %s", args->input, args->weights ? "default weights, then --weights" : "default weights (no clip)");
     }
+    fprintf(report, "; %u mesh%s (%s space, %s) written to %s\n", a->mesh_count, a->mesh_count == 1 ? "" : "es", space,
+            obj ? "OBJ" : "JSON", out.to_stdout ? "standard output" : args->output);
     for (uint32_t c = 0; c < a->channel_count; c++) {
         mk_channel_info ch;
         mk_channel_get(a, c, &ch);
-        printf("  %-32s %8.4f\n", ch.name, (double)weights[c]);
+        fprintf(report, "  %-32s %8.4f\n", ch.name, (double)weights[c]);
     }
 done:
+    free(text);
     for (uint32_t i = 0; pos && i < a->mesh_count; i++) free(pos[i]);
     for (uint32_t i = 0; nrm && i < a->mesh_count; i++) free(nrm[i]);
     free(pos);

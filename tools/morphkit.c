@@ -2,35 +2,58 @@
 #include <string.h>
 #include "cli.h"
 
-static const struct verb {
-    const char *name;
-    int (*run)(int argc, char **argv);
-    const char *summary;
-} verbs[] = {
-    { "import", cmd_import, "import FILE.fbx|FILE.gltf|FILE.glb -o OUT.morph   convert a source file" },
-    { "info", cmd_info, "info FILE.morph [--json]                           describe an asset" },
-    { "play", cmd_play, "play FILE.morph [--clip C] [--time T] ... -o OUT    evaluate one frame" },
-    { "bake", cmd_bake, "bake IN --recipe RECIPE.json -o OUT.morph          add baked channels" },
-    { "export", cmd_export, "export FILE.morph -o OUT.glb|OUT.gltf              write glTF" },
-    { "conform", cmd_conform, "conform CASES.json [--case S] [--precision P]      check against reference frames" },
-    { "bench", cmd_bench, "bench [FILE.morph] [--vertices N] ... [--json]     measure evaluation speed" },
+static const cli_verb *const verbs[] = {
+    &cli_verb_import, &cli_verb_info, &cli_verb_play, &cli_verb_bake, &cli_verb_export, &cli_verb_conform, &cli_verb_bench,
 };
+#define VERB_COUNT (sizeof verbs / sizeof verbs[0])
 
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: morphkit VERB ...\n\nverbs:\n");
-    for (size_t i = 0; i < sizeof verbs / sizeof verbs[0]; i++) fprintf(f, "  morphkit %s\n", verbs[i].summary);
-    fprintf(f, "\n'morphkit VERB --help' shows a verb's options.\n");
+    fprintf(f, "usage: morphkit VERB [arguments]\n       morphkit help VERB\n       morphkit --version\n\nverbs:\n");
+    for (size_t i = 0; i < VERB_COUNT; i++) fprintf(f, "  %-9s %s\n", verbs[i]->name, verbs[i]->summary);
+    fprintf(f, "\n'morphkit help VERB' or 'morphkit VERB --help' shows a verb's arguments and options.\n"
+               "exit status: 0 success, 1 failure, 2 usage error\n");
+}
+
+static const cli_verb *find_verb(const char *name)
+{
+    for (size_t i = 0; i < VERB_COUNT; i++)
+        if (!strcmp(name, verbs[i]->name)) return verbs[i];
+    return NULL;
 }
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) { usage(stderr); return 2; }
-    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) { usage(stdout); return 0; }
-    if (!strcmp(argv[1], "--version")) { printf("morphkit 0.1.0 (format v%u)\n", MK_FORMAT_VERSION); return 0; }
-    for (size_t i = 0; i < sizeof verbs / sizeof verbs[0]; i++)
-        if (!strcmp(argv[1], verbs[i].name)) return verbs[i].run(argc - 1, argv + 1);
-    fprintf(stderr, "morphkit: unknown verb '%s'\n", argv[1]);
-    usage(stderr);
-    return 2;
+    if (argc < 2) { usage(stderr); return CLI_EXIT_USAGE; }
+    const char *first = argv[1];
+    if (!strcmp(first, "--help") || !strcmp(first, "-h") || (!strcmp(first, "help") && argc == 2)) {
+        usage(stdout);
+        return CLI_EXIT_OK;
+    }
+    if (!strcmp(first, "--version")) {
+        printf("morphkit 0.1.0 (blob format v%u)\n", MK_FORMAT_VERSION);
+        return CLI_EXIT_OK;
+    }
+    if (!strcmp(first, "help")) {
+        const cli_verb *v = find_verb(argv[2]);
+        if (!v || argc > 3) {
+            fprintf(stderr, "morphkit help: unknown verb '%s'\n\n", argv[2]);
+            usage(stderr);
+            return CLI_EXIT_USAGE;
+        }
+        cli_print_help(v, stdout);
+        return CLI_EXIT_OK;
+    }
+    const cli_verb *v = find_verb(first);
+    if (!v) {
+        fprintf(stderr, "morphkit: unknown verb '%s'\n\n", first);
+        usage(stderr);
+        return CLI_EXIT_USAGE;
+    }
+    /* Each verb's arguments fit in a small struct; 256 bytes with 16-byte alignment is room
+     * for all of them (checked below). */
+    _Alignas(16) unsigned char args[256];
+    if (v->args_size > sizeof args) return CLI_EXIT_FAILURE;
+    int status = cli_parse(v, argc - 1, argv + 1, args);
+    return status >= 0 ? status : v->run(args);
 }

@@ -592,14 +592,12 @@ bool ends_with(const std::string &s, const char *suffix)
     return tail == suffix;
 }
 
-mk_result run(const mk_raw_asset *raw, const char *path, const char *sidecar_path, mk_gltf_export_report *report, mk_error *err)
+mk_result run(const mk_raw_asset *raw, mk_gltf_container container, mk_arena *arena, void **gltf, size_t *gltf_size,
+              char **sidecar, size_t *sidecar_size, mk_gltf_export_report *report, mk_error *err)
 {
     mk_result r = mk_raw_validate(raw, err);
     if (r != MK_OK) return r;
-    std::string p(path);
-    bool glb = ends_with(p, ".glb");
-    if (!glb && !ends_with(p, ".gltf"))
-        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "%s: the output must end in .glb or .gltf", path);
+    bool glb = container == MK_GLTF_GLB;
     Exporter ex;
     ex.raw = raw;
     ex.build();
@@ -608,29 +606,72 @@ mk_result run(const mk_raw_asset *raw, const char *path, const char *sidecar_pat
     tinygltf::TinyGLTF writer;
     std::ostringstream out;
     if (!writer.WriteGltfSceneToStream(&ex.model, out, !glb, glb))
-        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%s: tinygltf could not serialize the model", path);
+        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "glTF export: tinygltf could not serialize the model");
     std::string bytes = out.str();
-    if ((r = mk_write_file_atomic(path, bytes.data(), bytes.size(), err)) != MK_OK) return r;
-    if (sidecar_path) {
+    void *g = mk_arena_alloc(arena, bytes.size());
+    if (!g) return mk_error_oom(err, "glTF export");
+    memcpy(g, bytes.data(), bytes.size());
+    if (sidecar) {
         std::string text = ex.sidecar_json().dump();
         text.push_back('\n');
-        if ((r = mk_write_file_atomic(sidecar_path, text.data(), text.size(), err)) != MK_OK) return r;
+        char *t = mk_arena_strndup(arena, text.data(), text.size());
+        if (!t) return mk_error_oom(err, "glTF export");
+        *sidecar = t;
+        *sidecar_size = text.size();
     }
+    *gltf = g;
+    *gltf_size = bytes.size();
     if (report) *report = ex.rep;
     return MK_OK;
 }
 
 } // namespace
 
-extern "C" mk_result mk_export_gltf(const mk_raw_asset *raw, const char *path, const char *sidecar_path,
-                                    mk_gltf_export_report *report, mk_error *err)
+extern "C" mk_result mk_export_gltf_memory(const mk_raw_asset *raw, mk_gltf_container container, mk_arena *arena,
+                                           void **gltf, size_t *gltf_size, char **sidecar, size_t *sidecar_size,
+                                           mk_gltf_export_report *report, mk_error *err)
 {
-    if (!raw || !path) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "glTF export: invalid argument");
+    if (!raw || !arena || !gltf || !gltf_size || (sidecar && !sidecar_size) || (unsigned)container > MK_GLTF_JSON)
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "glTF export: invalid argument");
     try {
-        return run(raw, path, sidecar_path, report, err);
+        return run(raw, container, arena, gltf, gltf_size, sidecar, sidecar_size, report, err);
     } catch (const std::bad_alloc &) {
         return mk_error_oom(err, "glTF export");
     } catch (const std::exception &e) {
         return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "glTF export: %s", e.what());
     }
+}
+
+extern "C" mk_result mk_export_gltf(const mk_raw_asset *raw, const char *path, const char *sidecar_path,
+                                    mk_gltf_export_report *report, mk_error *err)
+{
+    if (!raw || !path) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "glTF export: invalid argument");
+    std::string p(path);
+    bool glb = ends_with(p, ".glb");
+    if (!glb && !ends_with(p, ".gltf"))
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "%.200s: the output must end in .glb or .gltf", path);
+    mk_output outs[2] = {};
+    outs[0].path = path;
+    outs[1].path = sidecar_path;
+    uint32_t count = sidecar_path ? 2 : 1;
+    for (uint32_t i = 0; i < count; i++) {
+        mk_result r = mk_output_check(&outs[i], nullptr, 0, err);
+        if (r != MK_OK) return r;
+    }
+    mk_arena arena;
+    mk_arena_init(&arena, nullptr);
+    void *gltf = nullptr;
+    char *sidecar = nullptr;
+    size_t gltf_size = 0, sidecar_size = 0;
+    mk_result r = mk_export_gltf_memory(raw, glb ? MK_GLTF_GLB : MK_GLTF_JSON, &arena, &gltf, &gltf_size,
+                                        sidecar_path ? &sidecar : nullptr, &sidecar_size, report, err);
+    if (r == MK_OK) {
+        outs[0].data = gltf;
+        outs[0].size = gltf_size;
+        outs[1].data = sidecar;
+        outs[1].size = sidecar_size;
+        r = mk_write_outputs(outs, count, err);
+    }
+    mk_arena_free_all(&arena);
+    return r;
 }

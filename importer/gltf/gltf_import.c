@@ -468,7 +468,8 @@ static mk_result import_doc(importer *im, mk_error *err)
         if ((uint32_t)n->mesh >= d->mesh_count)
             return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "node %u: mesh %d out of range (%u meshes)", i, n->mesh, d->mesh_count);
         const mk_gltf_mesh *gm = &d->meshes[n->mesh];
-        if (gm->primitive_count == 0 || gm->primitives[0].target_count == 0) continue;
+        int keep_plain = im->options && im->options->keep_plain_meshes;
+        if (gm->primitive_count == 0 || (gm->primitives[0].target_count == 0 && !keep_plain)) continue;
         for (uint32_t p = 1; p < gm->primitive_count; p++)
             if (gm->primitives[p].target_count != gm->primitives[0].target_count)
                 return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "mesh %d: primitive %u has %u targets, primitive 0 has %u (they must agree)",

@@ -26,8 +26,19 @@ typedef struct mk_gltf_export_report {
     uint32_t fixed_normals;         /* zero-length base normals/tangents replaced (glTF needs unit ones) */
 } mk_gltf_export_report;
 
-/* Writes raw as .gltf (JSON + embedded base64 buffer) or .glb (by the path's extension), via a
- * temporary file and rename, plus the channel sidecar at sidecar_path (NULL: none). */
+typedef enum mk_gltf_container {
+    MK_GLTF_GLB = 0,                /* binary .glb */
+    MK_GLTF_JSON = 1                /* .gltf: JSON with the buffer embedded as base64 */
+} mk_gltf_container;
+
+/* Exports raw as glTF into memory from arena: the file's bytes, and (when sidecar is not
+ * NULL) the channel sidecar's JSON text that lets a re-import restore progressive channels. */
+mk_result mk_export_gltf_memory(const mk_raw_asset *raw, mk_gltf_container container, mk_arena *arena,
+                                void **gltf, size_t *gltf_size, char **sidecar, size_t *sidecar_size,
+                                mk_gltf_export_report *report, mk_error *err);
+
+/* Writes raw as .gltf or .glb (by the path's extension) plus the sidecar at sidecar_path
+ * (NULL: none), both or neither, with the output rules of blob_io.h. */
 mk_result mk_export_gltf(const mk_raw_asset *raw, const char *path, const char *sidecar_path,
                          mk_gltf_export_report *report, mk_error *err);
 
