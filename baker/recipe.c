@@ -583,7 +583,17 @@ static mk_result resolve_mesh(recipe_ctx *ctx, const cJSON *item, const char *pa
             *mesh = m;
             return MK_OK;
         }
-    return field_error(ctx, path, "mesh", "no mesh named \"%s\"", item->valuestring);
+    char names[160] = "";
+    for (uint32_t m = 0; m < ctx->raw->mesh_count; m++) {
+        size_t n = strlen(names);
+        const char *name = ctx->raw->meshes[m].name ? ctx->raw->meshes[m].name : "";
+        if (n + strlen(name) + 8 >= sizeof names) { snprintf(names + n, sizeof names - n, ", ..."); break; }
+        snprintf(names + n, sizeof names - n, "%s\"%s\"", n ? ", " : "", name);
+    }
+    char msg[200];
+    snprintf(msg, sizeof msg, "no mesh named \"%.40s\"; the meshes are %s", item->valuestring,
+             ctx->raw->mesh_count ? names : "(none)");
+    return field_error(ctx, path, "mesh", "%s", msg);
 }
 
 static mk_result check_mesh(recipe_ctx *ctx, uint32_t m, const char *path)
