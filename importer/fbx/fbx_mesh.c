@@ -155,6 +155,13 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
         goto done;
     }
     size_t cp_count = vertex_doubles / 3;
+    if (cp_count == 0) {
+        /* Nothing to draw or morph: the caller skips the mesh with a warning rather than
+         * refusing a file whose other meshes are fine (polygons are not even read). */
+        mesh->vertex_count = 0;
+        r = MK_OK;
+        goto done;
+    }
     if (cp_count >= UINT32_MAX / 2) {
         r = mk_error_set(doc->err, MK_ERROR_LIMIT, geometry->offset, "FBX %s: too many control points", path);
         goto done;
@@ -261,10 +268,6 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
         isolated++;
     }
     (void)isolated;
-    if (rv_count == 0) {
-        r = mk_error_set(doc->err, MK_ERROR_PARSE, geometry->offset, "FBX %s: mesh has no vertices", path);
-        goto done;
-    }
     if (triangle_count > UINT32_MAX / 3) {
         r = mk_error_set(doc->err, MK_ERROR_LIMIT, geometry->offset, "FBX %s: too many triangles", path);
         goto done;

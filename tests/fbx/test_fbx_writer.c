@@ -653,6 +653,125 @@ static void test_inherit_type(void)
     }
 }
 
+/* ---- meshes that cannot be imported are skipped with a warning ---- */
+
+/* 1 when some warning contains both `a` and `b`. */
+static int has_warning(const mk_raw_asset *raw, const char *a, const char *b)
+{
+    for (uint32_t i = 0; i < raw->warning_count && i < MK_RAW_MAX_WARNINGS; i++)
+        if (strstr(raw->warnings[i].message, a) && strstr(raw->warnings[i].message, b)) return 1;
+    return 0;
+}
+
+/* A scene whose "Prop" mesh has an empty Vertices array (and, in one variant, a blend shape
+ * channel of its own) next to "Tri" (one triangle, one channel) and "Plain" (a triangle
+ * without blend shapes): Prop is skipped with a warning naming it, Tri and Plain import. */
+static void test_empty_mesh_skipped(void)
+{
+    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
+    static const int32_t tri[3] = { 0, 1, ~2 };
+    static const int32_t idx[1] = { 2 };
+    static const double delta[3] = { 0, 0, 1 };
+    static const double fw[1] = { 100 };
+    fbxw_shape shape = { "Up", 1, idx, delta, NULL };
+    fbxw_channel channels[2];
+    memset(channels, 0, sizeof channels);
+    channels[0].name = "Up";
+    channels[0].deform_percent = 50;
+    channels[0].shape_count = 1;
+    channels[0].shapes = &shape;
+    channels[0].full_weight_count = 1;
+    channels[0].full_weights = fw;
+    channels[1] = channels[0];
+    channels[1].name = "PropUp";
+    for (int variant = 0; variant < 4; variant++) {
+        int binary = variant & 1, prop_has_channel = variant >> 1;
+        fbxw_mesh meshes[3];
+        memset(meshes, 0, sizeof meshes);
+        meshes[0].name = "Prop";    /* no control points, no polygons */
+        meshes[0].parent = -1;
+        meshes[0].channel_count = prop_has_channel ? 1 : 0;
+        meshes[0].channels = &channels[1];
+        for (int m = 1; m < 3; m++) {
+            meshes[m].name = m == 1 ? "Tri" : "Plain";
+            meshes[m].control_point_count = 3;
+            meshes[m].control_points = points;
+            meshes[m].polygon_vertex_count = 3;
+            meshes[m].polygon_vertex_index = tri;
+            meshes[m].parent = -1;
+        }
+        meshes[1].channel_count = 1;
+        meshes[1].channels = &channels[0];
+        fbxw_scene scene;
+        memset(&scene, 0, sizeof scene);
+        scene.version = binary ? 7500 : 7400;
+        scene.binary = binary;
+        scene.mesh_count = 3;
+        scene.meshes = meshes;
+        unsigned char *data;
+        size_t size;
+        CHECK(fbxw_write(&scene, &data, &size) == 0);
+        mk_raw_asset raw;
+        mk_error err;
+        mk_result r = ft_import(data, size, NULL, &raw, &err);
+        free(data);
+        CHECK_MSG(r == MK_OK, "variant %d: %s", variant, err.message);
+        if (r == MK_OK) {
+            CHECK_EQ_INT(raw.mesh_count, 2);
+            CHECK(ft_find_mesh(&raw, "Prop") < 0);
+            CHECK(ft_find_mesh(&raw, "Tri") >= 0);
+            CHECK(ft_find_mesh(&raw, "Plain") >= 0);   /* meshes without blend shapes are kept */
+            CHECK_EQ_INT(raw.channel_count, 1);
+            if (raw.channel_count == 1) CHECK(strcmp(raw.channels[0].name, "Up") == 0);
+            CHECK_MSG(has_warning(&raw, "'Prop'", "no vertices"), "variant %d: no warning names the skipped mesh", variant);
+            if (prop_has_channel) CHECK(has_warning(&raw, "'Prop'", "1 blend shape channel"));
+            CHECK(mk_raw_validate(&raw, &err) == MK_OK);
+        }
+        mk_raw_free(&raw);
+    }
+}
+
+/* Other reasons a mesh is not imported, each named in a warning: a mesh geometry no model uses,
+ * a second mesh geometry on one model, and (6.x) a mesh model without Vertices. */
+static void test_skipped_mesh_warnings(void)
+{
+    const char *orphan =
+        "; FBX 7.4.0 project file\nObjects: {\n"
+        " Geometry: 1, \"Geometry::Used\", \"Mesh\" {\n  Vertices: *9 { a: 0,0,0,1,0,0,0,1,0 }\n"
+        "  PolygonVertexIndex: *3 { a: 0,1,-3 }\n }\n"
+        " Geometry: 3, \"Geometry::Spare\", \"Mesh\" {\n  Vertices: *9 { a: 0,0,0,1,0,0,0,1,0 }\n"
+        "  PolygonVertexIndex: *3 { a: 0,1,-3 }\n }\n"
+        " Geometry: 4, \"Geometry::Lost\", \"Mesh\" {\n  Vertices: *9 { a: 0,0,0,1,0,0,0,1,0 }\n"
+        "  PolygonVertexIndex: *3 { a: 0,1,-3 }\n }\n"
+        " Model: 2, \"Model::M\", \"Mesh\" {\n }\n"
+        " Model: 5, \"Model::Hollow\", \"Mesh\" {\n }\n"
+        "}\nConnections: {\n C: \"OO\",1,2\n C: \"OO\",3,2\n}\n";
+    mk_raw_asset raw;
+    mk_error err;
+    mk_result r = ft_import(orphan, strlen(orphan), NULL, &raw, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    CHECK_EQ_INT(raw.mesh_count, 1);
+    CHECK(has_warning(&raw, "'Lost'", "no model"));
+    CHECK(has_warning(&raw, "'M'", "'Spare'"));
+    CHECK(has_warning(&raw, "'Hollow'", "no mesh geometry"));
+    mk_raw_free(&raw);
+    const char *legacy =
+        "; FBX 6.1.0 project file\nObjects:  {\n"
+        "\tModel: \"Model::Tri\", \"Mesh\" {\n\t\tVertices: 0,0,0,1,0,0,0,1,0\n\t\tPolygonVertexIndex: 0,1,-3\n\t}\n"
+        "\tModel: \"Model::Prop\", \"Mesh\" {\n\t\tVersion: 232\n\t}\n"
+        "\tModel: \"Model::Empty\", \"Mesh\" {\n\t\tVertices: \n\t\tPolygonVertexIndex: \n\t}\n"
+        "\tModel: \"Model::Null\", \"Null\" {\n\t}\n"
+        "}\n";
+    r = ft_import(legacy, strlen(legacy), NULL, &raw, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    CHECK_EQ_INT(raw.mesh_count, 1);
+    CHECK(has_warning(&raw, "'Prop'", "no vertices"));
+    CHECK(has_warning(&raw, "'Empty'", "no vertices"));
+    CHECK(!has_warning(&raw, "'Null'", ""));
+    CHECK_EQ_INT(raw.warning_count, 2);
+    mk_raw_free(&raw);
+}
+
 /* ---- hostile constructs: clear errors ---- */
 
 typedef struct buf { unsigned char data[4096]; size_t size; } buf;
@@ -829,6 +948,7 @@ static const check_case cases[] = {
     CASE(test_formats_roundtrip), CASE(test_stacking_option), CASE(test_curves), CASE(test_blender_full_weights),
     CASE(test_duplicate_full_weights), CASE(test_hostile_constructs), CASE(test_allocation_failures),
     CASE(test_rotation_order), CASE(test_legacy_61_ascii), CASE(test_inherit_type),
+    CASE(test_empty_mesh_skipped), CASE(test_skipped_mesh_warnings),
 };
 
 int main(int argc, char **argv)
