@@ -187,6 +187,29 @@ static void test_missing_buffer_file(void)
     expect_error(json, MK_ERROR_PARSE, "x.bin");
 }
 
+/* A node whose mesh has no morph targets is not imported (only morphing meshes are), but the
+ * user is told which one and why. */
+static void test_plain_mesh_warns(void)
+{
+    fixture f;
+    fixture_default(&f);
+    char *json = fixture_json(&f);
+    json = edit(json, "\"translation\":[1,2,3]}]", "\"translation\":[1,2,3]},{\"name\":\"rock\",\"mesh\":1}]");
+    json = edit(json, "\"extras\":{\"targetNames\":[\"up\"]}}]",
+                "\"extras\":{\"targetNames\":[\"up\"]}},{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":2}]}]");
+    mk_raw_asset raw;
+    mk_error err;
+    mk_result r = import_text(json, &raw, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    CHECK_EQ_INT(raw.mesh_count, 1);
+    int warned = 0;
+    for (uint32_t i = 0; i < raw.warning_count && i < MK_RAW_MAX_WARNINGS; i++)
+        warned |= strstr(raw.warnings[i].message, "'rock'") && strstr(raw.warnings[i].message, "no morph targets");
+    CHECK_MSG(warned, "no warning names the skipped node 'rock'");
+    mk_raw_free(&raw);
+    free(json);
+}
+
 static void test_index_out_of_range(void)
 {
     fixture f;
@@ -444,7 +467,7 @@ static void test_corpus_mutations(void)
     printf("  %d mutated imports without a crash\n", runs);
 }
 
-CHECK_MAIN(CASE(test_fixture_is_valid), CASE(test_missing_buffer_file), CASE(test_index_out_of_range),
+CHECK_MAIN(CASE(test_fixture_is_valid), CASE(test_missing_buffer_file), CASE(test_plain_mesh_warns), CASE(test_index_out_of_range),
            CASE(test_accessor_counts_disagree), CASE(test_not_finite), CASE(test_cubicspline_one_key),
            CASE(test_structure_errors), CASE(test_sidecar), CASE(test_allocation_failures),
            CASE(test_corpus_mutations))
