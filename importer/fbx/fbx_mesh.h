@@ -29,6 +29,9 @@ typedef struct fbx_shape_data {
     const double *normals;         /* 3 per entry, or NULL (not used) */
     const double *vertex_weights;  /* Blender per-entry weights (0..1), or NULL */
     const char *path;              /* node path for messages */
+    const fbx_node *node;          /* the Shape node (its Vertices/Normals name bad values) */
+    const char *name;              /* shape name for messages */
+    uint32_t name_length;
 } fbx_shape_data;
 
 /* Fills target->count/indices/positions/normals with the deltas on render vertices (strictly

@@ -509,6 +509,37 @@ static int finite16(const float m[16])
     return 1;
 }
 
+/* A mesh's world transform is not finite: name the property that made it so, on the model or
+ * on an ancestor (the transform stack reads these; fbx_transform.c). Falls back to naming the
+ * model when every value is finite and only the product overflowed. */
+static mk_result transform_not_finite(scene *s, uint32_t o, const char *mesh_name)
+{
+    static const char *const names[] = { "Lcl Translation", "Lcl Rotation", "Lcl Scaling", "RotationOffset",
+                                         "RotationPivot", "ScalingOffset", "ScalingPivot", "PreRotation",
+                                         "PostRotation", "GeometricTranslation", "GeometricRotation", "GeometricScaling" };
+    int32_t cur = (int32_t)o;
+    for (int depth = 0; cur >= 0 && depth < 256; depth++, cur = s->parent[cur]) {
+        fbx_props props = fbx_props_of(s->objects[cur].node);
+        uint32_t at = fbx_prop_payload(props);
+        for (size_t n = 0; n < sizeof names / sizeof names[0]; n++) {
+            if (depth > 0 && n >= 9) break;  /* an ancestor's geometric transform is not inherited */
+            const fbx_node *p = fbx_prop_find(props, names[n]);
+            for (uint32_t k = at; p && k < p->value_count && k < at + 3; k++) {
+                double x;
+                if (fbx_value_float(&p->values[k], &x) && !isfinite(x))
+                    return fbx_error_not_finite(s->doc, p, k, "'%s' %c of model '%.*s' (transform of mesh '%s')", names[n],
+                                                "xyz"[k - at], (int)s->objects[cur].name_length, s->objects[cur].name,
+                                                mesh_name);
+            }
+        }
+    }
+    char path[160];
+    fbx_node_path(s->objects[o].node, path, sizeof path);
+    return mk_error_set(s->doc->err, MK_ERROR_NOT_FINITE, s->objects[o].node->offset,
+                        "FBX %s '%s' (byte %llu): transform is not finite (NaN, infinite or beyond float range)", path,
+                        mesh_name, (unsigned long long)s->objects[o].node->offset);
+}
+
 /* ---- blend shapes ---- */
 
 typedef struct shape_ref {
@@ -592,6 +623,9 @@ static mk_result add_channel(scene *s, uint32_t mesh, fbx_mesh_map *map, const c
             data.indexes = indexes;
             data.positions = positions;
             data.path = path;
+            data.node = node;
+            data.name = shapes[i].name;
+            data.name_length = shapes[i].name_length;
             if (normals && n_nrm != n_pos) {
                 mk_raw_warn(raw, "FBX %s: Normals has %zu values for %zu vertices; ignored", path, n_nrm, n_pos);
             } else if (normals && (s->options->keep_shape_normals || any_nonzero(normals, n_nrm))) {
@@ -861,10 +895,7 @@ static mk_result convert_meshes(scene *s)
         world_transform(s, o, mesh->world);
         if (!finite16(mesh->world)) {
             fbx_mesh_map_free(doc, &map);
-            char path[160];
-            fbx_node_path(s->objects[o].node, path, sizeof path);
-            return mk_error_set(doc->err, MK_ERROR_NOT_FINITE, s->objects[o].node->offset,
-                                "FBX %s '%s': transform is NaN or infinite", path, mesh->name);
+            return transform_not_finite(s, o, mesh->name);
         }
         s->objects[o].raw_mesh = (int32_t)mesh_index;
         uint32_t first_channel = raw->channel_count;

@@ -772,6 +772,183 @@ static void test_skipped_mesh_warnings(void)
     mk_raw_free(&raw);
 }
 
+/* ---- ASCII comments and not-finite numbers ---- */
+
+/* `;` comments inside `a:` arrays and between the items of a value list that spans lines
+ * import exactly like the same file without comments. */
+static void test_ascii_array_comments(void)
+{
+    static const char *const texts[2] = {
+        "; FBX 7.4.0 project file\nObjects: {\n Geometry: 1, \"Geometry::\", \"Mesh\" {\n"
+        "  Vertices: *9 {\n   a: 0,0,0,1,0,0,0,2,0\n  }\n"
+        "  PolygonVertexIndex: *3 { a: 0,1,-3 }\n }\n Model: 2, \"Model::M\", \"Mesh\" {\n }\n}\n"
+        "Connections: {\n C: \"OO\",1,2\n}\n",
+        "; FBX 7.4.0 project file\nObjects: {\n Geometry: 1, \"Geometry::\", \"Mesh\" {\n"
+        "  Vertices: *9 ; nine values\n  {\n   a: ; x, y, z per point\n"
+        "      0,0,0, ; point 0 } (a brace in a comment)\n"
+        "; a whole comment line between items, with commas , , and 1.#INF\n"
+        "      1,0,0 ; point 1, no trailing comma\n"
+        "      ,0,2,0 ; point 2\n  }\n"
+        "  PolygonVertexIndex: *3 { a: 0,1, ; closes\n -3 }\n }\n Model: 2, \"Model::M\", \"Mesh\" {\n }\n}\n"
+        "Connections: {\n C: \"OO\",1,2\n}\n",
+    };
+    float positions[2][9];
+    for (int t = 0; t < 2; t++) {
+        mk_raw_asset raw;
+        mk_error err;
+        mk_result r = ft_import(texts[t], strlen(texts[t]), NULL, &raw, &err);
+        CHECK_MSG(r == MK_OK, "text %d: %s", t, err.message);
+        CHECK_EQ_INT(raw.mesh_count, 1);
+        if (r == MK_OK && raw.mesh_count == 1 && raw.meshes[0].vertex_count == 3)
+            memcpy(positions[t], raw.meshes[0].positions, sizeof positions[t]);
+        else
+            memset(positions[t], 0xff, sizeof positions[t]);
+        mk_raw_free(&raw);
+    }
+    CHECK(memcmp(positions[0], positions[1], sizeof positions[0]) == 0);
+    CHECK_NEAR(positions[1][7], 2.0, 0);
+    /* 6.x value lists: a comment line between continuation lines. */
+    const char *legacy =
+        "; FBX 6.1.0 project file\nObjects:  {\n\tModel: \"Model::Tri\", \"Mesh\" {\n"
+        "\t\tVertices: 0,0,0,1,0,0 ; two points\n\t\t; the third follows\n\t\t,0,2,0\n"
+        "\t\tPolygonVertexIndex: 0,1,\n\t\t; the closing index\n\t\t-3\n\t}\n}\n";
+    mk_raw_asset raw;
+    mk_error err;
+    mk_result r = ft_import(legacy, strlen(legacy), NULL, &raw, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    CHECK(r == MK_OK && raw.mesh_count == 1 && raw.meshes[0].control_point_count == 3 && raw.meshes[0].triangle_count == 1);
+    mk_raw_free(&raw);
+}
+
+/* A 7.4 ASCII scene with one value of each kind the importer checks: a control point
+ * coordinate (@V), a Lcl Translation component (@T), a shape delta (@D), a curve key value
+ * (@K). fill() substitutes them and records where each token starts. */
+static const char not_finite_template[] =
+    "; FBX 7.4.0 project file\nObjects: {\n"
+    " Geometry: 1, \"Geometry::\", \"Mesh\" {\n  Vertices: *9 { a: 0,0,0,1,@V,0,0,1,0 }\n"
+    "  PolygonVertexIndex: *3 { a: 0,1,-3 }\n }\n"
+    " Model: 2, \"Model::M\", \"Mesh\" {\n  Properties70: {\n"
+    "   P: \"Lcl Translation\", \"Lcl Translation\", \"\", \"A\",@T,0,0\n  }\n }\n"
+    " Deformer: 3, \"Deformer::B\", \"BlendShape\" {\n }\n"
+    " Deformer: 4, \"SubDeformer::C\", \"BlendShapeChannel\" {\n  DeformPercent: 0\n  FullWeights: *1 { a: 100 }\n }\n"
+    " Geometry: 5, \"Geometry::S\", \"Shape\" {\n  Indexes: *1 { a: 2 }\n  Vertices: *3 { a: 0,@D,0 }\n }\n"
+    " AnimationStack: 6, \"AnimStack::Take\", \"\" {\n }\n AnimationLayer: 7, \"AnimLayer::Base\", \"\" {\n }\n"
+    " AnimationCurveNode: 8, \"AnimCurveNode::DeformPercent\", \"\" {\n }\n"
+    " AnimationCurve: 9, \"AnimCurve::\", \"\" {\n  KeyTime: *2 { a: 0,46186158000 }\n  KeyValueFloat: *2 { a: 0,@K }\n"
+    "  KeyAttrFlags: *1 { a: 4 }\n  KeyAttrDataFloat: *4 { a: 0,0,218434821,0 }\n  KeyAttrRefCount: *1 { a: 2 }\n }\n"
+    "}\nConnections: {\n C: \"OO\",1,2\n C: \"OO\",3,1\n C: \"OO\",4,3\n C: \"OO\",5,4\n C: \"OO\",7,6\n C: \"OO\",8,7\n"
+    " C: \"OP\",8,4, \"DeformPercent\"\n C: \"OP\",9,8, \"d|DeformPercent\"\n}\n";
+
+static char *fill(const char *bad, int slot, size_t *bad_offset)
+{
+    static const char slots[] = "VTDK";
+    char *out = malloc(sizeof not_finite_template + 64);
+    size_t n = 0;
+    for (const char *p = not_finite_template; *p; p++) {
+        if (p[0] == '@' && p[1]) {
+            int which = (int)(strchr(slots, p[1]) - slots);
+            const char *token = which == slot ? bad : "1";
+            if (which == slot) *bad_offset = n;
+            memcpy(out + n, token, strlen(token));
+            n += strlen(token);
+            p++;
+            continue;
+        }
+        out[n++] = *p;
+    }
+    out[n] = 0;
+    return out;
+}
+
+/* NaN and infinity in every spelling exporters write (C99, Windows CRT, glibc) are numbers,
+ * never "malformed" and never bare-word characters: each gives MK_ERROR_NOT_FINITE naming the
+ * array (or property), the element and the byte offset of the token. */
+static void test_ascii_not_finite(void)
+{
+    static const char *const spellings[] = { "nan", "-nan", "NaN", "NAN", "inf", "-inf", "INF", "Inf", "Infinity",
+                                              "-Infinity", "1.#INF", "-1.#INF", "1.#IND", "-1.#IND", "1.#QNAN",
+                                              "1.#SNAN", "1.#INF00", "-1.#IND00", "nan(ind)", "-nan(ind)", "1e999" };
+    static const char *const names[4][2] = { { "Objects/Geometry/Vertices", "control point 1" },
+                                             { "Lcl Translation", "'M'" },
+                                             { "Objects/Geometry/Vertices", "shape 'S' entry 0" },
+                                             { "Objects/AnimationCurve/KeyValueFloat", "key 1" } };
+    size_t offset = 0;
+    char *text = fill("1", -1, &offset);
+    mk_raw_asset raw;
+    mk_error err;
+    mk_result r = ft_import(text, strlen(text), NULL, &raw, &err);
+    CHECK_MSG(r == MK_OK, "finite template: %s", err.message);
+    CHECK_EQ_INT(raw.channel_count, 1);
+    CHECK_EQ_INT(raw.clip_count, 1);
+    mk_raw_free(&raw);
+    free(text);
+    for (size_t i = 0; i < sizeof spellings / sizeof spellings[0]; i++) {
+        for (int slot = 0; slot < 4; slot++) {
+            text = fill(spellings[i], slot, &offset);
+            memset(&err, 0, sizeof err);
+            r = ft_import(text, strlen(text), NULL, &raw, &err);
+            char at[48];
+            snprintf(at, sizeof at, "byte %zu", offset);
+            CHECK_MSG(r == MK_ERROR_NOT_FINITE, "'%s' in slot %d: %s (%s)", spellings[i], slot, mk_result_name(r), err.message);
+            CHECK_MSG(strstr(err.message, "not finite") && strstr(err.message, names[slot][0]) &&
+                          strstr(err.message, names[slot][1]) && strstr(err.message, at),
+                      "'%s' in slot %d: message '%s' should say not finite, name %s, %s and %s", spellings[i], slot,
+                      err.message, names[slot][0], names[slot][1], at);
+            CHECK_MSG(err.offset == offset, "'%s' in slot %d: offset %llu, token at %zu", spellings[i], slot,
+                      (unsigned long long)err.offset, offset);
+            mk_raw_free(&raw);
+            free(text);
+        }
+    }
+}
+
+/* The binary path reports the same error: a NaN control point in a raw array points at the
+ * element's eight bytes, in a zlib array at the array (its elements have no file offset). */
+static void test_binary_not_finite(void)
+{
+    double points[3 * 30];
+    for (int i = 0; i < 90; i++) points[i] = (double)(i % 7);
+    points[4] = NAN;   /* control point 1, y */
+    static const int32_t tri[3] = { 0, 1, ~2 };
+    for (int compress = 0; compress < 2; compress++) {
+        fbxw_mesh mesh;
+        memset(&mesh, 0, sizeof mesh);
+        mesh.name = "M";
+        mesh.control_point_count = 30;   /* 90 doubles: compressed when asked */
+        mesh.control_points = points;
+        mesh.polygon_vertex_count = 3;
+        mesh.polygon_vertex_index = tri;
+        mesh.parent = -1;
+        fbxw_scene scene;
+        memset(&scene, 0, sizeof scene);
+        scene.version = 7500;
+        scene.binary = 1;
+        scene.compress = compress;
+        scene.mesh_count = 1;
+        scene.meshes = &mesh;
+        unsigned char *data;
+        size_t size;
+        CHECK(fbxw_write(&scene, &data, &size) == 0);
+        mk_raw_asset raw;
+        mk_error err;
+        memset(&err, 0, sizeof err);
+        mk_result r = ft_import(data, size, NULL, &raw, &err);
+        CHECK_EQ_INT(r, MK_ERROR_NOT_FINITE);
+        char at[48];
+        snprintf(at, sizeof at, "byte %llu", (unsigned long long)err.offset);
+        CHECK_MSG(strstr(err.message, "Objects/Geometry/Vertices") && strstr(err.message, "control point 1") &&
+                      strstr(err.message, "not finite") && strstr(err.message, at),
+                  "message: %s", err.message);
+        CHECK(err.offset < size);
+        if (err.offset + 8 <= size) {
+            if (compress) CHECK(data[err.offset] == 'd');
+            else CHECK(memcmp(data + err.offset, &points[4], 8) == 0);
+        }
+        mk_raw_free(&raw);
+        free(data);
+    }
+}
+
 /* ---- hostile constructs: clear errors ---- */
 
 typedef struct buf { unsigned char data[4096]; size_t size; } buf;
@@ -949,6 +1126,7 @@ static const check_case cases[] = {
     CASE(test_duplicate_full_weights), CASE(test_hostile_constructs), CASE(test_allocation_failures),
     CASE(test_rotation_order), CASE(test_legacy_61_ascii), CASE(test_inherit_type),
     CASE(test_empty_mesh_skipped), CASE(test_skipped_mesh_warnings),
+    CASE(test_ascii_array_comments), CASE(test_ascii_not_finite), CASE(test_binary_not_finite),
 };
 
 int main(int argc, char **argv)
