@@ -29,6 +29,7 @@
 #include "fbx_anim.h"
 #include "fbx_mesh.h"
 #include "fbx_transform.h"
+#include "format.h"
 
 enum {
     OBJ_OTHER, OBJ_MODEL, OBJ_MESH, OBJ_SHAPE, OBJ_BLEND, OBJ_CHANNEL, OBJ_STACK, OBJ_LAYER, OBJ_CURVE_NODE, OBJ_CURVE
@@ -590,14 +591,16 @@ static mk_result add_channel(scene *s, uint32_t mesh, fbx_mesh_map *map, const c
         const fbx_node *node = shapes[i].node;
         fbx_node_path(node, path, sizeof path);
         float fw = (float)(shapes[i].full_weight / 100.0);
-        if (!isfinite(fw) || fw == 0.0f) {
-            mk_raw_warn(raw, "FBX %s '%.*s': full weight %g is zero or not finite; shape skipped", path,
+        /* The same gaps mk_raw_validate and the runtime require (format.h): a full weight the
+         * runtime cannot place is skipped here with a warning, never passed on to fail later. */
+        if (!isfinite(fw) || fabsf(fw) < MK_MIN_FULL_WEIGHT_GAP) {
+            mk_raw_warn(raw, "FBX %s '%.*s': full weight %g is zero (closer than 1e-6) or not finite; shape skipped", path,
                         (int)shapes[i].name_length, shapes[i].name, shapes[i].full_weight);
             continue;
         }
-        if (channel && channel->target_count > 0 && !(fw > last_weight)) {
-            mk_raw_warn(raw, "FBX %s '%.*s': full weight %g repeats the previous in-between; duplicate dropped", path,
-                        (int)shapes[i].name_length, shapes[i].name, shapes[i].full_weight);
+        if (channel && channel->target_count > 0 && !(fw - last_weight >= MK_MIN_FULL_WEIGHT_GAP)) {
+            mk_raw_warn(raw, "FBX %s '%.*s': full weight %g repeats the previous in-between (closer than 1e-6); duplicate dropped",
+                        path, (int)shapes[i].name_length, shapes[i].name, shapes[i].full_weight);
             continue;
         }
         int32_t *indexes = NULL;

@@ -511,6 +511,61 @@ static void test_duplicate_full_weights(void)
     mk_raw_free(&raw);
 }
 
+/* Full weights the runtime cannot place (closer than 1e-6 to 0, or to the previous
+ * in-between) are skipped with a warning at import, not passed on to fail validation. */
+static void test_tiny_full_weights(void)
+{
+    static const int32_t idx[1] = { 0 };
+    static const double d1[3] = { 1, 0, 0 }, d2[3] = { 2, 0, 0 }, d3[3] = { 3, 0, 0 }, d4[3] = { 4, 0, 0 };
+    /* percent: 1e-5 % = 1e-7 (too close to 0), 50, 50 + 1e-5 % (too close to 50), 100 */
+    static const double fw[4] = { 1e-5, 50, 50.00001, 100 };
+    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
+    static const int32_t tri[3] = { 0, 1, ~2 };
+    fbxw_shape shapes[4] = { { "A", 1, idx, d1, NULL }, { "B", 1, idx, d2, NULL }, { "C", 1, idx, d3, NULL },
+                             { "D", 1, idx, d4, NULL } };
+    fbxw_channel channel;
+    memset(&channel, 0, sizeof channel);
+    channel.name = "Tiny";
+    channel.shape_count = 4;
+    channel.shapes = shapes;
+    channel.full_weight_count = 4;
+    channel.full_weights = fw;
+    fbxw_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.name = "Tri";
+    mesh.control_point_count = 3;
+    mesh.control_points = points;
+    mesh.polygon_vertex_count = 3;
+    mesh.polygon_vertex_index = tri;
+    mesh.channel_count = 1;
+    mesh.channels = &channel;
+    mesh.parent = -1;
+    fbxw_scene scene;
+    memset(&scene, 0, sizeof scene);
+    scene.version = 7500;
+    scene.binary = 1;
+    scene.mesh_count = 1;
+    scene.meshes = &mesh;
+    unsigned char *data;
+    size_t size;
+    CHECK(fbxw_write(&scene, &data, &size) == 0);
+    mk_raw_asset raw;
+    mk_error err;
+    CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
+    free(data);
+    CHECK_MSG(mk_raw_validate(&raw, &err) == MK_OK, "%s", err.message);
+    CHECK_EQ_INT(raw.channel_count, 1);
+    if (raw.channel_count == 1) {
+        CHECK_EQ_INT(raw.channels[0].target_count, 2);
+        if (raw.channels[0].target_count == 2) {
+            CHECK(strcmp(raw.channels[0].targets[0].name, "B") == 0);
+            CHECK(strcmp(raw.channels[0].targets[1].name, "D") == 0);
+        }
+    }
+    CHECK(raw.warning_count >= 2);
+    mk_raw_free(&raw);
+}
+
 /* Rotation order and pre-rotation: a point at (1,0,0) under T(1,0,0) and R(90,0,90).
  * XYZ applies X first: (1,0,0) -> (1,0,0) -> (0,1,0), + T = (1,1,0).
  * ZYX applies Z first: (1,0,0) -> (0,1,0) -> (0,0,1), + T = (1,0,1).
@@ -1123,7 +1178,8 @@ static int write_seeds(const char *dir)
 
 static const check_case cases[] = {
     CASE(test_formats_roundtrip), CASE(test_stacking_option), CASE(test_curves), CASE(test_blender_full_weights),
-    CASE(test_duplicate_full_weights), CASE(test_hostile_constructs), CASE(test_allocation_failures),
+    CASE(test_duplicate_full_weights), CASE(test_tiny_full_weights), CASE(test_hostile_constructs),
+    CASE(test_allocation_failures),
     CASE(test_rotation_order), CASE(test_legacy_61_ascii), CASE(test_inherit_type),
     CASE(test_empty_mesh_skipped), CASE(test_skipped_mesh_warnings),
     CASE(test_ascii_array_comments), CASE(test_ascii_not_finite), CASE(test_binary_not_finite),
