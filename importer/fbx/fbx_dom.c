@@ -11,7 +11,7 @@
 #include "fbx_internal.h"
 
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
-#error "the FBX array decoder copies little-endian payloads directly; add byte swapping for this host"
+#error "the FBX array decoder assumes a little-endian host (it copies little-endian payloads and swaps big-endian files); adapt it for this host"
 #endif
 
 void *fbx_grow(mk_arena *arena, void *ptr, size_t old_size, size_t new_size)
@@ -171,11 +171,31 @@ static int store_i64(void *out, size_t i, fbx_elem elem, int64_t x)
     return 0;
 }
 
+/* Reverses the bytes of each of `count` elements of `size` bytes in place (big-endian files). */
+static void swap_elements(void *data, size_t count, size_t size)
+{
+    uint8_t *p = data;
+    for (size_t i = 0; i < count; i++, p += size)
+        for (size_t a = 0, b = size - 1; a < b; a++, b--) {
+            uint8_t t = p[a];
+            p[a] = p[b];
+            p[b] = t;
+        }
+}
+
+/* One element of `size` bytes from p into dst, in host order. */
+static void load_element(void *dst, const uint8_t *p, size_t size, int swap)
+{
+    memcpy(dst, p, size);
+    if (swap) swap_elements(dst, 1, size);
+}
+
 static mk_result decode_binary(fbx_doc *doc, const fbx_node *node, const fbx_value *v, fbx_elem elem,
                                void *out)
 {
     size_t src_size = (v->type == 'd' || v->type == 'l') ? 8 : (v->type == 'f' || v->type == 'i') ? 4 : 1;
     size_t bytes = (size_t)v->count * src_size;
+    int swap = doc->big_endian && src_size > 1;  /* the payload (also inflated) is in the file's order */
     const uint8_t *src = v->u.a.data;
     void *inflated = NULL;
     int same = (v->type == 'd' && elem == FBX_ELEM_F64) || (v->type == 'l' && elem == FBX_ELEM_I64) ||
@@ -199,20 +219,24 @@ static mk_result decode_binary(fbx_doc *doc, const fbx_node *node, const fbx_val
                                    ? "compressed array inflates to fewer bytes than declared"
                                    : "corrupt zlib stream in array");
         }
-        if (same) return MK_OK;
+        if (same) {
+            if (swap) swap_elements(out, v->count, src_size);
+            return MK_OK;
+        }
         src = inflated;
     } else if (same) {
         if (bytes) memcpy(out, src, bytes);
+        if (swap) swap_elements(out, v->count, src_size);
         return MK_OK;
     }
     int ok = 1;
     for (size_t i = 0; i < v->count && ok; i++) {
         const uint8_t *p = src + i * src_size;
         switch (v->type) {
-        case 'd': { double x; memcpy(&x, p, 8); ok = store_f64(out, i, elem, x); break; }
-        case 'f': { float x; memcpy(&x, p, 4); ok = store_f64(out, i, elem, x); break; }
-        case 'l': { int64_t x; memcpy(&x, p, 8); ok = store_i64(out, i, elem, x); break; }
-        case 'i': { int32_t x; memcpy(&x, p, 4); ok = store_i64(out, i, elem, x); break; }
+        case 'd': { double x; load_element(&x, p, 8, swap); ok = store_f64(out, i, elem, x); break; }
+        case 'f': { float x; load_element(&x, p, 4, swap); ok = store_f64(out, i, elem, x); break; }
+        case 'l': { int64_t x; load_element(&x, p, 8, swap); ok = store_i64(out, i, elem, x); break; }
+        case 'i': { int32_t x; load_element(&x, p, 4, swap); ok = store_i64(out, i, elem, x); break; }
         default: ok = store_i64(out, i, elem, p[0]); break;
         }
     }

@@ -61,6 +61,7 @@ typedef struct fbx_doc {
     const uint8_t *data;
     size_t size;
     int binary;
+    int big_endian;         /* binary file with the big-endian header flag: array elements are swapped on decode */
     uint32_t version;       /* header version (binary) or "; FBX x.y.z" (ASCII); may be raised from FBXVersion */
     uint32_t header_version;/* as found in the header (binary) */
     fbx_node root;          /* children = top-level nodes */

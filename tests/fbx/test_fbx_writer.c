@@ -13,6 +13,7 @@
 #include <libdeflate.h>
 #include "check.h"
 #include "fbx_fixtures.h"
+#include "fbx_internal.h"
 #include "fbx_test_util.h"
 
 /* Hand-computed world position of the Box fixture's control point `cp` with Squash weight ws
@@ -1004,6 +1005,249 @@ static void test_binary_not_finite(void)
     }
 }
 
+/* ---- big-endian binary files ---- */
+
+#define SAME(cond, ...) CHECK_MSG(cond, __VA_ARGS__)
+
+static int same_floats(const float *a, const float *b, size_t n)
+{
+    return (!a && !b) || (a && b && memcmp(a, b, n * sizeof(float)) == 0);
+}
+
+static int same_u32(const uint32_t *a, const uint32_t *b, size_t n)
+{
+    return (!a && !b) || (a && b && memcmp(a, b, n * sizeof(uint32_t)) == 0);
+}
+
+static int same_str(const char *a, const char *b)
+{
+    return (!a && !b) || (a && b && strcmp(a, b) == 0);
+}
+
+/* Every field of two raw models, bit for bit. */
+static void check_same_raw(const mk_raw_asset *a, const mk_raw_asset *b, const char *label)
+{
+    SAME(strcmp(a->source_format, b->source_format) == 0 && strcmp(a->source_creator, b->source_creator) == 0 &&
+             memcmp(&a->unit_scale, &b->unit_scale, sizeof a->unit_scale) == 0 && a->up_axis == b->up_axis,
+         "%s: import facts differ", label);
+    SAME(a->warning_count == b->warning_count, "%s: %u vs %u warnings", label, a->warning_count, b->warning_count);
+    for (uint32_t i = 0; i < a->warning_count && i < b->warning_count && i < MK_RAW_MAX_WARNINGS; i++)
+        SAME(strcmp(a->warnings[i].message, b->warnings[i].message) == 0, "%s: warning %u differs", label, i);
+    SAME(a->mesh_count == b->mesh_count && a->channel_count == b->channel_count && a->clip_count == b->clip_count,
+         "%s: counts differ", label);
+    for (uint32_t m = 0; m < a->mesh_count && m < b->mesh_count; m++) {
+        const mk_raw_mesh *x = &a->meshes[m], *y = &b->meshes[m];
+        SAME(same_str(x->name, y->name) && x->vertex_count == y->vertex_count && x->triangle_count == y->triangle_count &&
+                 x->control_point_count == y->control_point_count && x->gltf_node == y->gltf_node &&
+                 x->gltf_mesh == y->gltf_mesh && x->gltf_primitive == y->gltf_primitive && x->stacking == y->stacking,
+             "%s: mesh %u header differs", label, m);
+        if (x->vertex_count != y->vertex_count || x->triangle_count != y->triangle_count) continue;
+        SAME(same_floats(x->positions, y->positions, 3 * (size_t)x->vertex_count) &&
+                 same_floats(x->normals, y->normals, 3 * (size_t)x->vertex_count) &&
+                 same_floats(x->tangents, y->tangents, 4 * (size_t)x->vertex_count) &&
+                 same_u32(x->triangles, y->triangles, 3 * (size_t)x->triangle_count) &&
+                 same_u32(x->control_points, y->control_points, x->vertex_count) &&
+                 memcmp(x->world, y->world, sizeof x->world) == 0,
+             "%s: mesh %u data differs", label, m);
+    }
+    for (uint32_t c = 0; c < a->channel_count && c < b->channel_count; c++) {
+        const mk_raw_channel *x = &a->channels[c], *y = &b->channels[c];
+        SAME(same_str(x->name, y->name) && same_str(x->origin, y->origin) && x->mesh == y->mesh &&
+                 memcmp(&x->default_weight, &y->default_weight, sizeof(float)) == 0 && x->target_count == y->target_count,
+             "%s: channel %u header differs", label, c);
+        for (uint32_t k = 0; k < x->target_count && k < y->target_count; k++) {
+            const mk_raw_target *t = &x->targets[k], *u = &y->targets[k];
+            SAME(same_str(t->name, u->name) && memcmp(&t->full_weight, &u->full_weight, sizeof(float)) == 0 &&
+                     t->count == u->count, "%s: channel %u target %u header differs", label, c, k);
+            if (t->count != u->count) continue;
+            SAME(same_u32(t->indices, u->indices, t->count) && same_floats(t->positions, u->positions, 3 * (size_t)t->count) &&
+                     same_floats(t->normals, u->normals, 3 * (size_t)t->count) &&
+                     same_floats(t->tangents, u->tangents, 3 * (size_t)t->count),
+                 "%s: channel %u target %u data differs", label, c, k);
+        }
+    }
+    for (uint32_t c = 0; c < a->clip_count && c < b->clip_count; c++) {
+        const mk_raw_clip *x = &a->clips[c], *y = &b->clips[c];
+        SAME(same_str(x->name, y->name) && memcmp(&x->start, &y->start, sizeof(float)) == 0 &&
+                 memcmp(&x->duration, &y->duration, sizeof(float)) == 0 && x->track_count == y->track_count,
+             "%s: clip %u header differs", label, c);
+        for (uint32_t t = 0; t < x->track_count && t < y->track_count; t++)
+            SAME(x->tracks[t].channel == y->tracks[t].channel && x->tracks[t].key_count == y->tracks[t].key_count &&
+                     memcmp(x->tracks[t].keys, y->tracks[t].keys, x->tracks[t].key_count * sizeof(mk_key)) == 0,
+                 "%s: clip %u track %u differs", label, c, t);
+    }
+}
+
+typedef struct parsed { mk_arena arena; mk_error err; fbx_doc doc; mk_result result; } parsed;
+
+static void parse_binary(parsed *p, const unsigned char *data, size_t size)
+{
+    mk_arena_init(&p->arena, NULL);
+    memset(&p->err, 0, sizeof p->err);
+    memset(&p->doc, 0, sizeof p->doc);
+    p->doc.arena = &p->arena;
+    p->doc.data = data;
+    p->doc.size = size;
+    p->doc.err = &p->err;
+    p->doc.binary = 1;
+    p->result = fbx_parse_binary(&p->doc);
+    if (p->result == MK_OK) fbx_link_parents(&p->doc.root);
+}
+
+static void parsed_free(parsed *p)
+{
+    fbx_doc_free(&p->doc);
+    mk_arena_free_all(&p->arena);
+}
+
+/* Two parse trees value by value; arrays decoded as every element type (same values, or the
+ * same error). Offsets are compared when the files have the same layout (no zlib arrays: the
+ * compressed twins differ in length). Returns the number of values compared. */
+static int check_same_tree(parsed *pa, const fbx_node *a, parsed *pb, const fbx_node *b, int same_layout, const char *label)
+{
+    int compared = 0;
+    char path[160];
+    fbx_node_path(a, path, sizeof path);
+    if (!(a->name_length == b->name_length && memcmp(a->name, b->name, a->name_length) == 0 &&
+          a->value_count == b->value_count && a->child_count == b->child_count && (!same_layout || a->offset == b->offset))) {
+        CHECK_MSG(0, "%s: node %s differs", label, path);
+        return compared;
+    }
+    for (uint32_t i = 0; i < a->value_count; i++) {
+        const fbx_value *x = &a->values[i], *y = &b->values[i];
+        int same = x->kind == y->kind && x->type == y->type && x->encoding == y->encoding && x->count == y->count &&
+                   (!same_layout || x->offset == y->offset);
+        if (same && (x->kind == FBX_INT || x->kind == FBX_CHAR)) same = x->u.i == y->u.i;
+        if (same && x->kind == FBX_FLOAT) same = memcmp(&x->u.f, &y->u.f, sizeof x->u.f) == 0;
+        if (same && x->kind == FBX_STRING)
+            same = x->u.s.length == y->u.s.length && memcmp(x->u.s.data, y->u.s.data, x->u.s.length) == 0;
+        if (same && x->kind == FBX_ARRAY && a->value_count == 1) {
+            static const fbx_elem elems[5] = { FBX_ELEM_F64, FBX_ELEM_F32, FBX_ELEM_I32, FBX_ELEM_I64, FBX_ELEM_F32_BITS };
+            for (int e = 0; e < 5 && same; e++) {
+                void *da = NULL, *db = NULL;
+                size_t na = 0, nb = 0;
+                mk_result ra = fbx_node_array(&pa->doc, a, elems[e], &da, &na);
+                mk_result rb = fbx_node_array(&pb->doc, b, elems[e], &db, &nb);
+                size_t esize = (elems[e] == FBX_ELEM_F64 || elems[e] == FBX_ELEM_I64) ? 8 : 4;
+                same = ra == rb && na == nb && (ra != MK_OK || na == 0 || memcmp(da, db, na * esize) == 0);
+                if (ra == MK_OK) mk_arena_release(&pa->arena, da);
+                if (rb == MK_OK) mk_arena_release(&pb->arena, db);
+            }
+        }
+        CHECK_MSG(same, "%s: %s value %u (type '%c') differs", label, path, i, x->type);
+        compared++;
+    }
+    for (uint32_t c = 0; c < a->child_count; c++)
+        compared += check_same_tree(pa, &a->children[c], pb, &b->children[c], same_layout, label);
+    return compared;
+}
+
+/* The type zoo as a big-endian reader must see it (the writer's values, not just equal ones). */
+static void check_type_zoo(parsed *p, const char *label)
+{
+    const fbx_node *zoo = fbx_child(&p->doc.root, "MorphkitTypes");
+    CHECK_MSG(zoo && zoo->value_count == 10 && zoo->child_count == 12, "%s: type zoo missing", label);
+    if (!zoo || zoo->value_count != 10 || zoo->child_count != 12) return;
+    const fbx_value *v = zoo->values;
+    CHECK(v[0].type == 'Y' && v[0].u.i == -12345);
+    CHECK(v[1].type == 'C' && v[1].u.i == 'x');
+    CHECK(v[2].type == 'B' && v[2].u.i == 200);
+    CHECK(v[3].type == 'Z' && v[3].u.i == 1);
+    CHECK(v[4].type == 'I' && v[4].u.i == -123456789);
+    CHECK(v[5].type == 'L' && v[5].u.i == -1234567890123456789LL);
+    CHECK(v[6].type == 'F' && v[6].u.f == (double)-3.25e-3f);
+    CHECK(v[7].type == 'D' && v[7].u.f == 0.1);
+    CHECK(v[8].type == 'S' && v[8].u.s.length == 11 && memcmp(v[8].u.s.data, "name\0\1Class", 11) == 0);
+    CHECK(v[9].type == 'R' && v[9].u.s.length == 5 && memcmp(v[9].u.s.data, "\x00\x01\x02\xff\x80", 5) == 0);
+    static const double expect[6][5] = {
+        { 0.1, -2.5e10, 1e-300, 3.0, -0.0 },
+        { (double)1e-3f, -7.5, (double)3.0e38f, 0.0, (double)(1.0f / 3.0f) },
+        { (double)0x0102030405060708LL, -2, (double)INT64_MIN, 46186158000.0, 0 },
+        { (double)0x01020304, -2, (double)INT32_MIN, 7, 0 },
+        { 0, 1, 255, 128, 2 },
+        { 'a', 'Y', 0, 'T', 'N' } };
+    static const int64_t expect_l[5] = { 0x0102030405060708LL, -2, INT64_MIN, 46186158000LL, 0 };
+    for (uint32_t c = 0; c < 12; c++) {
+        const fbx_node *n = &zoo->children[c];
+        int a = (int)c / 2;
+        double *d = NULL;
+        size_t count = 0;
+        mk_result r = fbx_node_array(&p->doc, n, FBX_ELEM_F64, (void **)&d, &count);
+        CHECK_MSG(r == MK_OK && count == 5, "%s: zoo array %u: %s", label, c, p->err.message);
+        for (size_t k = 0; r == MK_OK && k < count; k++)
+            CHECK_MSG(d[k] == expect[a][k], "%s: zoo array %u[%zu] = %g, expected %g", label, c, k, d[k], expect[a][k]);
+        if (r == MK_OK) mk_arena_release(&p->arena, d);
+        if (a == 2) {  /* int64 exactly */
+            int64_t *l = NULL;
+            r = fbx_node_array(&p->doc, n, FBX_ELEM_I64, (void **)&l, &count);
+            CHECK(r == MK_OK && count == 5 && memcmp(l, expect_l, sizeof expect_l) == 0);
+            if (r == MK_OK) mk_arena_release(&p->arena, l);
+        }
+    }
+}
+
+/* A big-endian file imports to exactly the raw model of its little-endian twin: 13- and 25-byte
+ * records, raw and zlib arrays (some, all), and with the type mix every property type where
+ * the importer reads it; the parse trees agree value by value (arrays decoded as every element
+ * type), and the type zoo reads back the values the writer put in. */
+static void test_big_endian_twins(void)
+{
+    static const uint32_t be_versions[] = { 7100, 7400, 7500, 7700 };
+    int compared = 0;
+    for (size_t v = 0; v < sizeof be_versions / sizeof be_versions[0]; v++)
+        for (int compress = 0; compress < 3; compress++)
+            for (int mix = 0; mix < 2; mix++) {
+                char label[64];
+                snprintf(label, sizeof label, "%u compress %d%s", be_versions[v], compress, mix ? " type mix" : "");
+                unsigned char *data[2] = { NULL, NULL };
+                size_t size[2] = { 0, 0 };
+                for (int big = 0; big < 2; big++) {
+                    fbxw_scene scene;
+                    fixture_cube(&scene, be_versions[v], 1, compress);
+                    scene.big_endian = big;
+                    scene.type_mix = mix;
+                    CHECK(fbxw_write(&scene, &data[big], &size[big]) == 0);
+                }
+                if (!data[0] || !data[1]) { free(data[0]); free(data[1]); continue; }
+                int same_layout = compress == 0 && !mix;
+                CHECK(data[1][22] == 1 && data[0][22] == 0 && (!same_layout || size[0] == size[1]));
+                mk_raw_asset raw[2];
+                mk_error err[2];
+                mk_result r[2];
+                for (int big = 0; big < 2; big++) r[big] = ft_import(data[big], size[big], NULL, &raw[big], &err[big]);
+                CHECK_MSG(r[0] == MK_OK, "%s little-endian: %s", label, err[0].message);
+                CHECK_MSG(r[1] == MK_OK, "%s big-endian: %s", label, err[1].message);
+                if (r[0] == MK_OK && r[1] == MK_OK) {
+                    check_box_import(&raw[1], label);
+                    check_same_raw(&raw[0], &raw[1], label);
+                    CHECK(strstr(raw[1].source_format, "binary") != NULL);
+                }
+                mk_raw_free(&raw[0]);
+                mk_raw_free(&raw[1]);
+                parsed pa, pb;
+                parse_binary(&pa, data[0], size[0]);
+                parse_binary(&pb, data[1], size[1]);
+                CHECK_MSG(pa.result == MK_OK && pb.result == MK_OK, "%s: parse %s / %s", label, pa.err.message, pb.err.message);
+                if (pa.result == MK_OK && pb.result == MK_OK) {
+                    CHECK(pb.doc.header_version == be_versions[v]);
+                    CHECK_EQ_INT(pa.doc.root.child_count, pb.doc.root.child_count);
+                    for (uint32_t c = 0; c < pa.doc.root.child_count && c < pb.doc.root.child_count; c++)
+                        compared += check_same_tree(&pa, &pa.doc.root.children[c], &pb, &pb.doc.root.children[c],
+                                                    same_layout, label);
+                    if (mix) {
+                        check_type_zoo(&pa, label);
+                        check_type_zoo(&pb, label);
+                    }
+                }
+                parsed_free(&pa);
+                parsed_free(&pb);
+                free(data[0]);
+                free(data[1]);
+            }
+    fprintf(stderr, "big-endian twins: %d values compared\n", compared);
+    CHECK(compared > 1000);
+}
+
 /* ---- hostile constructs: clear errors ---- */
 
 typedef struct buf { unsigned char data[4096]; size_t size; } buf;
@@ -1168,6 +1412,21 @@ static int write_seeds(const char *dir)
             if (f) fclose(f);
             free(data);
         }
+    /* Big-endian, every property type, all arrays compressed. */
+    for (size_t v = 0; v < sizeof versions / sizeof versions[0]; v++) {
+        fbxw_scene scene;
+        fixture_cube(&scene, versions[v], 1, 2);
+        scene.big_endian = 1;
+        scene.type_mix = 1;
+        unsigned char *data = NULL;
+        size_t size = 0;
+        char path[1024];
+        snprintf(path, sizeof path, "%s/fixture_%u_big_endian.fbx", dir, versions[v]);
+        FILE *f = fbxw_write(&scene, &data, &size) == 0 ? fopen(path, "wb") : NULL;
+        if (!f || fwrite(data, 1, size, f) != size) failures++;
+        if (f) fclose(f);
+        free(data);
+    }
     char path[1024];
     snprintf(path, sizeof path, "%s/fixture_legacy61.fbx", dir);
     FILE *f = fopen(path, "wb");
@@ -1179,10 +1438,10 @@ static int write_seeds(const char *dir)
 static const check_case cases[] = {
     CASE(test_formats_roundtrip), CASE(test_stacking_option), CASE(test_curves), CASE(test_blender_full_weights),
     CASE(test_duplicate_full_weights), CASE(test_tiny_full_weights), CASE(test_hostile_constructs),
-    CASE(test_allocation_failures),
-    CASE(test_rotation_order), CASE(test_legacy_61_ascii), CASE(test_inherit_type),
+    CASE(test_allocation_failures), CASE(test_rotation_order), CASE(test_legacy_61_ascii), CASE(test_inherit_type),
     CASE(test_empty_mesh_skipped), CASE(test_skipped_mesh_warnings),
     CASE(test_ascii_array_comments), CASE(test_ascii_not_finite), CASE(test_binary_not_finite),
+    CASE(test_big_endian_twins),
 };
 
 int main(int argc, char **argv)
