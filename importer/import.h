@@ -17,7 +17,8 @@ typedef struct mk_import_options {
 mk_result mk_import_fbx(const void *data, size_t size, const mk_import_options *options,
                         mk_raw_asset *out, mk_error *err);
 
-/* .gltf or .glb from a path (external buffers resolve relative to it). */
+/* .gltf or .glb from a path (external buffers resolve against its folder only, see
+ * docs/importing-gltf.md). */
 mk_result mk_import_gltf(const char *path, const mk_import_options *options,
                          mk_raw_asset *out, mk_error *err);
 

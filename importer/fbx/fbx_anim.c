@@ -173,6 +173,12 @@ mk_result fbx_convert_curve(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *cur
         goto done;
     }
     size_t n = n_times;
+    for (size_t i = 0; i < n; i++) {
+        if (!isfinite(values[i])) {
+            r = fbx_error_not_finite(doc, fbx_child(curve, "KeyValueFloat"), i, "key %zu", i);
+            goto done;
+        }
+    }
     k = mk_arena_array(doc->arena, n ? n : 1, sizeof *k);
     if (!k) { r = mk_error_oom(doc->err, "FBX curve"); goto done; }
     size_t attr = 0;
@@ -211,6 +217,14 @@ mk_result fbx_convert_curve(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *cur
             right_slope = next_slope_left = 0.0;
         } else if (f & KEY_CUBIC) {
             key->interp = MK_INTERP_CUBIC;
+            /* Cubic keys read their slopes (TCB: tension, continuity, bias) from the data. */
+            for (int c = 0; c < ((f & KEY_TCB) ? 3 : 2); c++) {
+                if (!isfinite(d[c])) {
+                    r = fbx_error_not_finite(doc, fbx_child(curve, "KeyAttrDataFloat"), 4 * attr + (size_t)c,
+                                             "tangent data of key %zu", i);
+                    goto done;
+                }
+            }
             int has_prev = i > 0 && t > prev_time, after = has_next && next_t > t;
             if (f & KEY_TCB) {
                 /* Kochanek-Bartels on the one-sided secants; factor 1 at an end. */
@@ -301,9 +315,14 @@ mk_result fbx_convert_legacy_curve(fbx_doc *doc, mk_raw_asset *raw, const fbx_no
     const char *problem = NULL;
     double slope_left = 0.0, weight_left = THIRD, prev_time = 0.0;
 #define NEED(count) do { if (size - pos < (size_t)(count)) { problem = "key list ends inside a key"; goto fail; } } while (0)
-    for (size_t i = 0; i < n; i++) {
+    /* Values the key uses (time, value, slopes, weights) must be finite; skipped ones need not. */
+#define USE(at) do { if (!isfinite(data[at])) { bad = (at); goto not_finite; } } while (0)
+    size_t i = 0, bad = 0;
+    for (; i < n; i++) {
         dkey *key = &k[i];
         NEED(3);
+        USE(pos);
+        USE(pos + 1);
         double t = data[pos] / ticks_per_second, v = data[pos + 1];
         char mode = key_char(data[pos + 2]);
         pos += 3;
@@ -316,6 +335,8 @@ mk_result fbx_convert_legacy_curve(fbx_doc *doc, mk_raw_asset *raw, const fbx_no
             int weights = 1;
             if (slope_mode == 's' || slope_mode == 'b') {
                 NEED(2);
+                USE(pos);
+                USE(pos + 1);
                 right_slope = data[pos];
                 next_slope_left = data[pos + 1];
                 pos += 2;
@@ -345,14 +366,18 @@ mk_result fbx_convert_legacy_curve(fbx_doc *doc, mk_raw_asset *raw, const fbx_no
                 char weight_mode = key_char(data[pos++]);
                 if (weight_mode == 'a') {
                     NEED(2);
+                    USE(pos);
+                    USE(pos + 1);
                     right_weight = data[pos];
                     next_weight_left = data[pos + 1];
                     pos += 2;
                 } else if (weight_mode == 'l') {
                     NEED(1);
+                    USE(pos);
                     next_weight_left = data[pos++];
                 } else if (weight_mode == 'r') {
                     NEED(1);
+                    USE(pos);
                     right_weight = data[pos++];
                 } else if (weight_mode != 'n' && weight_mode != 'c') {
                     problem = "unknown tangent weight mode";
@@ -396,6 +421,7 @@ mk_result fbx_convert_legacy_curve(fbx_doc *doc, mk_raw_asset *raw, const fbx_no
         prev_time = t;
     }
 #undef NEED
+#undef USE
     if (pos != size) mk_raw_warn(raw, "FBX %s: %zu trailing key values ignored", path, size - pos);
     r = finish(doc, raw, path, k, n, scale, out_keys, out_count);
     fbx_release(doc->arena, data);
@@ -405,4 +431,8 @@ fail:
     fbx_release(doc->arena, data);
     fbx_release(doc->arena, k);
     return mk_error_set(doc->err, MK_ERROR_PARSE, key_node->offset, "FBX %s: %s (key value %zu)", path, problem, pos);
+not_finite:
+    fbx_release(doc->arena, data);
+    fbx_release(doc->arena, k);
+    return fbx_error_not_finite(doc, key_node, bad, "key %zu", i);
 }

@@ -5,14 +5,18 @@
  * Values are integers, floats, "quoted strings" (entities &quot; &cr; &lf; &amp;), bare words
  * (T, Y, N, W: the first character is the value) and 7.x arrays `*N { a: v,v,v }`. A value list
  * continues on the next line after a trailing comma (6.x arrays span many lines). `;` starts a
- * comment. Node names may be quoted ("Transport Tool Settings":). A leading comma
- * (`Content: , "..."`) is allowed.
+ * comment anywhere a value may end, also inside arrays and on lines between the items of a
+ * list. Node names may be quoted ("Transport Tool Settings":). A leading comma
+ * (`Content: , "..."`) is allowed. NaN and infinity are numbers in every spelling exporters use
+ * (fbx_ascii_not_finite), never characters: the importer then reports them where they are
+ * used, exactly as for a binary file.
  *
  * Arrays keep their text span and are parsed on access (fbx_dom.c). The version comes from
  * the first comment line "; FBX 7.5.0 project file" (else FBXHeaderExtension/FBXVersion, read
  * by the scene step).
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "fbx_internal.h"
@@ -33,6 +37,80 @@ static int is_name_char(char c)
 {
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
            c == '_' || c == '|' || c == '-' || c == '.' || c == '+';
+}
+
+static int is_digit(char c) { return c >= '0' && c <= '9'; }
+
+static char lower(char c) { return c >= 'A' && c <= 'Z' ? (char)(c - 'A' + 'a') : c; }
+
+/* Case-insensitive comparison of [s, s + n) with the lower-case word `w`. */
+static int word_is(const char *s, size_t n, const char *w)
+{
+    size_t l = strlen(w);
+    if (n != l) return 0;
+    for (size_t i = 0; i < n; i++)
+        if (lower(s[i]) != w[i]) return 0;
+    return 1;
+}
+
+int fbx_ascii_not_finite(const char *s, size_t n, double *out)
+{
+    size_t i = 0;
+    int negative = 0;
+    if (n && (s[0] == '-' || s[0] == '+')) negative = s[i++] == '-';
+    const char *w = s + i;
+    size_t m = n - i;
+    if (word_is(w, m, "inf") || word_is(w, m, "infinity")) {
+        *out = negative ? -(double)INFINITY : (double)INFINITY;
+        return 1;
+    }
+    /* C99 allows "nan(n-char-sequence)"; MSVC prints "nan(ind)". */
+    if (m >= 3 && word_is(w, 3, "nan") && (m == 3 || (w[3] == '(' && w[m - 1] == ')'))) {
+        *out = (double)NAN;
+        return 1;
+    }
+    /* Windows CRT: "1.#INF", "-1.#IND", "1.#QNAN", "1.#SNAN"; "%f" appends digits ("1.#INF00"). */
+    size_t j = 0;
+    while (j < m && is_digit(w[j])) j++;
+    if (j == 0 || j + 2 > m || w[j] != '.' || w[j + 1] != '#') return 0;
+    size_t word = j += 2;
+    while (j < m && !is_digit(w[j])) j++;
+    size_t word_length = j - word;
+    while (j < m && is_digit(w[j])) j++;
+    if (j != m) return 0;
+    if (word_is(w + word, word_length, "inf")) {
+        *out = negative ? -(double)INFINITY : (double)INFINITY;
+        return 1;
+    }
+    if (word_is(w + word, word_length, "ind") || word_is(w + word, word_length, "qnan") ||
+        word_is(w + word, word_length, "snan")) {
+        *out = (double)NAN;
+        return 1;
+    }
+    return 0;
+}
+
+int fbx_ascii_array_token(const char *s, size_t size, size_t *pos, size_t *start)
+{
+    size_t i = *pos;
+    for (;;) {
+        while (i < size && (s[i] == ' ' || s[i] == '\t' || s[i] == '\n' || s[i] == '\r' || s[i] == ','))
+            i++;
+        if (i < size && s[i] == ';') {  /* a comment runs to the end of its line */
+            while (i < size && s[i] != '\n') i++;
+            continue;
+        }
+        break;
+    }
+    if (i >= size) {
+        *pos = i;
+        return 0;
+    }
+    *start = i;
+    while (i < size && s[i] != ',' && s[i] != ' ' && s[i] != '\t' && s[i] != '\n' && s[i] != '\r' && s[i] != ';')
+        i++;
+    *pos = i;
+    return 1;
 }
 
 static mk_result perr(ascii_parser *p, size_t at, const char *what)
@@ -155,17 +233,23 @@ static mk_result parse_number(ascii_parser *p, size_t start, size_t end, fbx_val
             return MK_OK;
         }
     }
-    /* strtod needs a terminated copy: the input buffer is not NUL-terminated. */
-    char buffer[96];
-    if (length >= sizeof buffer) return perr(p, start, "number token too long");
-    memcpy(buffer, s, length);
-    buffer[length] = 0;
-    char *stop;
-    double d = strtod(buffer, &stop);
-    if (stop == buffer) return perr(p, start, "malformed number");
-    /* Windows-style "1.#INF", "-1.#IND" spellings: not representable here, read as NaN so
-     * validation reports the element that holds it. */
-    if (*stop) d = (double)NAN;
+    double d;
+    if (!fbx_ascii_not_finite(s, length, &d)) {
+        /* strtod needs a terminated copy: the input buffer is not NUL-terminated. */
+        char buffer[96];
+        if (length >= sizeof buffer) return perr(p, start, "number token too long");
+        memcpy(buffer, s, length);
+        buffer[length] = 0;
+        char *stop;
+        d = strtod(buffer, &stop);
+        if (stop == buffer || *stop) {
+            char what[80];
+            snprintf(what, sizeof what, "malformed number '%.40s'", buffer);
+            return perr(p, start, what);
+        }
+    }
+    /* NaN and infinity stay what they are: the importer reports them where the value is used
+     * (the element and its byte offset), as it does for binary files. */
     v->kind = FBX_FLOAT;
     v->type = 'D';
     v->u.f = d;
@@ -184,7 +268,7 @@ static mk_result parse_array(ascii_parser *p, fbx_value *v)
         digits++;
     }
     if (!digits) return perr(p, at, "'*' without an array count");
-    while (p->pos < p->size && (is_space(p->text[p->pos]) || is_newline(p->text[p->pos]))) p->pos++;
+    skip_blank(p);
     if (p->pos >= p->size || p->text[p->pos] != '{') return perr(p, p->pos, "expected '{' after array count");
     p->pos++;
     skip_blank(p);
@@ -195,9 +279,17 @@ static mk_result parse_array(ascii_parser *p, fbx_value *v)
         if (p->pos >= p->size || p->text[p->pos] != ':') return perr(p, p->pos, "expected 'a:' in array");
         p->pos++;
         data_start = p->pos;
-        const char *close = memchr(p->text + p->pos, '}', p->size - p->pos);
-        if (!close) return perr(p, at, "unterminated array");
-        data_end = (size_t)(close - p->text);
+        /* The closing brace, skipping comments (one may contain '}'). */
+        size_t close = p->pos;
+        while (close < p->size && p->text[close] != '}') {
+            if (p->text[close] == ';') {
+                while (close < p->size && p->text[close] != '\n') close++;
+            } else {
+                close++;
+            }
+        }
+        if (close >= p->size) return perr(p, at, "unterminated array");
+        data_end = close;
         p->pos = data_end;
     }
     if (p->pos >= p->size || p->text[p->pos] != '}') return perr(p, at, "unterminated array");
@@ -281,7 +373,11 @@ static mk_result parse_node(ascii_parser *p, uint32_t depth)
              * continuation lines with the comma; Blender 2.79 writes "Key:" alone on its
              * line with the numbers below. A node name never starts with these. */
             size_t look = p->pos;
-            while (look < p->size && (is_space(p->text[look]) || is_newline(p->text[look]))) look++;
+            for (;;) {  /* blank and comment lines may separate the items */
+                while (look < p->size && (is_space(p->text[look]) || is_newline(p->text[look]))) look++;
+                if (look >= p->size || p->text[look] != ';') break;
+                while (look < p->size && p->text[look] != '\n') look++;
+            }
             if (look < p->size) {
                 char d = p->text[look];
                 int number = (d >= '0' && d <= '9') || d == '-' || d == '+' || d == '.';
@@ -311,10 +407,16 @@ static mk_result parse_node(ascii_parser *p, uint32_t depth)
         } else if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_') {
             size_t start = p->pos;
             while (p->pos < p->size && is_name_char(p->text[p->pos])) p->pos++;
-            size_t length = p->pos - start;
-            /* nan/inf spelled as words are numbers; other bare words are characters. */
-            if ((length == 3 && (memcmp(p->text + start, "nan", 3) == 0 || memcmp(p->text + start, "inf", 3) == 0)) ||
-                (length == 3 && (memcmp(p->text + start, "NaN", 3) == 0 || memcmp(p->text + start, "Inf", 3) == 0))) {
+            /* "nan(ind)": the parenthesized part belongs to the number. */
+            if (p->pos - start == 3 && word_is(p->text + start, 3, "nan") && p->pos < p->size && p->text[p->pos] == '(') {
+                size_t close = p->pos;
+                while (close < p->size && close - start < 64 && p->text[close] != ')' && !is_newline(p->text[close])) close++;
+                if (close < p->size && p->text[close] == ')') p->pos = close + 1;
+            }
+            /* NaN and infinity spelled as words ("nan", "INF", "Infinity") are numbers, never
+             * the character 'N' or 'I'; other bare words are characters. */
+            double not_finite;
+            if (fbx_ascii_not_finite(p->text + start, p->pos - start, &not_finite)) {
                 r = parse_number(p, start, p->pos, &v);
             } else {
                 v.kind = FBX_CHAR;

@@ -8,6 +8,11 @@
  * (the null record is 13 or 25 zero bytes). The header version decides, never FBXVersion:
  * 3ds Max 7 writes header 3000 with FBXVersion 5000.
  *
+ * A non-zero endianness byte means big-endian (as ufbx decides; Maya can write such files):
+ * the version, every record counter, scalar, string/array length and array header is then
+ * stored most significant byte first, and so are array elements, also inside zlib streams
+ * (fbx_dom.c swaps those on decode).
+ *
  * Every offset and length is checked against the enclosing record and the file size; arrays
  * are not decoded here (fbx_dom.c does it on access), only their bounds are checked.
  */
@@ -21,20 +26,11 @@ int fbx_is_binary(const void *data, size_t size)
     return size >= 23 && memcmp(data, fbx_magic, 21) == 0;
 }
 
-static uint32_t rd_u32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-static uint64_t rd_u64(const uint8_t *p)
-{
-    return (uint64_t)rd_u32(p) | (uint64_t)rd_u32(p + 4) << 32;
-}
-
 typedef struct bin_parser {
     fbx_doc *doc;
     const uint8_t *data;
     uint64_t size;
+    int big;                /* big-endian file */
     int wide;               /* 25-byte record headers */
     uint32_t header_size;
     /* Sibling stack: children of every open node are collected here and copied into the
@@ -42,6 +38,18 @@ typedef struct bin_parser {
     fbx_node *stack;
     size_t top, cap;
 } bin_parser;
+
+/* Unsigned integer of `bytes` bytes at b in the file's byte order. */
+static uint64_t rd_uint(int big, const uint8_t *b, int bytes)
+{
+    uint64_t v = 0;
+    for (int i = 0; i < bytes; i++) v |= (uint64_t)b[big ? bytes - 1 - i : i] << (8 * i);
+    return v;
+}
+
+static uint16_t rd_u16(const bin_parser *p, const uint8_t *b) { return (uint16_t)rd_uint(p->big, b, 2); }
+static uint32_t rd_u32(const bin_parser *p, const uint8_t *b) { return (uint32_t)rd_uint(p->big, b, 4); }
+static uint64_t rd_u64(const bin_parser *p, const uint8_t *b) { return rd_uint(p->big, b, 8); }
 
 static mk_result push_node(bin_parser *p, const fbx_node *node)
 {
@@ -85,7 +93,7 @@ static mk_result parse_values(bin_parser *p, fbx_node *node, uint64_t pos, uint6
         case 'Y':
             if (left < 2) goto truncated;
             v->kind = FBX_INT;
-            v->u.i = (int16_t)(uint16_t)(p->data[pos] | p->data[pos + 1] << 8);
+            v->u.i = (int16_t)rd_u16(p, p->data + pos);
             pos += 2;
             break;
         case 'C':
@@ -103,18 +111,18 @@ static mk_result parse_values(bin_parser *p, fbx_node *node, uint64_t pos, uint6
         case 'I':
             if (left < 4) goto truncated;
             v->kind = FBX_INT;
-            v->u.i = (int32_t)rd_u32(p->data + pos);
+            v->u.i = (int32_t)rd_u32(p, p->data + pos);
             pos += 4;
             break;
         case 'L':
             if (left < 8) goto truncated;
             v->kind = FBX_INT;
-            v->u.i = (int64_t)rd_u64(p->data + pos);
+            v->u.i = (int64_t)rd_u64(p, p->data + pos);
             pos += 8;
             break;
         case 'F': {
             if (left < 4) goto truncated;
-            uint32_t bits = rd_u32(p->data + pos);
+            uint32_t bits = rd_u32(p, p->data + pos);
             float f;
             memcpy(&f, &bits, 4);
             v->kind = FBX_FLOAT;
@@ -124,7 +132,7 @@ static mk_result parse_values(bin_parser *p, fbx_node *node, uint64_t pos, uint6
         }
         case 'D': {
             if (left < 8) goto truncated;
-            uint64_t bits = rd_u64(p->data + pos);
+            uint64_t bits = rd_u64(p, p->data + pos);
             double d;
             memcpy(&d, &bits, 8);
             v->kind = FBX_FLOAT;
@@ -134,7 +142,7 @@ static mk_result parse_values(bin_parser *p, fbx_node *node, uint64_t pos, uint6
         }
         case 'S': case 'R': {
             if (left < 4) goto truncated;
-            uint32_t length = rd_u32(p->data + pos);
+            uint32_t length = rd_u32(p, p->data + pos);
             pos += 4;
             if (length > end - pos) goto truncated;
             v->kind = FBX_STRING;
@@ -145,9 +153,9 @@ static mk_result parse_values(bin_parser *p, fbx_node *node, uint64_t pos, uint6
         }
         case 'f': case 'd': case 'l': case 'i': case 'b': case 'c': {
             if (left < 12) goto truncated;
-            uint32_t count32 = rd_u32(p->data + pos);
-            uint32_t encoding = rd_u32(p->data + pos + 4);
-            uint32_t stored = rd_u32(p->data + pos + 8);
+            uint32_t count32 = rd_u32(p, p->data + pos);
+            uint32_t encoding = rd_u32(p, p->data + pos + 4);
+            uint32_t stored = rd_u32(p, p->data + pos + 8);
             pos += 12;
             if (stored > end - pos) goto truncated;
             uint64_t elem = (type == 'd' || type == 'l') ? 8 : (type == 'f' || type == 'i') ? 4 : 1;
@@ -206,9 +214,9 @@ static mk_result parse_node(bin_parser *p, uint64_t *pos, uint64_t limit, uint32
     const uint8_t *h = p->data + at;
     uint64_t end, count, list_length;
     if (p->wide) {
-        end = rd_u64(h); count = rd_u64(h + 8); list_length = rd_u64(h + 16);
+        end = rd_u64(p, h); count = rd_u64(p, h + 8); list_length = rd_u64(p, h + 16);
     } else {
-        end = rd_u32(h); count = rd_u32(h + 4); list_length = rd_u32(h + 8);
+        end = rd_u32(p, h); count = rd_u32(p, h + 4); list_length = rd_u32(p, h + 8);
     }
     uint8_t name_length = h[p->header_size - 1];
     if (end == 0 && name_length == 0 && count == 0 && list_length == 0) {
@@ -264,9 +272,10 @@ mk_result fbx_parse_binary(fbx_doc *doc)
     p.size = doc->size;
     if (doc->size < 27 || !fbx_is_binary(doc->data, doc->size))
         return mk_error_set(doc->err, MK_ERROR_PARSE, 0, "not a binary FBX file (bad magic)");
-    if (p.data[22] != 0)
-        return mk_error_set(doc->err, MK_ERROR_UNSUPPORTED, 22, "big-endian binary FBX is not supported");
-    doc->header_version = rd_u32(p.data + 23);
+    /* Byte 22: 0 little-endian, anything else big-endian (as ufbx decides). */
+    p.big = p.data[22] != 0;
+    doc->big_endian = p.big;
+    doc->header_version = rd_u32(&p, p.data + 23);
     doc->version = doc->header_version;
     p.wide = doc->header_version >= 7500;
     p.header_size = p.wide ? 25 : 13;

@@ -3,6 +3,7 @@
  * FBX 5.x/6.x binary).
  */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,7 +11,7 @@
 #include "fbx_internal.h"
 
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
-#error "the FBX array decoder copies little-endian payloads directly; add byte swapping for this host"
+#error "the FBX array decoder assumes a little-endian host (it copies little-endian payloads and swaps big-endian files); adapt it for this host"
 #endif
 
 void *fbx_grow(mk_arena *arena, void *ptr, size_t old_size, size_t new_size)
@@ -170,11 +171,31 @@ static int store_i64(void *out, size_t i, fbx_elem elem, int64_t x)
     return 0;
 }
 
+/* Reverses the bytes of each of `count` elements of `size` bytes in place (big-endian files). */
+static void swap_elements(void *data, size_t count, size_t size)
+{
+    uint8_t *p = data;
+    for (size_t i = 0; i < count; i++, p += size)
+        for (size_t a = 0, b = size - 1; a < b; a++, b--) {
+            uint8_t t = p[a];
+            p[a] = p[b];
+            p[b] = t;
+        }
+}
+
+/* One element of `size` bytes from p into dst, in host order. */
+static void load_element(void *dst, const uint8_t *p, size_t size, int swap)
+{
+    memcpy(dst, p, size);
+    if (swap) swap_elements(dst, 1, size);
+}
+
 static mk_result decode_binary(fbx_doc *doc, const fbx_node *node, const fbx_value *v, fbx_elem elem,
                                void *out)
 {
     size_t src_size = (v->type == 'd' || v->type == 'l') ? 8 : (v->type == 'f' || v->type == 'i') ? 4 : 1;
     size_t bytes = (size_t)v->count * src_size;
+    int swap = doc->big_endian && src_size > 1;  /* the payload (also inflated) is in the file's order */
     const uint8_t *src = v->u.a.data;
     void *inflated = NULL;
     int same = (v->type == 'd' && elem == FBX_ELEM_F64) || (v->type == 'l' && elem == FBX_ELEM_I64) ||
@@ -198,20 +219,24 @@ static mk_result decode_binary(fbx_doc *doc, const fbx_node *node, const fbx_val
                                    ? "compressed array inflates to fewer bytes than declared"
                                    : "corrupt zlib stream in array");
         }
-        if (same) return MK_OK;
+        if (same) {
+            if (swap) swap_elements(out, v->count, src_size);
+            return MK_OK;
+        }
         src = inflated;
     } else if (same) {
         if (bytes) memcpy(out, src, bytes);
+        if (swap) swap_elements(out, v->count, src_size);
         return MK_OK;
     }
     int ok = 1;
     for (size_t i = 0; i < v->count && ok; i++) {
         const uint8_t *p = src + i * src_size;
         switch (v->type) {
-        case 'd': { double x; memcpy(&x, p, 8); ok = store_f64(out, i, elem, x); break; }
-        case 'f': { float x; memcpy(&x, p, 4); ok = store_f64(out, i, elem, x); break; }
-        case 'l': { int64_t x; memcpy(&x, p, 8); ok = store_i64(out, i, elem, x); break; }
-        case 'i': { int32_t x; memcpy(&x, p, 4); ok = store_i64(out, i, elem, x); break; }
+        case 'd': { double x; load_element(&x, p, 8, swap); ok = store_f64(out, i, elem, x); break; }
+        case 'f': { float x; load_element(&x, p, 4, swap); ok = store_f64(out, i, elem, x); break; }
+        case 'l': { int64_t x; load_element(&x, p, 8, swap); ok = store_i64(out, i, elem, x); break; }
+        case 'i': { int32_t x; load_element(&x, p, 4, swap); ok = store_i64(out, i, elem, x); break; }
         default: ok = store_i64(out, i, elem, p[0]); break;
         }
     }
@@ -222,19 +247,20 @@ static mk_result decode_binary(fbx_doc *doc, const fbx_node *node, const fbx_val
 
 static int is_digit(char c) { return c >= '0' && c <= '9'; }
 
+/* File offset of an ASCII array's text (the values after "a:"). */
+static uint64_t ascii_data_offset(const fbx_doc *doc, const fbx_value *v)
+{
+    return (uint64_t)(v->u.a.data - doc->data);
+}
+
 static mk_result decode_ascii(fbx_doc *doc, const fbx_node *node, const fbx_value *v, fbx_elem elem, void *out)
 {
     const char *s = (const char *)v->u.a.data;
-    size_t size = (size_t)v->u.a.size, pos = 0, n = 0;
-    for (;;) {
-        while (pos < size && (s[pos] == ' ' || s[pos] == '\t' || s[pos] == '\n' || s[pos] == '\r' || s[pos] == ','))
-            pos++;
-        if (pos >= size) break;
-        size_t start = pos;
-        while (pos < size && s[pos] != ',' && s[pos] != ' ' && s[pos] != '\t' && s[pos] != '\n' && s[pos] != '\r')
-            pos++;
+    size_t size = (size_t)v->u.a.size, pos = 0, n = 0, start;
+    uint64_t base = ascii_data_offset(doc, v);
+    while (fbx_ascii_array_token(s, size, &pos, &start)) {
         if (n >= v->count)
-            return array_error(doc, node, v->offset + start, MK_ERROR_PARSE, "array has more values than its *N count");
+            return array_error(doc, node, base + start, MK_ERROR_PARSE, "array has more values than its *N count");
         size_t length = pos - start;
         /* Integer fast path (indices, KTime, bit patterns). */
         size_t k = (s[start] == '-' || s[start] == '+') ? 1 : 0;
@@ -246,18 +272,26 @@ static mk_result decode_ascii(fbx_doc *doc, const fbx_node *node, const fbx_valu
             for (size_t j = k; j < length; j++) x = x * 10 + (s[start + j] - '0');
             ok = store_i64(out, n, elem, s[start] == '-' ? -x : x);
         } else {
-            char buffer[96];
-            if (length >= sizeof buffer)
-                return array_error(doc, node, v->offset + start, MK_ERROR_PARSE, "number token too long");
-            memcpy(buffer, s + start, length);
-            buffer[length] = 0;
-            char *stop;
-            double x = strtod(buffer, &stop);
-            if (stop == buffer || *stop)
-                return array_error(doc, node, v->offset + start, MK_ERROR_PARSE, "malformed number in array");
+            double x;
+            /* NaN and infinity (any spelling) are values like in a binary array; where the
+             * importer uses them it reports the element (fbx_error_not_finite). */
+            if (!fbx_ascii_not_finite(s + start, length, &x)) {
+                char buffer[96];
+                if (length >= sizeof buffer)
+                    return array_error(doc, node, base + start, MK_ERROR_PARSE, "number token too long");
+                memcpy(buffer, s + start, length);
+                buffer[length] = 0;
+                char *stop;
+                x = strtod(buffer, &stop);
+                if (stop == buffer || *stop) {
+                    char what[160];
+                    snprintf(what, sizeof what, "malformed number '%.40s' (value %zu) in array", buffer, n);
+                    return array_error(doc, node, base + start, MK_ERROR_PARSE, what);
+                }
+            }
             ok = store_f64(out, n, elem, x);
         }
-        if (!ok) return array_error(doc, node, v->offset + start, MK_ERROR_PARSE, "array value out of range for its use");
+        if (!ok) return array_error(doc, node, base + start, MK_ERROR_PARSE, "array value out of range for its use");
         n++;
     }
     if (n != v->count)
@@ -309,6 +343,44 @@ mk_result fbx_child_array(fbx_doc *doc, const fbx_node *node, const char *name, 
     const fbx_node *c = fbx_child(node, name);
     if (!c) return MK_OK;
     return fbx_node_array(doc, c, elem, out, count);
+}
+
+uint64_t fbx_value_offset(const fbx_doc *doc, const fbx_node *node, size_t index, int *zlib)
+{
+    *zlib = 0;
+    if (node->value_count == 1 && node->values[0].kind == FBX_ARRAY) {
+        const fbx_value *v = &node->values[0];
+        if (v->type == 'a') {
+            const char *s = (const char *)v->u.a.data;
+            size_t pos = 0, start = 0, n = 0;
+            while (fbx_ascii_array_token(s, (size_t)v->u.a.size, &pos, &start))
+                if (n++ == index) return ascii_data_offset(doc, v) + start;
+            return v->offset;
+        }
+        if (v->encoding != 0 || index >= v->count) {
+            *zlib = v->encoding != 0;
+            return v->offset;
+        }
+        size_t size = (v->type == 'd' || v->type == 'l') ? 8 : (v->type == 'f' || v->type == 'i') ? 4 : 1;
+        return (uint64_t)(v->u.a.data - doc->data) + (uint64_t)index * size;
+    }
+    return index < node->value_count ? node->values[index].offset : node->offset;
+}
+
+mk_result fbx_error_not_finite(fbx_doc *doc, const fbx_node *node, size_t index, const char *what_fmt, ...)
+{
+    char what[160], path[160];
+    va_list ap;
+    va_start(ap, what_fmt);
+    vsnprintf(what, sizeof what, what_fmt, ap);
+    va_end(ap);
+    if (!node) return mk_error_set(doc->err, MK_ERROR_NOT_FINITE, UINT64_MAX, "FBX: %s is not finite", what);
+    fbx_node_path(node, path, sizeof path);
+    int zlib;
+    uint64_t at = fbx_value_offset(doc, node, index, &zlib);
+    return mk_error_set(doc->err, MK_ERROR_NOT_FINITE, at,
+                        "FBX %s: %s is not finite (NaN, infinite or beyond float range; value %zu %sat byte %llu)", path,
+                        what, index, zlib ? "of the zlib array " : "", (unsigned long long)at);
 }
 
 /* ---- Properties ---- */

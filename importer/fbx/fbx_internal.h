@@ -61,6 +61,7 @@ typedef struct fbx_doc {
     const uint8_t *data;
     size_t size;
     int binary;
+    int big_endian;         /* binary file with the big-endian header flag: array elements are swapped on decode */
     uint32_t version;       /* header version (binary) or "; FBX x.y.z" (ASCII); may be raised from FBXVersion */
     uint32_t header_version;/* as found in the header (binary) */
     fbx_node root;          /* children = top-level nodes */
@@ -74,6 +75,16 @@ void fbx_doc_free(fbx_doc *doc);
 mk_result fbx_parse_binary(fbx_doc *doc);
 mk_result fbx_parse_ascii(fbx_doc *doc);
 int fbx_is_binary(const void *data, size_t size);
+
+/* ASCII number helpers (fbx_ascii.c), shared by the parser and the lazy array decoder. */
+/* 1 and the value when [s, s + n) spells NaN or infinity as some exporter writes it (C99 and
+ * glibc "nan", "nan(...)", "inf", "infinity" in any case with an optional sign; the Windows
+ * CRT's "1.#INF", "-1.#IND", "1.#QNAN", "1.#SNAN", optionally followed by digits). */
+int fbx_ascii_not_finite(const char *s, size_t n, double *out);
+/* Next value of an ASCII array body [s, s + size) from *pos: skips spaces, newlines, commas
+ * and `;` comments (to the end of their line). Returns 0 at the end, else 1 with the token
+ * in [*start, *pos). */
+int fbx_ascii_array_token(const char *s, size_t size, size_t *pos, size_t *start);
 
 /* Arena helpers that accept NULL (grow from nothing, release nothing). */
 void *fbx_grow(mk_arena *arena, void *ptr, size_t old_size, size_t new_size);
@@ -107,6 +118,20 @@ mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void
 /* Same for the child named `name`; *out NULL and count 0 when the child is absent (MK_OK). */
 mk_result fbx_child_array(fbx_doc *doc, const fbx_node *node, const char *name, fbx_elem elem,
                           void **out, size_t *count);
+/* Byte offset in the file of value `index` of a node's data: the element of a raw binary
+ * array, the token of an ASCII array, the scalar of a value run (FBX 5.x/6.x, and any node's
+ * plain values). Elements of a zlib array have no offset of their own: the array's is given
+ * and *zlib set. Used on error paths only (ASCII arrays are re-scanned). */
+uint64_t fbx_value_offset(const fbx_doc *doc, const fbx_node *node, size_t index, int *zlib);
+/* MK_ERROR_NOT_FINITE for value `index` of `node` (an array or a node's plain values, e.g. a
+ * P property): "FBX <path>: <what> is not finite (NaN, infinite or beyond float range; value
+ * <index> at byte <offset>)", with err->offset set to that byte. The binary and ASCII paths
+ * report the same way: the value is checked where it is used, after decoding. */
+mk_result fbx_error_not_finite(fbx_doc *doc, const fbx_node *node, size_t index, const char *what_fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
 
 /* ---- Properties (fbx_dom.c): Properties70 "P" and Properties60 "Property" ---- */
 typedef struct fbx_props {

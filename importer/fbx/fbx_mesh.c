@@ -23,6 +23,7 @@
 enum { MAP_NONE, MAP_PV, MAP_CP, MAP_POLY, MAP_ALL };
 
 typedef struct layer {
+    const fbx_node *node;   /* the data array's node (for error messages) */
     int mapping;
     int stride;
     float *data;            /* decoded as float: what the raw model keeps, half the scratch */
@@ -65,6 +66,7 @@ static mk_result read_layer(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *ele
     mk_result r = fbx_child_array(doc, element, data_name, FBX_ELEM_F32, (void **)&out->data, &count);
     if (r != MK_OK) return r;
     if (!out->data) { out->mapping = MAP_NONE; return MK_OK; }
+    out->node = fbx_child(element, data_name);
     out->data_count = count / (size_t)stride;
     if (index_name) {
         r = fbx_child_array(doc, element, index_name, FBX_ELEM_I32, (void **)&out->index, &out->index_count);
@@ -83,8 +85,9 @@ static void free_layer(fbx_doc *doc, layer *l)
     l->index = NULL;
 }
 
-/* Element of a layer for one polygon vertex; NULL when missing or out of range. */
-static const float *layer_value(const layer *l, size_t pv, uint32_t cp, size_t poly, size_t *bad)
+/* Element of a layer for one polygon vertex; NULL when missing or out of range. *element is
+ * its index in the data array. */
+static const float *layer_value(const layer *l, size_t pv, uint32_t cp, size_t poly, size_t *bad, size_t *element)
 {
     if (l->mapping == MAP_NONE || !l->data) return NULL;
     size_t i;
@@ -101,6 +104,7 @@ static const float *layer_value(const layer *l, size_t pv, uint32_t cp, size_t p
         i = (size_t)k;
     }
     if (i >= l->data_count) { (*bad)++; return NULL; }
+    *element = i;
     return l->data + i * (size_t)l->stride;
 }
 
@@ -155,6 +159,13 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
         goto done;
     }
     size_t cp_count = vertex_doubles / 3;
+    if (cp_count == 0) {
+        /* Nothing to draw or morph: the caller skips the mesh with a warning rather than
+         * refusing a file whose other meshes are fine (polygons are not even read). */
+        mesh->vertex_count = 0;
+        r = MK_OK;
+        goto done;
+    }
     if (cp_count >= UINT32_MAX / 2) {
         r = mk_error_set(doc->err, MK_ERROR_LIMIT, geometry->offset, "FBX %s: too many control points", path);
         goto done;
@@ -173,6 +184,7 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
     } else if (fbx_child(geometry, "Normals") && !fbx_child(geometry, "Indexes")) {
         size_t count;
         r = fbx_child_array(doc, geometry, "Normals", FBX_ELEM_F32, (void **)&normals.data, &count);
+        normals.node = fbx_child(geometry, "Normals");
         normals.stride = 3;
         normals.data_count = count / 3;
         normals.mapping = normals.data_count == cp_count ? MAP_CP : normals.data_count == pv_count ? MAP_PV : MAP_NONE;
@@ -211,9 +223,20 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
         }
         rv_key key;
         memset(&key, 0, sizeof key);
-        const float *n = normals_present ? layer_value(&normals, i, cp, poly, &bad_layer) : NULL;
-        if (n) for (int k = 0; k < 3; k++) key.normal[k] = n[k];
-        const float *t = uvs.data ? layer_value(&uvs, i, cp, poly, &bad_layer) : NULL;
+        size_t element = 0;
+        const float *n = normals_present ? layer_value(&normals, i, cp, poly, &bad_layer, &element) : NULL;
+        if (n) {
+            for (int k = 0; k < 3; k++) {
+                /* Checked where a polygon vertex uses it: an unused bad normal is harmless. */
+                if (!isfinite(n[k])) {
+                    r = fbx_error_not_finite(doc, normals.node, 3 * element + (size_t)k, "normal %zu (of control point %u)",
+                                             element, cp);
+                    goto done;
+                }
+                key.normal[k] = n[k];
+            }
+        }
+        const float *t = uvs.data ? layer_value(&uvs, i, cp, poly, &bad_layer, &element) : NULL;
         if (t) for (int k = 0; k < 2; k++) key.uv[k] = t[k];
         /* Walk the control point's vertices; the walk is capped so a hostile file with
          * thousands of distinct normals on one point stays linear (it just welds less). */
@@ -261,10 +284,6 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
         isolated++;
     }
     (void)isolated;
-    if (rv_count == 0) {
-        r = mk_error_set(doc->err, MK_ERROR_PARSE, geometry->offset, "FBX %s: mesh has no vertices", path);
-        goto done;
-    }
     if (triangle_count > UINT32_MAX / 3) {
         r = mk_error_set(doc->err, MK_ERROR_LIMIT, geometry->offset, "FBX %s: too many triangles", path);
         goto done;
@@ -289,8 +308,7 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
         for (int k = 0; k < 3; k++) {
             float x = (float)vertices[3 * (size_t)cp + (size_t)k];
             if (!isfinite(x)) {
-                r = mk_error_set(doc->err, MK_ERROR_NOT_FINITE, geometry->offset,
-                                 "FBX %s: control point %u is NaN, infinite or beyond float range", path, cp);
+                r = fbx_error_not_finite(doc, fbx_child(geometry, "Vertices"), 3 * (size_t)cp + (size_t)k, "control point %u", cp);
                 goto done;
             }
             mesh->positions[3 * v + (size_t)k] = x;
@@ -311,15 +329,7 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
         }
     }
     if (normals_present) {
-        for (size_t v = 0; v < rv_count; v++) {
-            const float *n = rv_keys[v].normal;
-            if (!isfinite(n[0]) || !isfinite(n[1]) || !isfinite(n[2])) {
-                r = mk_error_set(doc->err, MK_ERROR_NOT_FINITE, geometry->offset,
-                                 "FBX %s: a normal of control point %u is NaN or infinite", path, rv_cp[v]);
-                goto done;
-            }
-            memcpy(mesh->normals + 3 * v, n, 3 * sizeof(float));
-        }
+        for (size_t v = 0; v < rv_count; v++) memcpy(mesh->normals + 3 * v, rv_keys[v].normal, 3 * sizeof(float));
     } else {
         /* No normals in the file: area-weighted smooth normals per control point, so targets
          * can still get normal deltas computed the same way. */
@@ -415,6 +425,16 @@ mk_result fbx_expand_shape(fbx_doc *doc, mk_raw_asset *raw, fbx_mesh_map *map, c
     for (size_t i = 0; i < n; i++) {
         int32_t cp = shape->indexes[i];
         if (cp < 0 || (uint32_t)cp >= map->control_point_count) { (*skipped)++; continue; }
+        for (int k = 0; k < 6; k++) {
+            /* Name the file's value; sums that only overflow float are caught below. */
+            const double *values = k < 3 ? shape->positions : shape->normals;
+            if (values && !isfinite(values[3 * i + (size_t)(k % 3)])) {
+                r = fbx_error_not_finite(doc, fbx_child(shape->node, k < 3 ? "Vertices" : "Normals"), 3 * i + (size_t)(k % 3),
+                                         "shape '%.*s' entry %zu (control point %d)", (int)shape->name_length, shape->name,
+                                         i, (int)cp);
+                goto done;
+            }
+        }
         double scale = shape->vertex_weights ? shape->vertex_weights[i] : 1.0;
         uint32_t e = map->cp_entry[cp];
         if (e == UINT32_MAX) {

@@ -14,7 +14,9 @@ typedef struct fbx_mesh_map {
 } fbx_mesh_map;
 
 /* Reads Vertices, PolygonVertexIndex and the normal/UV layers of `geometry` into `mesh`
- * (positions, normals, triangles, control_points; world and name are the caller's). */
+ * (positions, normals, triangles, control_points; world and name are the caller's). A geometry
+ * without control points is not an error: it returns MK_OK with mesh->vertex_count 0 and an
+ * empty map, and the caller skips the mesh. */
 mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geometry, mk_raw_mesh *mesh,
                          fbx_mesh_map *map);
 void fbx_mesh_map_free(fbx_doc *doc, fbx_mesh_map *map);
@@ -27,6 +29,9 @@ typedef struct fbx_shape_data {
     const double *normals;         /* 3 per entry, or NULL (not used) */
     const double *vertex_weights;  /* Blender per-entry weights (0..1), or NULL */
     const char *path;              /* node path for messages */
+    const fbx_node *node;          /* the Shape node (its Vertices/Normals name bad values) */
+    const char *name;              /* shape name for messages */
+    uint32_t name_length;
 } fbx_shape_data;
 
 /* Fills target->count/indices/positions/normals with the deltas on render vertices (strictly

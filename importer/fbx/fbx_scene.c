@@ -29,6 +29,7 @@
 #include "fbx_anim.h"
 #include "fbx_mesh.h"
 #include "fbx_transform.h"
+#include "format.h"
 
 enum {
     OBJ_OTHER, OBJ_MODEL, OBJ_MESH, OBJ_SHAPE, OBJ_BLEND, OBJ_CHANNEL, OBJ_STACK, OBJ_LAYER, OBJ_CURVE_NODE, OBJ_CURVE
@@ -509,6 +510,37 @@ static int finite16(const float m[16])
     return 1;
 }
 
+/* A mesh's world transform is not finite: name the property that made it so, on the model or
+ * on an ancestor (the transform stack reads these; fbx_transform.c). Falls back to naming the
+ * model when every value is finite and only the product overflowed. */
+static mk_result transform_not_finite(scene *s, uint32_t o, const char *mesh_name)
+{
+    static const char *const names[] = { "Lcl Translation", "Lcl Rotation", "Lcl Scaling", "RotationOffset",
+                                         "RotationPivot", "ScalingOffset", "ScalingPivot", "PreRotation",
+                                         "PostRotation", "GeometricTranslation", "GeometricRotation", "GeometricScaling" };
+    int32_t cur = (int32_t)o;
+    for (int depth = 0; cur >= 0 && depth < 256; depth++, cur = s->parent[cur]) {
+        fbx_props props = fbx_props_of(s->objects[cur].node);
+        uint32_t at = fbx_prop_payload(props);
+        for (size_t n = 0; n < sizeof names / sizeof names[0]; n++) {
+            if (depth > 0 && n >= 9) break;  /* an ancestor's geometric transform is not inherited */
+            const fbx_node *p = fbx_prop_find(props, names[n]);
+            for (uint32_t k = at; p && k < p->value_count && k < at + 3; k++) {
+                double x;
+                if (fbx_value_float(&p->values[k], &x) && !isfinite(x))
+                    return fbx_error_not_finite(s->doc, p, k, "'%s' %c of model '%.*s' (transform of mesh '%s')", names[n],
+                                                "xyz"[k - at], (int)s->objects[cur].name_length, s->objects[cur].name,
+                                                mesh_name);
+            }
+        }
+    }
+    char path[160];
+    fbx_node_path(s->objects[o].node, path, sizeof path);
+    return mk_error_set(s->doc->err, MK_ERROR_NOT_FINITE, s->objects[o].node->offset,
+                        "FBX %s '%s' (byte %llu): transform is not finite (NaN, infinite or beyond float range)", path,
+                        mesh_name, (unsigned long long)s->objects[o].node->offset);
+}
+
 /* ---- blend shapes ---- */
 
 typedef struct shape_ref {
@@ -559,14 +591,16 @@ static mk_result add_channel(scene *s, uint32_t mesh, fbx_mesh_map *map, const c
         const fbx_node *node = shapes[i].node;
         fbx_node_path(node, path, sizeof path);
         float fw = (float)(shapes[i].full_weight / 100.0);
-        if (!isfinite(fw) || fw == 0.0f) {
-            mk_raw_warn(raw, "FBX %s '%.*s': full weight %g is zero or not finite; shape skipped", path,
+        /* The same gaps mk_raw_validate and the runtime require (format.h): a full weight the
+         * runtime cannot place is skipped here with a warning, never passed on to fail later. */
+        if (!isfinite(fw) || fabsf(fw) < MK_MIN_FULL_WEIGHT_GAP) {
+            mk_raw_warn(raw, "FBX %s '%.*s': full weight %g is zero (closer than 1e-6) or not finite; shape skipped", path,
                         (int)shapes[i].name_length, shapes[i].name, shapes[i].full_weight);
             continue;
         }
-        if (channel && channel->target_count > 0 && !(fw > last_weight)) {
-            mk_raw_warn(raw, "FBX %s '%.*s': full weight %g repeats the previous in-between; duplicate dropped", path,
-                        (int)shapes[i].name_length, shapes[i].name, shapes[i].full_weight);
+        if (channel && channel->target_count > 0 && !(fw - last_weight >= MK_MIN_FULL_WEIGHT_GAP)) {
+            mk_raw_warn(raw, "FBX %s '%.*s': full weight %g repeats the previous in-between (closer than 1e-6); duplicate dropped",
+                        path, (int)shapes[i].name_length, shapes[i].name, shapes[i].full_weight);
             continue;
         }
         int32_t *indexes = NULL;
@@ -592,6 +626,9 @@ static mk_result add_channel(scene *s, uint32_t mesh, fbx_mesh_map *map, const c
             data.indexes = indexes;
             data.positions = positions;
             data.path = path;
+            data.node = node;
+            data.name = shapes[i].name;
+            data.name_length = shapes[i].name_length;
             if (normals && n_nrm != n_pos) {
                 mk_raw_warn(raw, "FBX %s: Normals has %zu values for %zu vertices; ignored", path, n_nrm, n_pos);
             } else if (normals && (s->options->keep_shape_normals || any_nonzero(normals, n_nrm))) {
@@ -742,21 +779,104 @@ static mk_result legacy_shapes(scene *s, const fbx_node *geometry, const fbx_nod
 
 /* ---- meshes ---- */
 
+/* Model subclass "Mesh" (7.x: id, name, subclass; 6.x: name, subclass). FBX 5 models have no
+ * subclass, so for them only the presence of Vertices says "mesh". */
+static int model_is_mesh(const scene *s, const fbx_node *model)
+{
+    uint32_t at = s->legacy_ids ? 1u : 2u;
+    const char *sub;
+    uint32_t n;
+    return model->value_count > at && fbx_value_string(&model->values[at], &sub, &n) && str_eq(sub, n, "Mesh");
+}
+
+/* Blend shape channels that hang off a geometry (7.x deformers and legacy `Shape:` children),
+ * so a warning about a skipped mesh can say what is lost with it. */
+static uint32_t geometry_channel_count(const scene *s, int32_t geometry_object, const fbx_node *geometry)
+{
+    uint32_t n = 0;
+    if (geometry_object >= 0) {
+        uint32_t deformer_cursor = 0;
+        const conn *dc;
+        while ((dc = child_of_kind(s, (uint32_t)geometry_object, OBJ_BLEND, &deformer_cursor)) != NULL) {
+            uint32_t channel_cursor = 0;
+            while (child_of_kind(s, dc->src, OBJ_CHANNEL, &channel_cursor)) n++;
+        }
+    }
+    for (const fbx_node *shape = NULL; (shape = fbx_next_child(geometry, shape, "Shape")) != NULL;) n++;
+    return n;
+}
+
+/* Warning for a mesh that is not imported: the model's name (what the user sees in the
+ * authoring tool), where its geometry is, why, and what goes with it. Library code never
+ * prints: warnings are the caller's to show. */
+static void warn_skipped_mesh(scene *s, uint32_t model, const fbx_node *geometry, const char *why, uint32_t channels)
+{
+    char path[160];
+    fbx_node_path(geometry, path, sizeof path);
+    const object *m = &s->objects[model];
+    if (channels)
+        mk_raw_warn(s->raw, "FBX model '%.*s' (%s at byte %llu): %s; skipped with its %u blend shape channel%s",
+                    (int)m->name_length, m->name, path, (unsigned long long)geometry->offset, why, channels,
+                    channels == 1 ? "" : "s");
+    else
+        mk_raw_warn(s->raw, "FBX model '%.*s' (%s at byte %llu): %s; skipped", (int)m->name_length, m->name,
+                    path, (unsigned long long)geometry->offset, why);
+}
+
+/* 7.x mesh geometries that no model uses are never imported: say so, they may be what the
+ * user expected to see. */
+static void warn_unused_geometries(scene *s)
+{
+    for (uint32_t o = 0; o < s->object_count; o++) {
+        if (s->objects[o].kind != OBJ_MESH) continue;
+        uint32_t cursor = 0;
+        if (parent_of_kind(s, o, OBJ_MODEL, &cursor)) continue;
+        char path[160];
+        fbx_node_path(s->objects[o].node, path, sizeof path);
+        mk_raw_warn(s->raw, "FBX geometry '%.*s' (%s at byte %llu): mesh connected to no model; skipped",
+                    (int)s->objects[o].name_length, s->objects[o].name, path,
+                    (unsigned long long)s->objects[o].node->offset);
+    }
+}
+
+/* The mesh geometry of model `o`, or NULL (geometry_object -1 for 5.x/6.x, where the Model
+ * holds its geometry). Mesh models that end up without geometry are reported here. */
+static const fbx_node *model_geometry(scene *s, uint32_t o, int32_t *geometry_object)
+{
+    const fbx_node *model = s->objects[o].node;
+    *geometry_object = -1;
+    if (s->legacy_ids) {
+        if (fbx_child(model, "Vertices")) return model;
+        if (model_is_mesh(s, model)) warn_skipped_mesh(s, o, model, "mesh has no vertices", geometry_channel_count(s, -1, model));
+        return NULL;
+    }
+    uint32_t cursor = 0;
+    const conn *c = child_of_kind(s, o, OBJ_MESH, &cursor);
+    if (!c) {
+        if (model_is_mesh(s, model)) warn_skipped_mesh(s, o, model, "mesh model has no mesh geometry", 0);
+        return NULL;
+    }
+    for (const conn *extra; (extra = child_of_kind(s, o, OBJ_MESH, &cursor)) != NULL;) {
+        const object *g = &s->objects[extra->src];
+        char path[160];
+        fbx_node_path(g->node, path, sizeof path);
+        mk_raw_warn(s->raw, "FBX model '%.*s': second mesh geometry '%.*s' (%s at byte %llu) skipped; only the first is used",
+                    (int)s->objects[o].name_length, s->objects[o].name, (int)g->name_length, g->name, path,
+                    (unsigned long long)g->node->offset);
+    }
+    *geometry_object = (int32_t)c->src;
+    return s->objects[c->src].node;
+}
+
 static mk_result convert_meshes(scene *s)
 {
     fbx_doc *doc = s->doc;
     mk_raw_asset *raw = s->raw;
+    if (!s->legacy_ids) warn_unused_geometries(s);
     for (uint32_t o = 0; o < s->object_count; o++) {
         if (s->objects[o].kind != OBJ_MODEL) continue;
-        const fbx_node *geometry = NULL;
-        int32_t geometry_object = -1;
-        if (!s->legacy_ids) {
-            uint32_t cursor = 0;
-            const conn *c = child_of_kind(s, o, OBJ_MESH, &cursor);
-            if (c) { geometry = s->objects[c->src].node; geometry_object = (int32_t)c->src; }
-        } else if (fbx_child(s->objects[o].node, "Vertices")) {
-            geometry = s->objects[o].node;  /* 5.x/6.x: the Model holds its geometry */
-        }
+        int32_t geometry_object;
+        const fbx_node *geometry = model_geometry(s, o, &geometry_object);
         if (!geometry) continue;
         uint32_t mesh_index = raw->mesh_count;
         mk_raw_mesh *mesh = mk_raw_add_meshes(raw, 1);
@@ -765,16 +885,20 @@ static mk_result convert_meshes(scene *s)
         mk_result r = fbx_build_mesh(doc, raw, geometry, mesh, &map);
         if (r != MK_OK) return r;
         mesh = &raw->meshes[mesh_index];
+        if (mesh->vertex_count == 0) {
+            /* A prop with an empty Vertices array must not refuse the whole file. Give the
+             * slot back (the arena keeps its bytes; the next mesh reuses it). */
+            raw->mesh_count = mesh_index;
+            warn_skipped_mesh(s, o, geometry, "mesh has no vertices", geometry_channel_count(s, geometry_object, geometry));
+            continue;
+        }
         mesh->name = dup_name(s, s->objects[o].name, s->objects[o].name_length);
         if (!mesh->name) { fbx_mesh_map_free(doc, &map); return mk_error_oom(doc->err, "FBX mesh"); }
         mesh->stacking = s->options->stacking ? s->options->stacking : MK_STACKING_ADDITIVE;
         world_transform(s, o, mesh->world);
         if (!finite16(mesh->world)) {
             fbx_mesh_map_free(doc, &map);
-            char path[160];
-            fbx_node_path(s->objects[o].node, path, sizeof path);
-            return mk_error_set(doc->err, MK_ERROR_NOT_FINITE, s->objects[o].node->offset,
-                                "FBX %s '%s': transform is NaN or infinite", path, mesh->name);
+            return transform_not_finite(s, o, mesh->name);
         }
         s->objects[o].raw_mesh = (int32_t)mesh_index;
         uint32_t first_channel = raw->channel_count;

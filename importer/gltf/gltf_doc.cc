@@ -18,6 +18,14 @@
 // Meshopt fallback buffers (EXT_meshopt_compression "fallback": true) have a byteLength but no
 // data; tinygltf would reject them, so they are replaced by a 1-byte data URI before parsing
 // and reported as empty buffers (the C side decodes the compressed views instead).
+//
+// External files: tinygltf looks a buffer URI up in the base directory and then in "." (the
+// process's working directory), so a .gltf copied without its .bin silently read a same-named
+// file from wherever the tool was started. The loader is given a marker instead of the real
+// directory; the file callbacks accept only paths under the marker (the "." lookup never is),
+// resolve the URI against the glTF file's folder themselves and refuse absolute paths and URI
+// schemes other than data: (tinygltf decodes those itself). Images are never read
+// (TINYGLTF_NO_EXTERNAL_IMAGE), so buffers are the only external files.
 
 #define TINYGLTF_IMPLEMENTATION
 #define TINYGLTF_NO_STB_IMAGE
@@ -29,6 +37,8 @@
 #include <draco/compression/decode.h>
 #include <draco/core/decoder_buffer.h>
 
+#include <cctype>
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -50,19 +60,79 @@ struct Impl {
     std::map<std::pair<int, int>, int> hidden_indices;
 };
 
+// What tinygltf gets as its base directory: paths it builds from a URI start with this plus
+// '/'; its fallback lookup in "." starts with "./" and so never matches.
+const char kBaseMarker[] = "<glTF folder>";
+
 struct FsContext {
-    std::string base_dir;
+    std::string base_dir;          // the glTF file's folder ("" = the working directory)
     bool allow_files;
     uint64_t max_size;
-    std::string last_error;
+    std::string failure;           // first refused or missing external file, for the error
+    mk_result failure_code = MK_OK;
 };
+
+// RFC 3986 scheme: a letter, then letters, digits, '+', '-', '.', up to ':' (before any '/').
+bool has_scheme(const std::string &uri)
+{
+    if (uri.empty() || !std::isalpha(static_cast<unsigned char>(uri[0]))) return false;
+    for (size_t i = 1; i < uri.size(); i++) {
+        unsigned char c = static_cast<unsigned char>(uri[i]);
+        if (c == ':') return true;
+        if (!std::isalnum(c) && c != '+' && c != '-' && c != '.') return false;
+    }
+    return false;
+}
+
+void fail_once(FsContext *ctx, mk_result code, const std::string &message)
+{
+    if (ctx->failure_code != MK_OK) return;
+    ctx->failure_code = code;
+    ctx->failure = message;
+}
+
+// The file a tinygltf path stands for, or "" (after recording why) when it must not be read;
+// *uri is the URI it came from (percent-decoded by tinygltf). Relative references, ".."
+// included, resolve against the glTF file's folder as the spec says; absolute paths and other
+// schemes are refused, so a downloaded .gltf cannot pull in an arbitrary file of the machine.
+std::string resolve(FsContext *ctx, const std::string &path, std::string *uri_out)
+{
+    const std::string prefix = std::string(kBaseMarker) + "/";
+    if (path.compare(0, prefix.size(), prefix) != 0) return "";  // tinygltf's "." fallback
+    const std::string uri = *uri_out = path.substr(prefix.size());
+    const std::string named = "buffer URI '" + uri + "'";
+    if (!ctx->allow_files) {
+        fail_once(ctx, MK_ERROR_PARSE, named + ": external files are not allowed when loading from memory");
+        return "";
+    }
+    if (uri.empty() || uri.find('\0') != std::string::npos) {
+        fail_once(ctx, MK_ERROR_PARSE, named + ": not a file name");
+        return "";
+    }
+    if (uri[0] == '/' || uri[0] == '\\') {
+        fail_once(ctx, MK_ERROR_UNSUPPORTED, named + ": absolute paths are not allowed (external files resolve against the glTF file's folder)");
+        return "";
+    }
+    if (has_scheme(uri)) {
+        fail_once(ctx, MK_ERROR_UNSUPPORTED, named + ": URI scheme '" + uri.substr(0, uri.find(':') + 1) +
+                                                 "' is not supported (only data: URIs and paths relative to the glTF file's folder)");
+        return "";
+    }
+    if (ctx->base_dir.empty()) return uri;
+    return ctx->base_dir + (ctx->base_dir.back() == '/' ? "" : "/") + uri;
+}
 
 bool fs_exists(const std::string &path, void *user)
 {
-    const FsContext *ctx = static_cast<const FsContext *>(user);
-    if (!ctx->allow_files) return false;
-    FILE *f = std::fopen(path.c_str(), "rb");
-    if (!f) return false;
+    FsContext *ctx = static_cast<FsContext *>(user);
+    std::string uri, file = resolve(ctx, path, &uri);
+    if (file.empty()) return false;
+    FILE *f = std::fopen(file.c_str(), "rb");
+    if (!f) {
+        fail_once(ctx, MK_ERROR_IO, "buffer URI '" + uri + "': cannot open '" + file + "' (" + std::strerror(errno) +
+                                        "); external files resolve against the glTF file's folder only");
+        return false;
+    }
     std::fclose(f);
     return true;
 }
@@ -74,13 +144,15 @@ std::string fs_expand(const std::string &path, void *) { return path; }
 bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *user)
 {
     FsContext *ctx = static_cast<FsContext *>(user);
-    if (!ctx->allow_files) {
-        if (err) *err += "external file '" + path + "' not allowed when loading from memory\n";
+    std::string uri, file = resolve(ctx, path, &uri);
+    if (file.empty()) {
+        if (err) *err += "external file '" + path + "' refused\n";
         return false;
     }
-    FILE *f = std::fopen(path.c_str(), "rb");
+    FILE *f = std::fopen(file.c_str(), "rb");
     if (!f) {
-        if (err) *err += "cannot open '" + path + "'\n";
+        fail_once(ctx, MK_ERROR_IO, "buffer URI '" + uri + "': cannot open '" + file + "' (" + std::strerror(errno) + ")");
+        if (err) *err += "cannot open '" + file + "'\n";
         return false;
     }
     out->clear();
@@ -89,7 +161,7 @@ bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::strin
     while ((n = std::fread(chunk, 1, sizeof chunk, f)) > 0) {
         if (ctx->max_size && out->size() + n > ctx->max_size) {
             std::fclose(f);
-            if (err) *err += "'" + path + "' exceeds the input size limit\n";
+            if (err) *err += "'" + file + "' exceeds the input size limit\n";
             return false;
         }
         out->insert(out->end(), chunk, chunk + n);
@@ -97,7 +169,7 @@ bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::strin
     bool bad = std::ferror(f) != 0;
     std::fclose(f);
     if (bad) {
-        if (err) *err += "read error on '" + path + "'\n";
+        if (err) *err += "read error on '" + file + "'\n";
         return false;
     }
     return true;
@@ -641,6 +713,7 @@ mk_result load(mk_arena *arena, const unsigned char *bytes, size_t size, int is_
     FsContext fsctx;
     fsctx.allow_files = base_dir != nullptr;
     fsctx.base_dir = base_dir ? base_dir : "";
+    const std::string marker = kBaseMarker;
     fsctx.max_size = max_file_size;
     tinygltf::FsCallbacks fs;
     fs.FileExists = fs_exists;
@@ -655,12 +728,22 @@ mk_result load(mk_arena *arena, const unsigned char *bytes, size_t size, int is_
     std::string terr, twarn;
     bool ok = is_binary
         ? loader.LoadBinaryFromMemory(&impl->model, &terr, &twarn, reinterpret_cast<const unsigned char *>(glb.data()),
-                                      (unsigned int)glb.size(), fsctx.base_dir)
+                                      (unsigned int)glb.size(), marker)
         : loader.LoadASCIIFromString(&impl->model, &terr, &twarn, json_text.data(), (unsigned int)json_text.size(),
-                                     fsctx.base_dir);
+                                     marker);
     if (!ok) {
+        // Our own account of an external file says which URI and which path; tinygltf's only
+        // says "File not found".
+        if (fsctx.failure_code != MK_OK)
+            return mk_error_set(err, fsctx.failure_code, UINT64_MAX, "glTF %s", fsctx.failure.c_str());
         std::string msg = first_line(terr);
         if (msg.empty()) msg = "tinygltf refused the document";
+        // tinygltf names external files by the path it built ("File size mismatch : <marker>/x.bin"):
+        // show the real one.
+        std::string dir = fsctx.base_dir;
+        if (!dir.empty() && dir.back() != '/') dir += '/';
+        for (size_t at = 0; (at = msg.find(marker + "/", at)) != std::string::npos; at += dir.size())
+            msg.replace(at, marker.size() + 1, dir);
         return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "glTF: %s", msg.c_str());
     }
 

@@ -163,6 +163,9 @@ typedef struct mk_gltf_doc {
 
 /* Parses a document from memory. `is_binary`: 1 GLB, 0 JSON, -1 decide from the "glTF" magic.
  * base_dir: directory for external buffer URIs, or NULL to refuse external files (fuzzing).
+ * URIs resolve against base_dir only, never the working directory; absolute paths and schemes
+ * other than data: are refused (MK_ERROR_UNSUPPORTED), a missing file is MK_ERROR_IO naming the
+ * URI and the path tried.
  * max_file_size bounds every external file (0 = no bound). Warnings of the parser are dropped;
  * errors name the parser's complaint. */
 mk_result mk_gltf_doc_load(mk_arena *arena, const void *data, size_t size, int is_binary,

@@ -342,7 +342,7 @@ static mk_result import_primitive(importer *im, uint32_t node_index, uint32_t pr
     snprintf(what, sizeof what, "%s POSITION", where);
     if ((r = base_attribute(im, p, "POSITION", 3, what, &pos, &np, err)) != MK_OK) return r;
     if (!pos || np == 0) {
-        mk_raw_warn(im->out, "%s: no POSITION; primitive skipped", where);
+        mk_raw_warn(im->out, "%s '%s': no POSITION; primitive skipped", where, node->name ? node->name : "");
         return MK_OK;
     }
     if (np > (1u << 28)) return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "%s: %llu vertices", where, (unsigned long long)np);
@@ -469,7 +469,12 @@ static mk_result import_doc(importer *im, mk_error *err)
             return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "node %u: mesh %d out of range (%u meshes)", i, n->mesh, d->mesh_count);
         const mk_gltf_mesh *gm = &d->meshes[n->mesh];
         int keep_plain = im->options && im->options->keep_plain_meshes;
-        if (gm->primitive_count == 0 || (gm->primitives[0].target_count == 0 && !keep_plain)) continue;
+        if (gm->primitive_count == 0 || (gm->primitives[0].target_count == 0 && !keep_plain)) {
+            /* Only morphing meshes are imported unless asked; say which node is left out, it
+             * may be the one the user expected to see. */
+            mk_raw_warn(im->out, "node %u '%s' mesh %d: no morph targets; skipped", i, n->name ? n->name : "", n->mesh);
+            continue;
+        }
         for (uint32_t p = 1; p < gm->primitive_count; p++)
             if (gm->primitives[p].target_count != gm->primitives[0].target_count)
                 return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "mesh %d: primitive %u has %u targets, primitive 0 has %u (they must agree)",

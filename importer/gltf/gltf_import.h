@@ -8,8 +8,9 @@ extern "C" {
 
 #include "import.h"
 
-/* .gltf or .glb bytes (sniffed by the "glTF" magic). base_dir resolves external buffer URIs;
- * NULL refuses them. options->channels_sidecar is read from its path when set. */
+/* .gltf or .glb bytes (sniffed by the "glTF" magic). base_dir resolves external buffer URIs
+ * (and only it: never the working directory; "" is the working directory); NULL refuses them.
+ * options->channels_sidecar is read from its path when set. */
 mk_result mk_import_gltf_memory(const void *data, size_t size, const char *base_dir,
                                 const mk_import_options *options, mk_raw_asset *out, mk_error *err);
 

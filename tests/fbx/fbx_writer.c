@@ -1,7 +1,9 @@
 /* Test-only FBX writer (see fbx_writer.h). Binary records follow the layout fbx_binary.c
  * reads (13-byte headers below 7500, 25-byte from 7500, a null record closing every child
  * list); ASCII follows the 7.x syntax with `*N { a: ... }` arrays and, from 7200, integer bit
- * patterns for KeyAttrDataFloat, as the FBX SDK writes them.
+ * patterns for KeyAttrDataFloat, as the FBX SDK writes them. Big-endian binary files (header
+ * byte 22 = 1, as ufbx reads them) byte-swap every record counter, scalar, string/array length
+ * and array element (before compression); the zlib stream's own header is big-endian anyway.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,6 +27,8 @@ typedef struct out {
     int top;
     struct libdeflate_compressor *compressor;
     int compress;
+    int big;                   /* binary: big-endian */
+    int type_mix;
 } out;
 
 static long long tell(out *o)
@@ -64,12 +68,20 @@ static void patch(out *o, long long at, const void *p, size_t n)
 }
 
 static void put_u8(out *o, uint8_t v) { put(o, &v, 1); }
-static void put_u32(out *o, uint32_t v)
+
+/* `bytes` bytes of v in the file's byte order. */
+static void encode(const out *o, unsigned char *b, uint64_t v, int bytes)
 {
-    unsigned char b[4] = { (unsigned char)v, (unsigned char)(v >> 8), (unsigned char)(v >> 16), (unsigned char)(v >> 24) };
-    put(o, b, 4);
+    for (int i = 0; i < bytes; i++) b[o->big ? bytes - 1 - i : i] = (unsigned char)(v >> (8 * i));
 }
-static void put_u64(out *o, uint64_t v) { put_u32(o, (uint32_t)v); put_u32(o, (uint32_t)(v >> 32)); }
+static void put_uint(out *o, uint64_t v, int bytes)
+{
+    unsigned char b[8];
+    encode(o, b, v, bytes);
+    put(o, b, (size_t)bytes);
+}
+static void put_u32(out *o, uint32_t v) { put_uint(o, v, 4); }
+static void put_u64(out *o, uint64_t v) { put_uint(o, v, 8); }
 
 static void text(out *o, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -141,7 +153,8 @@ static void end(out *o, int children)
         uint64_t fields[3] = { end_offset, o->prop_count[t], list_length };
         for (int f = 0; f < 3; f++) {
             int bytes = o->wide ? 8 : 4;
-            for (int b = 0; b < bytes; b++) header[n++] = (unsigned char)(fields[f] >> (8 * b));
+            encode(o, header + n, fields[f], bytes);
+            n += (size_t)bytes;
         }
         patch(o, o->node_start[t], header, n);
     } else if (children) {
@@ -157,11 +170,14 @@ static void sep(out *o)
     o->has_values = 1;
 }
 
+/* Integers: 'I' (i32), 'L' (i64), 'Y' (i16), 'B'/'Z' (one byte). ASCII writes the number. */
 static void v_i64(out *o, int64_t v, char type)
 {
     if (o->binary) {
         put_u8(o, (uint8_t)type);
         if (type == 'L') put_u64(o, (uint64_t)v);
+        else if (type == 'Y') put_uint(o, (uint16_t)(int16_t)v, 2);
+        else if (type == 'B' || type == 'Z') put_u8(o, (uint8_t)v);
         else put_u32(o, (uint32_t)(int32_t)v);
         o->prop_count[o->top - 1]++;
     } else {
@@ -182,6 +198,27 @@ static void v_f64(out *o, double v)
         sep(o);
         text(o, "%.17g", v);
     }
+}
+
+/* A number as 'F' (f32) when the scene mixes types, else as 'D'. */
+static void v_real(out *o, double v)
+{
+    if (!o->binary || !o->type_mix) { v_f64(o, v); return; }
+    float f = (float)v;
+    uint32_t bits;
+    memcpy(&bits, &f, 4);
+    put_u8(o, 'F');
+    put_u32(o, bits);
+    o->prop_count[o->top - 1]++;
+}
+
+/* Strings: 'S', or 'R' (raw bytes, length given) in binary. */
+static void v_bytes(out *o, char type, const void *s, size_t n)
+{
+    put_u8(o, (uint8_t)type);
+    put_u32(o, (uint32_t)n);
+    put(o, s, n);
+    o->prop_count[o->top - 1]++;
 }
 
 static void v_str(out *o, const char *s)
@@ -226,29 +263,47 @@ static void v_char(out *o, char c)
     }
 }
 
+/* Binary array payload: the elements in the file's byte order (the host is little-endian),
+ * zlib-compressed when `compress` (after swapping, as the stream holds the file's bytes). */
+static void put_array(out *o, char kind, const void *data, size_t count, int compress)
+{
+    size_t elem = (kind == 'd' || kind == 'l') ? 8 : (kind == 'f' || kind == 'i') ? 4 : 1;
+    size_t bytes = count * elem;
+    const unsigned char *payload = data;
+    unsigned char *swapped = NULL;
+    if (o->big && elem > 1 && bytes) {
+        swapped = malloc(bytes);
+        if (!swapped) { o->failed = 1; return; }
+        for (size_t i = 0; i < count; i++)
+            for (size_t b = 0; b < elem; b++) swapped[i * elem + b] = payload[i * elem + elem - 1 - b];
+        payload = swapped;
+    }
+    put_u8(o, (uint8_t)kind);
+    put_u32(o, (uint32_t)count);
+    if (compress && o->compressor) {
+        size_t bound = libdeflate_zlib_compress_bound(o->compressor, bytes);
+        unsigned char *z = malloc(bound);
+        size_t zn = z ? libdeflate_zlib_compress(o->compressor, payload, bytes, z, bound) : 0;
+        if (!zn) o->failed = 1;
+        put_u32(o, 1);
+        put_u32(o, (uint32_t)zn);
+        put(o, z, zn);
+        free(z);
+    } else {
+        put_u32(o, 0);
+        put_u32(o, (uint32_t)bytes);
+        put(o, payload, bytes);
+    }
+    free(swapped);
+    o->prop_count[o->top - 1]++;
+}
+
 /* Arrays: kind 'd' (double), 'f' (float), 'i' (int32), 'l' (int64); `bits` writes floats as
  * their int32 bit patterns in ASCII (KeyAttrDataFloat from 7200). */
 static void v_array(out *o, char kind, const void *data, size_t count, int bits)
 {
-    size_t elem = (kind == 'd' || kind == 'l') ? 8 : 4;
     if (o->binary) {
-        put_u8(o, (uint8_t)kind);
-        put_u32(o, (uint32_t)count);
-        if (o->compress && count > 64 && o->compressor) {
-            size_t bound = libdeflate_zlib_compress_bound(o->compressor, count * elem);
-            unsigned char *z = malloc(bound);
-            size_t zn = z ? libdeflate_zlib_compress(o->compressor, data, count * elem, z, bound) : 0;
-            if (!zn) { o->failed = 1; free(z); return; }
-            put_u32(o, 1);
-            put_u32(o, (uint32_t)zn);
-            put(o, z, zn);
-            free(z);
-        } else {
-            put_u32(o, 0);
-            put_u32(o, (uint32_t)(count * elem));
-            put(o, data, count * elem);  /* little-endian host */
-        }
-        o->prop_count[o->top - 1]++;
+        put_array(o, kind, data, count, o->compress == 2 ? count > 0 : o->compress && count > 64);
         return;
     }
     sep(o);
@@ -283,6 +338,34 @@ static void v_array(out *o, char kind, const void *data, size_t count, int bits)
     text(o, "}");
 }
 
+/* Typed arrays for the type mix: the values (doubles or int64) written as `kind`. */
+static void v_array_as(out *o, char kind, const double *d, const int64_t *l, size_t count)
+{
+    if (!o->binary || !o->type_mix) {
+        if (d) v_array(o, 'd', d, count, 0);
+        else v_array(o, 'l', l, count, 0);
+        return;
+    }
+    size_t elem = (kind == 'd' || kind == 'l') ? 8 : (kind == 'f' || kind == 'i') ? 4 : 1;
+    unsigned char *buffer = malloc(count * elem + 1);
+    if (!buffer) { o->failed = 1; return; }
+    for (size_t i = 0; i < count; i++) {
+        double x = d ? d[i] : (double)l[i];
+        int64_t y = l ? l[i] : (int64_t)d[i];
+        float f = (float)x;
+        int32_t w = (int32_t)y;
+        switch (kind) {
+        case 'd': memcpy(buffer + 8 * i, &x, 8); break;
+        case 'f': memcpy(buffer + 4 * i, &f, 4); break;
+        case 'l': memcpy(buffer + 8 * i, &y, 8); break;
+        case 'i': memcpy(buffer + 4 * i, &w, 4); break;
+        default: buffer[i] = (unsigned char)y; break;
+        }
+    }
+    v_array(o, kind, buffer, count, 0);
+    free(buffer);
+}
+
 /* Leaf helpers */
 static void leaf_i64(out *o, const char *name, int64_t v, char type) { begin(o, name); v_i64(o, v, type); values_end(o, 0); end(o, 0); }
 static void leaf_f64(out *o, const char *name, double v) { begin(o, name); v_f64(o, v); values_end(o, 0); end(o, 0); }
@@ -310,6 +393,51 @@ static void prop_vec3(out *o, const char *name, const double v[3])
     prop_begin(o, name, "Lcl Translation", "", "A");
     for (int i = 0; i < 3; i++) v_f64(o, v[i]);
     prop_end(o);
+}
+
+/* Array leaf whose values are written as `kind` in a type-mixed binary file (else 'd'). */
+static void leaf_array_as(out *o, const char *name, char kind, const double *values, size_t count)
+{
+    begin(o, name);
+    v_array_as(o, kind, values, NULL, count);
+    values_end(o, 0);
+    end(o, 0);
+}
+
+/* Every property type and every array type (raw and zlib), with values whose bytes are not
+ * palindromes, so a reader that ignores the byte order reads different values. */
+static void write_type_zoo(out *o)
+{
+    begin(o, "MorphkitTypes");
+    v_i64(o, -12345, 'Y');
+    v_char(o, 'x');
+    v_i64(o, 200, 'B');
+    v_i64(o, 1, 'Z');
+    v_i64(o, -123456789, 'I');
+    v_i64(o, -1234567890123456789LL, 'L');
+    v_real(o, -3.25e-3);
+    v_f64(o, 0.1);
+    v_bytes(o, 'S', "name\0\1Class", 11);  /* binary object name: Name, 0, 1, Class */
+    v_bytes(o, 'R', "\x00\x01\x02\xff\x80", 5);
+    values_end(o, 1);
+    static const double d[5] = { 0.1, -2.5e10, 1e-300, 3.0, -0.0 };
+    static const float f[5] = { 1e-3f, -7.5f, 3.0e38f, 0.0f, 1.0f / 3.0f };
+    static const int64_t l[5] = { 0x0102030405060708LL, -2, INT64_MIN, 46186158000LL, 0 };
+    static const int32_t i[5] = { 0x01020304, -2, INT32_MIN, 7, 0 };
+    static const unsigned char b[5] = { 0, 1, 0xff, 0x80, 2 };
+    static const char c[5] = { 'a', 'Y', 0, 'T', 'N' };
+    static const struct { char kind; const void *data; } arrays[6] = {
+        { 'd', d }, { 'f', f }, { 'l', l }, { 'i', i }, { 'b', b }, { 'c', c } };
+    for (int a = 0; a < 6; a++)
+        for (int z = 0; z < 2; z++) {
+            char name[16];
+            snprintf(name, sizeof name, "%c%s", arrays[a].kind, z ? "zlib" : "raw");
+            begin(o, name);
+            put_array(o, arrays[a].kind, arrays[a].data, 5, z);
+            values_end(o, 0);
+            end(o, 0);
+        }
+    end(o, 1);
 }
 
 /* ---- scene ---- */
@@ -371,7 +499,8 @@ static void write_scene(out *o, const fbxw_scene *sc)
 {
     ids g = { 1000000 };
     if (o->binary) {
-        put(o, "Kaydara FBX Binary  \0\x1a\0", 23);
+        put(o, "Kaydara FBX Binary  \0\x1a", 22);
+        put_u8(o, o->big ? 1 : 0);  /* endianness */
         put_u32(o, sc->version);
     } else {
         text(o, "; FBX %u.%u.%u project file\n; written by the morphkit test writer\n", sc->version / 1000,
@@ -384,13 +513,20 @@ static void write_scene(out *o, const fbxw_scene *sc)
     leaf_i64(o, "FBXVersion", sc->version, 'I');
     leaf_str(o, "Creator", creator);
     end(o, 1);
-    leaf_str(o, "Creator", creator);
+    if (o->binary && o->type_mix) {
+        begin(o, "Creator");
+        v_bytes(o, 'R', creator, strlen(creator));
+        values_end(o, 0);
+        end(o, 0);
+    } else {
+        leaf_str(o, "Creator", creator);
+    }
     begin(o, "GlobalSettings");
     values_end(o, 1);
     leaf_i64(o, "Version", 1000, 'I');
     begin(o, "Properties70");
     values_end(o, 1);
-    prop_begin(o, "UpAxis", "int", "Integer", ""); v_i64(o, 1, 'I'); prop_end(o);
+    prop_begin(o, "UpAxis", "int", "Integer", ""); v_i64(o, 1, o->binary && o->type_mix ? 'Y' : 'I'); prop_end(o);
     prop_begin(o, "UnitScaleFactor", "double", "Number", ""); v_f64(o, 1.0); prop_end(o);
     prop_begin(o, "TimeMode", "enum", "", ""); v_i64(o, 11, 'I'); prop_end(o);
     end(o, 1);
@@ -434,7 +570,7 @@ static void write_scene(out *o, const fbxw_scene *sc)
             leaf_str(o, "Name", "");
             leaf_str(o, "MappingInformationType", "ByPolygonVertex");
             leaf_str(o, "ReferenceInformationType", "Direct");
-            leaf_array(o, "Normals", 'd', mesh->normals, 3 * (size_t)mesh->polygon_vertex_count, 0);
+            leaf_array_as(o, "Normals", 'f', mesh->normals, 3 * (size_t)mesh->polygon_vertex_count);
             end(o, 1);
         }
         if (mesh->uvs) {
@@ -443,7 +579,7 @@ static void write_scene(out *o, const fbxw_scene *sc)
             leaf_str(o, "Name", "map1");
             leaf_str(o, "MappingInformationType", "ByPolygonVertex");
             leaf_str(o, "ReferenceInformationType", "Direct");
-            leaf_array(o, "UV", 'd', mesh->uvs, 2 * (size_t)mesh->polygon_vertex_count, 0);
+            leaf_array_as(o, "UV", 'f', mesh->uvs, 2 * (size_t)mesh->polygon_vertex_count);
             end(o, 1);
         }
         begin(o, "Layer"); v_i64(o, 0, 'I'); values_end(o, 1);
@@ -468,8 +604,16 @@ static void write_scene(out *o, const fbxw_scene *sc)
         prop_vec3(o, "GeometricTranslation", mesh->geometric_translation);
         prop_vec3(o, "Lcl Translation", mesh->translation);
         prop_vec3(o, "Lcl Rotation", mesh->rotation);
-        prop_vec3(o, "Lcl Scaling", s);
+        prop_begin(o, "Lcl Scaling", "Lcl Scaling", "", "A");
+        for (int k = 0; k < 3; k++) v_real(o, s[k]);
+        prop_end(o);
         end(o, 1);
+        if (o->binary && o->type_mix) {
+            begin(o, "Shading");
+            v_char(o, 'Y');
+            values_end(o, 0);
+            end(o, 0);
+        }
         leaf_str(o, "Culling", "CullingOff");
         end(o, 1);
 
@@ -499,7 +643,7 @@ static void write_scene(out *o, const fbxw_scene *sc)
                 end(o, 1);
             }
             leaf_f64(o, "DeformPercent", ch->deform_percent);
-            leaf_array(o, "FullWeights", 'd', ch->full_weights, ch->full_weight_count, 0);
+            leaf_array_as(o, "FullWeights", 'f', ch->full_weights, ch->full_weight_count);
             end(o, 1);
             for (uint32_t k = 0; k < ch->shape_count; k++, si++) {
                 const fbxw_shape *sh = &ch->shapes[k];
@@ -510,7 +654,18 @@ static void write_scene(out *o, const fbxw_scene *sc)
                 v_str(o, "Shape");
                 values_end(o, 1);
                 leaf_i64(o, "Version", 100, 'I');
-                leaf_array(o, "Indexes", 'i', sh->indexes, sh->count, 0);
+                if (o->binary && o->type_mix) {
+                    int64_t *wide = malloc(((size_t)sh->count + 1) * sizeof *wide);
+                    if (!wide) o->failed = 1;
+                    for (uint32_t k = 0; wide && k < sh->count; k++) wide[k] = sh->indexes[k];
+                    begin(o, "Indexes");
+                    if (wide) v_array_as(o, 'l', NULL, wide, sh->count);
+                    values_end(o, 0);
+                    end(o, 0);
+                    free(wide);
+                } else {
+                    leaf_array(o, "Indexes", 'i', sh->indexes, sh->count, 0);
+                }
                 leaf_array(o, "Vertices", 'd', sh->deltas, 3 * (size_t)sh->count, 0);
                 if (sh->normals) leaf_array(o, "Normals", 'd', sh->normals, 3 * (size_t)sh->count, 0);
                 end(o, 1);
@@ -576,6 +731,7 @@ static void write_scene(out *o, const fbxw_scene *sc)
     }
     if (animated) connect(o, "OO", layer_id, stack_id, NULL);
     end(o, 1);
+    if (o->binary && o->type_mix) write_type_zoo(o);
     if (o->binary) {
         unsigned char zero[25] = { 0 };
         put(o, zero, (size_t)(o->wide ? 25 : 13));  /* closes the top-level list */
@@ -589,7 +745,6 @@ static void write_scene(out *o, const fbxw_scene *sc)
     free(node_id);
     free(curve_id);
     free(shape_id);
-    (void)v_char;
 }
 
 static void setup(out *o, const fbxw_scene *sc)
@@ -599,7 +754,9 @@ static void setup(out *o, const fbxw_scene *sc)
     o->version = (int)sc->version;
     o->wide = sc->version >= 7500;
     o->compress = sc->compress;
-    if (sc->binary && sc->compress) {
+    o->big = sc->binary && sc->big_endian;
+    o->type_mix = sc->binary && sc->type_mix;
+    if (sc->binary && (sc->compress || sc->type_mix)) {  /* the type zoo has zlib arrays */
         o->compressor = libdeflate_alloc_compressor(1);  /* fast: tests and the benchmark */
         if (!o->compressor) o->failed = 1;
     }

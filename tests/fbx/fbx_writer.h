@@ -60,7 +60,13 @@ typedef struct fbxw_mesh {
 typedef struct fbxw_scene {
     uint32_t version;             /* 7100..7700; selects 13- or 25-byte records in binary */
     int binary;
-    int compress;                 /* binary: zlib-compress arrays of more than 64 elements */
+    int compress;                 /* binary: 1 zlib-compresses arrays of more than 64 elements, 2 every non-empty array */
+    int big_endian;               /* binary: header byte 22 = 1, every counter, scalar and array element big-endian */
+    /* binary: use every property type where the importer reads the value (UpAxis 'Y', Creator
+     * 'R', Lcl Scaling 'F', Shading 'C', normals/UVs/FullWeights 'f', shape Indexes 'l') and
+     * add a top-level "MorphkitTypes" node with every scalar type (Y C B Z I L F D S R) and
+     * every array type (f d l i b c, raw and zlib), which the importer ignores. */
+    int type_mix;
     const char *creator;          /* NULL: "morphkit test writer" */
     int64_t stack_start, stack_stop; /* KTime of the single AnimationStack (written if any curve) */
     uint32_t mesh_count;

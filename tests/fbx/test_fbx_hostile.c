@@ -1,6 +1,7 @@
 /* Hostile input: the fuzz target's function (tests/fuzz/fuzz_fbx.c, LLVMFuzzerTestOneInput)
  * over every truncation length and seeded random byte changes of
- *   - writer-made fixtures (binary 7400/7500 raw and zlib, ASCII 7500) — always run;
+ *   - writer-made fixtures (binary 7400/7500 raw and zlib, big-endian 7100 raw and 7500 zlib
+ *     with every property type, ASCII 7500/7100) — always run;
  *   - every FBX file of the shared corpus — SKIP when the corpus is absent.
  * Each input must give an error or a valid import (the target aborts otherwise); under
  * ASan/UBSan this also proves there is no out-of-bounds access. A hang shows up as the test
@@ -55,13 +56,15 @@ static int hammer(const unsigned char *data, size_t size, int flips, size_t trun
 
 static void test_fixtures(void)
 {
-    static const struct { uint32_t version; int binary, compress; } forms[] = {
-        { 7400, 1, 0 }, { 7500, 1, 1 }, { 7500, 0, 0 }, { 7100, 0, 0 },
+    static const struct { uint32_t version; int binary, compress, big_endian; } forms[] = {
+        { 7400, 1, 0, 0 }, { 7500, 1, 1, 0 }, { 7500, 0, 0, 0 }, { 7100, 0, 0, 0 }, { 7100, 1, 0, 1 }, { 7500, 1, 2, 1 },
     };
     int runs = 0;
     for (size_t i = 0; i < sizeof forms / sizeof forms[0]; i++) {
         fbxw_scene scene;
         fixture_cube(&scene, forms[i].version, forms[i].binary, forms[i].compress);
+        scene.big_endian = forms[i].big_endian;
+        scene.type_mix = forms[i].big_endian;
         unsigned char *data;
         size_t size;
         CHECK(fbxw_write(&scene, &data, &size) == 0);

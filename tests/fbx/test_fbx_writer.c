@@ -13,6 +13,7 @@
 #include <libdeflate.h>
 #include "check.h"
 #include "fbx_fixtures.h"
+#include "fbx_internal.h"
 #include "fbx_test_util.h"
 
 /* Hand-computed world position of the Box fixture's control point `cp` with Squash weight ws
@@ -511,6 +512,61 @@ static void test_duplicate_full_weights(void)
     mk_raw_free(&raw);
 }
 
+/* Full weights the runtime cannot place (closer than 1e-6 to 0, or to the previous
+ * in-between) are skipped with a warning at import, not passed on to fail validation. */
+static void test_tiny_full_weights(void)
+{
+    static const int32_t idx[1] = { 0 };
+    static const double d1[3] = { 1, 0, 0 }, d2[3] = { 2, 0, 0 }, d3[3] = { 3, 0, 0 }, d4[3] = { 4, 0, 0 };
+    /* percent: 1e-5 % = 1e-7 (too close to 0), 50, 50 + 1e-5 % (too close to 50), 100 */
+    static const double fw[4] = { 1e-5, 50, 50.00001, 100 };
+    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
+    static const int32_t tri[3] = { 0, 1, ~2 };
+    fbxw_shape shapes[4] = { { "A", 1, idx, d1, NULL }, { "B", 1, idx, d2, NULL }, { "C", 1, idx, d3, NULL },
+                             { "D", 1, idx, d4, NULL } };
+    fbxw_channel channel;
+    memset(&channel, 0, sizeof channel);
+    channel.name = "Tiny";
+    channel.shape_count = 4;
+    channel.shapes = shapes;
+    channel.full_weight_count = 4;
+    channel.full_weights = fw;
+    fbxw_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.name = "Tri";
+    mesh.control_point_count = 3;
+    mesh.control_points = points;
+    mesh.polygon_vertex_count = 3;
+    mesh.polygon_vertex_index = tri;
+    mesh.channel_count = 1;
+    mesh.channels = &channel;
+    mesh.parent = -1;
+    fbxw_scene scene;
+    memset(&scene, 0, sizeof scene);
+    scene.version = 7500;
+    scene.binary = 1;
+    scene.mesh_count = 1;
+    scene.meshes = &mesh;
+    unsigned char *data;
+    size_t size;
+    CHECK(fbxw_write(&scene, &data, &size) == 0);
+    mk_raw_asset raw;
+    mk_error err;
+    CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
+    free(data);
+    CHECK_MSG(mk_raw_validate(&raw, &err) == MK_OK, "%s", err.message);
+    CHECK_EQ_INT(raw.channel_count, 1);
+    if (raw.channel_count == 1) {
+        CHECK_EQ_INT(raw.channels[0].target_count, 2);
+        if (raw.channels[0].target_count == 2) {
+            CHECK(strcmp(raw.channels[0].targets[0].name, "B") == 0);
+            CHECK(strcmp(raw.channels[0].targets[1].name, "D") == 0);
+        }
+    }
+    CHECK(raw.warning_count >= 2);
+    mk_raw_free(&raw);
+}
+
 /* Rotation order and pre-rotation: a point at (1,0,0) under T(1,0,0) and R(90,0,90).
  * XYZ applies X first: (1,0,0) -> (1,0,0) -> (0,1,0), + T = (1,1,0).
  * ZYX applies Z first: (1,0,0) -> (0,1,0) -> (0,0,1), + T = (1,0,1).
@@ -651,6 +707,545 @@ static void test_inherit_type(void)
         free(p);
         mk_raw_free(&raw);
     }
+}
+
+/* ---- meshes that cannot be imported are skipped with a warning ---- */
+
+/* 1 when some warning contains both `a` and `b`. */
+static int has_warning(const mk_raw_asset *raw, const char *a, const char *b)
+{
+    for (uint32_t i = 0; i < raw->warning_count && i < MK_RAW_MAX_WARNINGS; i++)
+        if (strstr(raw->warnings[i].message, a) && strstr(raw->warnings[i].message, b)) return 1;
+    return 0;
+}
+
+/* A scene whose "Prop" mesh has an empty Vertices array (and, in one variant, a blend shape
+ * channel of its own) next to "Tri" (one triangle, one channel) and "Plain" (a triangle
+ * without blend shapes): Prop is skipped with a warning naming it, Tri and Plain import. */
+static void test_empty_mesh_skipped(void)
+{
+    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
+    static const int32_t tri[3] = { 0, 1, ~2 };
+    static const int32_t idx[1] = { 2 };
+    static const double delta[3] = { 0, 0, 1 };
+    static const double fw[1] = { 100 };
+    fbxw_shape shape = { "Up", 1, idx, delta, NULL };
+    fbxw_channel channels[2];
+    memset(channels, 0, sizeof channels);
+    channels[0].name = "Up";
+    channels[0].deform_percent = 50;
+    channels[0].shape_count = 1;
+    channels[0].shapes = &shape;
+    channels[0].full_weight_count = 1;
+    channels[0].full_weights = fw;
+    channels[1] = channels[0];
+    channels[1].name = "PropUp";
+    for (int variant = 0; variant < 4; variant++) {
+        int binary = variant & 1, prop_has_channel = variant >> 1;
+        fbxw_mesh meshes[3];
+        memset(meshes, 0, sizeof meshes);
+        meshes[0].name = "Prop";    /* no control points, no polygons */
+        meshes[0].parent = -1;
+        meshes[0].channel_count = prop_has_channel ? 1 : 0;
+        meshes[0].channels = &channels[1];
+        for (int m = 1; m < 3; m++) {
+            meshes[m].name = m == 1 ? "Tri" : "Plain";
+            meshes[m].control_point_count = 3;
+            meshes[m].control_points = points;
+            meshes[m].polygon_vertex_count = 3;
+            meshes[m].polygon_vertex_index = tri;
+            meshes[m].parent = -1;
+        }
+        meshes[1].channel_count = 1;
+        meshes[1].channels = &channels[0];
+        fbxw_scene scene;
+        memset(&scene, 0, sizeof scene);
+        scene.version = binary ? 7500 : 7400;
+        scene.binary = binary;
+        scene.mesh_count = 3;
+        scene.meshes = meshes;
+        unsigned char *data;
+        size_t size;
+        CHECK(fbxw_write(&scene, &data, &size) == 0);
+        mk_raw_asset raw;
+        mk_error err;
+        mk_result r = ft_import(data, size, NULL, &raw, &err);
+        free(data);
+        CHECK_MSG(r == MK_OK, "variant %d: %s", variant, err.message);
+        if (r == MK_OK) {
+            CHECK_EQ_INT(raw.mesh_count, 2);
+            CHECK(ft_find_mesh(&raw, "Prop") < 0);
+            CHECK(ft_find_mesh(&raw, "Tri") >= 0);
+            CHECK(ft_find_mesh(&raw, "Plain") >= 0);   /* meshes without blend shapes are kept */
+            CHECK_EQ_INT(raw.channel_count, 1);
+            if (raw.channel_count == 1) CHECK(strcmp(raw.channels[0].name, "Up") == 0);
+            CHECK_MSG(has_warning(&raw, "'Prop'", "no vertices"), "variant %d: no warning names the skipped mesh", variant);
+            if (prop_has_channel) CHECK(has_warning(&raw, "'Prop'", "1 blend shape channel"));
+            CHECK(mk_raw_validate(&raw, &err) == MK_OK);
+        }
+        mk_raw_free(&raw);
+    }
+}
+
+/* Other reasons a mesh is not imported, each named in a warning: a mesh geometry no model uses,
+ * a second mesh geometry on one model, and (6.x) a mesh model without Vertices. */
+static void test_skipped_mesh_warnings(void)
+{
+    const char *orphan =
+        "; FBX 7.4.0 project file\nObjects: {\n"
+        " Geometry: 1, \"Geometry::Used\", \"Mesh\" {\n  Vertices: *9 { a: 0,0,0,1,0,0,0,1,0 }\n"
+        "  PolygonVertexIndex: *3 { a: 0,1,-3 }\n }\n"
+        " Geometry: 3, \"Geometry::Spare\", \"Mesh\" {\n  Vertices: *9 { a: 0,0,0,1,0,0,0,1,0 }\n"
+        "  PolygonVertexIndex: *3 { a: 0,1,-3 }\n }\n"
+        " Geometry: 4, \"Geometry::Lost\", \"Mesh\" {\n  Vertices: *9 { a: 0,0,0,1,0,0,0,1,0 }\n"
+        "  PolygonVertexIndex: *3 { a: 0,1,-3 }\n }\n"
+        " Model: 2, \"Model::M\", \"Mesh\" {\n }\n"
+        " Model: 5, \"Model::Hollow\", \"Mesh\" {\n }\n"
+        "}\nConnections: {\n C: \"OO\",1,2\n C: \"OO\",3,2\n}\n";
+    mk_raw_asset raw;
+    mk_error err;
+    mk_result r = ft_import(orphan, strlen(orphan), NULL, &raw, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    CHECK_EQ_INT(raw.mesh_count, 1);
+    CHECK(has_warning(&raw, "'Lost'", "no model"));
+    CHECK(has_warning(&raw, "'M'", "'Spare'"));
+    CHECK(has_warning(&raw, "'Hollow'", "no mesh geometry"));
+    mk_raw_free(&raw);
+    const char *legacy =
+        "; FBX 6.1.0 project file\nObjects:  {\n"
+        "\tModel: \"Model::Tri\", \"Mesh\" {\n\t\tVertices: 0,0,0,1,0,0,0,1,0\n\t\tPolygonVertexIndex: 0,1,-3\n\t}\n"
+        "\tModel: \"Model::Prop\", \"Mesh\" {\n\t\tVersion: 232\n\t}\n"
+        "\tModel: \"Model::Empty\", \"Mesh\" {\n\t\tVertices: \n\t\tPolygonVertexIndex: \n\t}\n"
+        "\tModel: \"Model::Null\", \"Null\" {\n\t}\n"
+        "}\n";
+    r = ft_import(legacy, strlen(legacy), NULL, &raw, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    CHECK_EQ_INT(raw.mesh_count, 1);
+    CHECK(has_warning(&raw, "'Prop'", "no vertices"));
+    CHECK(has_warning(&raw, "'Empty'", "no vertices"));
+    CHECK(!has_warning(&raw, "'Null'", ""));
+    CHECK_EQ_INT(raw.warning_count, 2);
+    mk_raw_free(&raw);
+}
+
+/* ---- ASCII comments and not-finite numbers ---- */
+
+/* `;` comments inside `a:` arrays and between the items of a value list that spans lines
+ * import exactly like the same file without comments. */
+static void test_ascii_array_comments(void)
+{
+    static const char *const texts[2] = {
+        "; FBX 7.4.0 project file\nObjects: {\n Geometry: 1, \"Geometry::\", \"Mesh\" {\n"
+        "  Vertices: *9 {\n   a: 0,0,0,1,0,0,0,2,0\n  }\n"
+        "  PolygonVertexIndex: *3 { a: 0,1,-3 }\n }\n Model: 2, \"Model::M\", \"Mesh\" {\n }\n}\n"
+        "Connections: {\n C: \"OO\",1,2\n}\n",
+        "; FBX 7.4.0 project file\nObjects: {\n Geometry: 1, \"Geometry::\", \"Mesh\" {\n"
+        "  Vertices: *9 ; nine values\n  {\n   a: ; x, y, z per point\n"
+        "      0,0,0, ; point 0 } (a brace in a comment)\n"
+        "; a whole comment line between items, with commas , , and 1.#INF\n"
+        "      1,0,0 ; point 1, no trailing comma\n"
+        "      ,0,2,0 ; point 2\n  }\n"
+        "  PolygonVertexIndex: *3 { a: 0,1, ; closes\n -3 }\n }\n Model: 2, \"Model::M\", \"Mesh\" {\n }\n}\n"
+        "Connections: {\n C: \"OO\",1,2\n}\n",
+    };
+    float positions[2][9];
+    for (int t = 0; t < 2; t++) {
+        mk_raw_asset raw;
+        mk_error err;
+        mk_result r = ft_import(texts[t], strlen(texts[t]), NULL, &raw, &err);
+        CHECK_MSG(r == MK_OK, "text %d: %s", t, err.message);
+        CHECK_EQ_INT(raw.mesh_count, 1);
+        if (r == MK_OK && raw.mesh_count == 1 && raw.meshes[0].vertex_count == 3)
+            memcpy(positions[t], raw.meshes[0].positions, sizeof positions[t]);
+        else
+            memset(positions[t], 0xff, sizeof positions[t]);
+        mk_raw_free(&raw);
+    }
+    CHECK(memcmp(positions[0], positions[1], sizeof positions[0]) == 0);
+    CHECK_NEAR(positions[1][7], 2.0, 0);
+    /* 6.x value lists: a comment line between continuation lines. */
+    const char *legacy =
+        "; FBX 6.1.0 project file\nObjects:  {\n\tModel: \"Model::Tri\", \"Mesh\" {\n"
+        "\t\tVertices: 0,0,0,1,0,0 ; two points\n\t\t; the third follows\n\t\t,0,2,0\n"
+        "\t\tPolygonVertexIndex: 0,1,\n\t\t; the closing index\n\t\t-3\n\t}\n}\n";
+    mk_raw_asset raw;
+    mk_error err;
+    mk_result r = ft_import(legacy, strlen(legacy), NULL, &raw, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    CHECK(r == MK_OK && raw.mesh_count == 1 && raw.meshes[0].control_point_count == 3 && raw.meshes[0].triangle_count == 1);
+    mk_raw_free(&raw);
+}
+
+/* A 7.4 ASCII scene with one value of each kind the importer checks: a control point
+ * coordinate (@V), a Lcl Translation component (@T), a shape delta (@D), a curve key value
+ * (@K). fill() substitutes them and records where each token starts. */
+static const char not_finite_template[] =
+    "; FBX 7.4.0 project file\nObjects: {\n"
+    " Geometry: 1, \"Geometry::\", \"Mesh\" {\n  Vertices: *9 { a: 0,0,0,1,@V,0,0,1,0 }\n"
+    "  PolygonVertexIndex: *3 { a: 0,1,-3 }\n }\n"
+    " Model: 2, \"Model::M\", \"Mesh\" {\n  Properties70: {\n"
+    "   P: \"Lcl Translation\", \"Lcl Translation\", \"\", \"A\",@T,0,0\n  }\n }\n"
+    " Deformer: 3, \"Deformer::B\", \"BlendShape\" {\n }\n"
+    " Deformer: 4, \"SubDeformer::C\", \"BlendShapeChannel\" {\n  DeformPercent: 0\n  FullWeights: *1 { a: 100 }\n }\n"
+    " Geometry: 5, \"Geometry::S\", \"Shape\" {\n  Indexes: *1 { a: 2 }\n  Vertices: *3 { a: 0,@D,0 }\n }\n"
+    " AnimationStack: 6, \"AnimStack::Take\", \"\" {\n }\n AnimationLayer: 7, \"AnimLayer::Base\", \"\" {\n }\n"
+    " AnimationCurveNode: 8, \"AnimCurveNode::DeformPercent\", \"\" {\n }\n"
+    " AnimationCurve: 9, \"AnimCurve::\", \"\" {\n  KeyTime: *2 { a: 0,46186158000 }\n  KeyValueFloat: *2 { a: 0,@K }\n"
+    "  KeyAttrFlags: *1 { a: 4 }\n  KeyAttrDataFloat: *4 { a: 0,0,218434821,0 }\n  KeyAttrRefCount: *1 { a: 2 }\n }\n"
+    "}\nConnections: {\n C: \"OO\",1,2\n C: \"OO\",3,1\n C: \"OO\",4,3\n C: \"OO\",5,4\n C: \"OO\",7,6\n C: \"OO\",8,7\n"
+    " C: \"OP\",8,4, \"DeformPercent\"\n C: \"OP\",9,8, \"d|DeformPercent\"\n}\n";
+
+static char *fill(const char *bad, int slot, size_t *bad_offset)
+{
+    static const char slots[] = "VTDK";
+    char *out = malloc(sizeof not_finite_template + 64);
+    size_t n = 0;
+    for (const char *p = not_finite_template; *p; p++) {
+        if (p[0] == '@' && p[1]) {
+            int which = (int)(strchr(slots, p[1]) - slots);
+            const char *token = which == slot ? bad : "1";
+            if (which == slot) *bad_offset = n;
+            memcpy(out + n, token, strlen(token));
+            n += strlen(token);
+            p++;
+            continue;
+        }
+        out[n++] = *p;
+    }
+    out[n] = 0;
+    return out;
+}
+
+/* NaN and infinity in every spelling exporters write (C99, Windows CRT, glibc) are numbers,
+ * never "malformed" and never bare-word characters: each gives MK_ERROR_NOT_FINITE naming the
+ * array (or property), the element and the byte offset of the token. */
+static void test_ascii_not_finite(void)
+{
+    static const char *const spellings[] = { "nan", "-nan", "NaN", "NAN", "inf", "-inf", "INF", "Inf", "Infinity",
+                                              "-Infinity", "1.#INF", "-1.#INF", "1.#IND", "-1.#IND", "1.#QNAN",
+                                              "1.#SNAN", "1.#INF00", "-1.#IND00", "nan(ind)", "-nan(ind)", "1e999" };
+    static const char *const names[4][2] = { { "Objects/Geometry/Vertices", "control point 1" },
+                                             { "Lcl Translation", "'M'" },
+                                             { "Objects/Geometry/Vertices", "shape 'S' entry 0" },
+                                             { "Objects/AnimationCurve/KeyValueFloat", "key 1" } };
+    size_t offset = 0;
+    char *text = fill("1", -1, &offset);
+    mk_raw_asset raw;
+    mk_error err;
+    mk_result r = ft_import(text, strlen(text), NULL, &raw, &err);
+    CHECK_MSG(r == MK_OK, "finite template: %s", err.message);
+    CHECK_EQ_INT(raw.channel_count, 1);
+    CHECK_EQ_INT(raw.clip_count, 1);
+    mk_raw_free(&raw);
+    free(text);
+    for (size_t i = 0; i < sizeof spellings / sizeof spellings[0]; i++) {
+        for (int slot = 0; slot < 4; slot++) {
+            text = fill(spellings[i], slot, &offset);
+            memset(&err, 0, sizeof err);
+            r = ft_import(text, strlen(text), NULL, &raw, &err);
+            char at[48];
+            snprintf(at, sizeof at, "byte %zu", offset);
+            CHECK_MSG(r == MK_ERROR_NOT_FINITE, "'%s' in slot %d: %s (%s)", spellings[i], slot, mk_result_name(r), err.message);
+            CHECK_MSG(strstr(err.message, "not finite") && strstr(err.message, names[slot][0]) &&
+                          strstr(err.message, names[slot][1]) && strstr(err.message, at),
+                      "'%s' in slot %d: message '%s' should say not finite, name %s, %s and %s", spellings[i], slot,
+                      err.message, names[slot][0], names[slot][1], at);
+            CHECK_MSG(err.offset == offset, "'%s' in slot %d: offset %llu, token at %zu", spellings[i], slot,
+                      (unsigned long long)err.offset, offset);
+            mk_raw_free(&raw);
+            free(text);
+        }
+    }
+}
+
+/* The binary path reports the same error: a NaN control point in a raw array points at the
+ * element's eight bytes, in a zlib array at the array (its elements have no file offset). */
+static void test_binary_not_finite(void)
+{
+    double points[3 * 30];
+    for (int i = 0; i < 90; i++) points[i] = (double)(i % 7);
+    points[4] = NAN;   /* control point 1, y */
+    static const int32_t tri[3] = { 0, 1, ~2 };
+    for (int compress = 0; compress < 2; compress++) {
+        fbxw_mesh mesh;
+        memset(&mesh, 0, sizeof mesh);
+        mesh.name = "M";
+        mesh.control_point_count = 30;   /* 90 doubles: compressed when asked */
+        mesh.control_points = points;
+        mesh.polygon_vertex_count = 3;
+        mesh.polygon_vertex_index = tri;
+        mesh.parent = -1;
+        fbxw_scene scene;
+        memset(&scene, 0, sizeof scene);
+        scene.version = 7500;
+        scene.binary = 1;
+        scene.compress = compress;
+        scene.mesh_count = 1;
+        scene.meshes = &mesh;
+        unsigned char *data;
+        size_t size;
+        CHECK(fbxw_write(&scene, &data, &size) == 0);
+        mk_raw_asset raw;
+        mk_error err;
+        memset(&err, 0, sizeof err);
+        mk_result r = ft_import(data, size, NULL, &raw, &err);
+        CHECK_EQ_INT(r, MK_ERROR_NOT_FINITE);
+        char at[48];
+        snprintf(at, sizeof at, "byte %llu", (unsigned long long)err.offset);
+        CHECK_MSG(strstr(err.message, "Objects/Geometry/Vertices") && strstr(err.message, "control point 1") &&
+                      strstr(err.message, "not finite") && strstr(err.message, at),
+                  "message: %s", err.message);
+        CHECK(err.offset < size);
+        if (err.offset + 8 <= size) {
+            if (compress) CHECK(data[err.offset] == 'd');
+            else CHECK(memcmp(data + err.offset, &points[4], 8) == 0);
+        }
+        mk_raw_free(&raw);
+        free(data);
+    }
+}
+
+/* ---- big-endian binary files ---- */
+
+#define SAME(cond, ...) CHECK_MSG(cond, __VA_ARGS__)
+
+static int same_floats(const float *a, const float *b, size_t n)
+{
+    return (!a && !b) || (a && b && memcmp(a, b, n * sizeof(float)) == 0);
+}
+
+static int same_u32(const uint32_t *a, const uint32_t *b, size_t n)
+{
+    return (!a && !b) || (a && b && memcmp(a, b, n * sizeof(uint32_t)) == 0);
+}
+
+static int same_str(const char *a, const char *b)
+{
+    return (!a && !b) || (a && b && strcmp(a, b) == 0);
+}
+
+/* Every field of two raw models, bit for bit. */
+static void check_same_raw(const mk_raw_asset *a, const mk_raw_asset *b, const char *label)
+{
+    SAME(strcmp(a->source_format, b->source_format) == 0 && strcmp(a->source_creator, b->source_creator) == 0 &&
+             memcmp(&a->unit_scale, &b->unit_scale, sizeof a->unit_scale) == 0 && a->up_axis == b->up_axis,
+         "%s: import facts differ", label);
+    SAME(a->warning_count == b->warning_count, "%s: %u vs %u warnings", label, a->warning_count, b->warning_count);
+    for (uint32_t i = 0; i < a->warning_count && i < b->warning_count && i < MK_RAW_MAX_WARNINGS; i++)
+        SAME(strcmp(a->warnings[i].message, b->warnings[i].message) == 0, "%s: warning %u differs", label, i);
+    SAME(a->mesh_count == b->mesh_count && a->channel_count == b->channel_count && a->clip_count == b->clip_count,
+         "%s: counts differ", label);
+    for (uint32_t m = 0; m < a->mesh_count && m < b->mesh_count; m++) {
+        const mk_raw_mesh *x = &a->meshes[m], *y = &b->meshes[m];
+        SAME(same_str(x->name, y->name) && x->vertex_count == y->vertex_count && x->triangle_count == y->triangle_count &&
+                 x->control_point_count == y->control_point_count && x->gltf_node == y->gltf_node &&
+                 x->gltf_mesh == y->gltf_mesh && x->gltf_primitive == y->gltf_primitive && x->stacking == y->stacking,
+             "%s: mesh %u header differs", label, m);
+        if (x->vertex_count != y->vertex_count || x->triangle_count != y->triangle_count) continue;
+        SAME(same_floats(x->positions, y->positions, 3 * (size_t)x->vertex_count) &&
+                 same_floats(x->normals, y->normals, 3 * (size_t)x->vertex_count) &&
+                 same_floats(x->tangents, y->tangents, 4 * (size_t)x->vertex_count) &&
+                 same_u32(x->triangles, y->triangles, 3 * (size_t)x->triangle_count) &&
+                 same_u32(x->control_points, y->control_points, x->vertex_count) &&
+                 memcmp(x->world, y->world, sizeof x->world) == 0,
+             "%s: mesh %u data differs", label, m);
+    }
+    for (uint32_t c = 0; c < a->channel_count && c < b->channel_count; c++) {
+        const mk_raw_channel *x = &a->channels[c], *y = &b->channels[c];
+        SAME(same_str(x->name, y->name) && same_str(x->origin, y->origin) && x->mesh == y->mesh &&
+                 memcmp(&x->default_weight, &y->default_weight, sizeof(float)) == 0 && x->target_count == y->target_count,
+             "%s: channel %u header differs", label, c);
+        for (uint32_t k = 0; k < x->target_count && k < y->target_count; k++) {
+            const mk_raw_target *t = &x->targets[k], *u = &y->targets[k];
+            SAME(same_str(t->name, u->name) && memcmp(&t->full_weight, &u->full_weight, sizeof(float)) == 0 &&
+                     t->count == u->count, "%s: channel %u target %u header differs", label, c, k);
+            if (t->count != u->count) continue;
+            SAME(same_u32(t->indices, u->indices, t->count) && same_floats(t->positions, u->positions, 3 * (size_t)t->count) &&
+                     same_floats(t->normals, u->normals, 3 * (size_t)t->count) &&
+                     same_floats(t->tangents, u->tangents, 3 * (size_t)t->count),
+                 "%s: channel %u target %u data differs", label, c, k);
+        }
+    }
+    for (uint32_t c = 0; c < a->clip_count && c < b->clip_count; c++) {
+        const mk_raw_clip *x = &a->clips[c], *y = &b->clips[c];
+        SAME(same_str(x->name, y->name) && memcmp(&x->start, &y->start, sizeof(float)) == 0 &&
+                 memcmp(&x->duration, &y->duration, sizeof(float)) == 0 && x->track_count == y->track_count,
+             "%s: clip %u header differs", label, c);
+        for (uint32_t t = 0; t < x->track_count && t < y->track_count; t++)
+            SAME(x->tracks[t].channel == y->tracks[t].channel && x->tracks[t].key_count == y->tracks[t].key_count &&
+                     memcmp(x->tracks[t].keys, y->tracks[t].keys, x->tracks[t].key_count * sizeof(mk_key)) == 0,
+                 "%s: clip %u track %u differs", label, c, t);
+    }
+}
+
+typedef struct parsed { mk_arena arena; mk_error err; fbx_doc doc; mk_result result; } parsed;
+
+static void parse_binary(parsed *p, const unsigned char *data, size_t size)
+{
+    mk_arena_init(&p->arena, NULL);
+    memset(&p->err, 0, sizeof p->err);
+    memset(&p->doc, 0, sizeof p->doc);
+    p->doc.arena = &p->arena;
+    p->doc.data = data;
+    p->doc.size = size;
+    p->doc.err = &p->err;
+    p->doc.binary = 1;
+    p->result = fbx_parse_binary(&p->doc);
+    if (p->result == MK_OK) fbx_link_parents(&p->doc.root);
+}
+
+static void parsed_free(parsed *p)
+{
+    fbx_doc_free(&p->doc);
+    mk_arena_free_all(&p->arena);
+}
+
+/* Two parse trees value by value; arrays decoded as every element type (same values, or the
+ * same error). Offsets are compared when the files have the same layout (no zlib arrays: the
+ * compressed twins differ in length). Returns the number of values compared. */
+static int check_same_tree(parsed *pa, const fbx_node *a, parsed *pb, const fbx_node *b, int same_layout, const char *label)
+{
+    int compared = 0;
+    char path[160];
+    fbx_node_path(a, path, sizeof path);
+    if (!(a->name_length == b->name_length && memcmp(a->name, b->name, a->name_length) == 0 &&
+          a->value_count == b->value_count && a->child_count == b->child_count && (!same_layout || a->offset == b->offset))) {
+        CHECK_MSG(0, "%s: node %s differs", label, path);
+        return compared;
+    }
+    for (uint32_t i = 0; i < a->value_count; i++) {
+        const fbx_value *x = &a->values[i], *y = &b->values[i];
+        int same = x->kind == y->kind && x->type == y->type && x->encoding == y->encoding && x->count == y->count &&
+                   (!same_layout || x->offset == y->offset);
+        if (same && (x->kind == FBX_INT || x->kind == FBX_CHAR)) same = x->u.i == y->u.i;
+        if (same && x->kind == FBX_FLOAT) same = memcmp(&x->u.f, &y->u.f, sizeof x->u.f) == 0;
+        if (same && x->kind == FBX_STRING)
+            same = x->u.s.length == y->u.s.length && memcmp(x->u.s.data, y->u.s.data, x->u.s.length) == 0;
+        if (same && x->kind == FBX_ARRAY && a->value_count == 1) {
+            static const fbx_elem elems[5] = { FBX_ELEM_F64, FBX_ELEM_F32, FBX_ELEM_I32, FBX_ELEM_I64, FBX_ELEM_F32_BITS };
+            for (int e = 0; e < 5 && same; e++) {
+                void *da = NULL, *db = NULL;
+                size_t na = 0, nb = 0;
+                mk_result ra = fbx_node_array(&pa->doc, a, elems[e], &da, &na);
+                mk_result rb = fbx_node_array(&pb->doc, b, elems[e], &db, &nb);
+                size_t esize = (elems[e] == FBX_ELEM_F64 || elems[e] == FBX_ELEM_I64) ? 8 : 4;
+                same = ra == rb && na == nb && (ra != MK_OK || na == 0 || memcmp(da, db, na * esize) == 0);
+                if (ra == MK_OK) mk_arena_release(&pa->arena, da);
+                if (rb == MK_OK) mk_arena_release(&pb->arena, db);
+            }
+        }
+        CHECK_MSG(same, "%s: %s value %u (type '%c') differs", label, path, i, x->type);
+        compared++;
+    }
+    for (uint32_t c = 0; c < a->child_count; c++)
+        compared += check_same_tree(pa, &a->children[c], pb, &b->children[c], same_layout, label);
+    return compared;
+}
+
+/* The type zoo as a big-endian reader must see it (the writer's values, not just equal ones). */
+static void check_type_zoo(parsed *p, const char *label)
+{
+    const fbx_node *zoo = fbx_child(&p->doc.root, "MorphkitTypes");
+    CHECK_MSG(zoo && zoo->value_count == 10 && zoo->child_count == 12, "%s: type zoo missing", label);
+    if (!zoo || zoo->value_count != 10 || zoo->child_count != 12) return;
+    const fbx_value *v = zoo->values;
+    CHECK(v[0].type == 'Y' && v[0].u.i == -12345);
+    CHECK(v[1].type == 'C' && v[1].u.i == 'x');
+    CHECK(v[2].type == 'B' && v[2].u.i == 200);
+    CHECK(v[3].type == 'Z' && v[3].u.i == 1);
+    CHECK(v[4].type == 'I' && v[4].u.i == -123456789);
+    CHECK(v[5].type == 'L' && v[5].u.i == -1234567890123456789LL);
+    CHECK(v[6].type == 'F' && v[6].u.f == (double)-3.25e-3f);
+    CHECK(v[7].type == 'D' && v[7].u.f == 0.1);
+    CHECK(v[8].type == 'S' && v[8].u.s.length == 11 && memcmp(v[8].u.s.data, "name\0\1Class", 11) == 0);
+    CHECK(v[9].type == 'R' && v[9].u.s.length == 5 && memcmp(v[9].u.s.data, "\x00\x01\x02\xff\x80", 5) == 0);
+    static const double expect[6][5] = {
+        { 0.1, -2.5e10, 1e-300, 3.0, -0.0 },
+        { (double)1e-3f, -7.5, (double)3.0e38f, 0.0, (double)(1.0f / 3.0f) },
+        { (double)0x0102030405060708LL, -2, (double)INT64_MIN, 46186158000.0, 0 },
+        { (double)0x01020304, -2, (double)INT32_MIN, 7, 0 },
+        { 0, 1, 255, 128, 2 },
+        { 'a', 'Y', 0, 'T', 'N' } };
+    static const int64_t expect_l[5] = { 0x0102030405060708LL, -2, INT64_MIN, 46186158000LL, 0 };
+    for (uint32_t c = 0; c < 12; c++) {
+        const fbx_node *n = &zoo->children[c];
+        int a = (int)c / 2;
+        double *d = NULL;
+        size_t count = 0;
+        mk_result r = fbx_node_array(&p->doc, n, FBX_ELEM_F64, (void **)&d, &count);
+        CHECK_MSG(r == MK_OK && count == 5, "%s: zoo array %u: %s", label, c, p->err.message);
+        for (size_t k = 0; r == MK_OK && k < count; k++)
+            CHECK_MSG(d[k] == expect[a][k], "%s: zoo array %u[%zu] = %g, expected %g", label, c, k, d[k], expect[a][k]);
+        if (r == MK_OK) mk_arena_release(&p->arena, d);
+        if (a == 2) {  /* int64 exactly */
+            int64_t *l = NULL;
+            r = fbx_node_array(&p->doc, n, FBX_ELEM_I64, (void **)&l, &count);
+            CHECK(r == MK_OK && count == 5 && memcmp(l, expect_l, sizeof expect_l) == 0);
+            if (r == MK_OK) mk_arena_release(&p->arena, l);
+        }
+    }
+}
+
+/* A big-endian file imports to exactly the raw model of its little-endian twin: 13- and 25-byte
+ * records, raw and zlib arrays (some, all), and with the type mix every property type where
+ * the importer reads it; the parse trees agree value by value (arrays decoded as every element
+ * type), and the type zoo reads back the values the writer put in. */
+static void test_big_endian_twins(void)
+{
+    static const uint32_t be_versions[] = { 7100, 7400, 7500, 7700 };
+    int compared = 0;
+    for (size_t v = 0; v < sizeof be_versions / sizeof be_versions[0]; v++)
+        for (int compress = 0; compress < 3; compress++)
+            for (int mix = 0; mix < 2; mix++) {
+                char label[64];
+                snprintf(label, sizeof label, "%u compress %d%s", be_versions[v], compress, mix ? " type mix" : "");
+                unsigned char *data[2] = { NULL, NULL };
+                size_t size[2] = { 0, 0 };
+                for (int big = 0; big < 2; big++) {
+                    fbxw_scene scene;
+                    fixture_cube(&scene, be_versions[v], 1, compress);
+                    scene.big_endian = big;
+                    scene.type_mix = mix;
+                    CHECK(fbxw_write(&scene, &data[big], &size[big]) == 0);
+                }
+                if (!data[0] || !data[1]) { free(data[0]); free(data[1]); continue; }
+                int same_layout = compress == 0 && !mix;
+                CHECK(data[1][22] == 1 && data[0][22] == 0 && (!same_layout || size[0] == size[1]));
+                mk_raw_asset raw[2];
+                mk_error err[2];
+                mk_result r[2];
+                for (int big = 0; big < 2; big++) r[big] = ft_import(data[big], size[big], NULL, &raw[big], &err[big]);
+                CHECK_MSG(r[0] == MK_OK, "%s little-endian: %s", label, err[0].message);
+                CHECK_MSG(r[1] == MK_OK, "%s big-endian: %s", label, err[1].message);
+                if (r[0] == MK_OK && r[1] == MK_OK) {
+                    check_box_import(&raw[1], label);
+                    check_same_raw(&raw[0], &raw[1], label);
+                    CHECK(strstr(raw[1].source_format, "binary") != NULL);
+                }
+                mk_raw_free(&raw[0]);
+                mk_raw_free(&raw[1]);
+                parsed pa, pb;
+                parse_binary(&pa, data[0], size[0]);
+                parse_binary(&pb, data[1], size[1]);
+                CHECK_MSG(pa.result == MK_OK && pb.result == MK_OK, "%s: parse %s / %s", label, pa.err.message, pb.err.message);
+                if (pa.result == MK_OK && pb.result == MK_OK) {
+                    CHECK(pb.doc.header_version == be_versions[v]);
+                    CHECK_EQ_INT(pa.doc.root.child_count, pb.doc.root.child_count);
+                    for (uint32_t c = 0; c < pa.doc.root.child_count && c < pb.doc.root.child_count; c++)
+                        compared += check_same_tree(&pa, &pa.doc.root.children[c], &pb, &pb.doc.root.children[c],
+                                                    same_layout, label);
+                    if (mix) {
+                        check_type_zoo(&pa, label);
+                        check_type_zoo(&pb, label);
+                    }
+                }
+                parsed_free(&pa);
+                parsed_free(&pb);
+                free(data[0]);
+                free(data[1]);
+            }
+    fprintf(stderr, "big-endian twins: %d values compared\n", compared);
+    CHECK(compared > 1000);
 }
 
 /* ---- hostile constructs: clear errors ---- */
@@ -817,6 +1412,21 @@ static int write_seeds(const char *dir)
             if (f) fclose(f);
             free(data);
         }
+    /* Big-endian, every property type, all arrays compressed. */
+    for (size_t v = 0; v < sizeof versions / sizeof versions[0]; v++) {
+        fbxw_scene scene;
+        fixture_cube(&scene, versions[v], 1, 2);
+        scene.big_endian = 1;
+        scene.type_mix = 1;
+        unsigned char *data = NULL;
+        size_t size = 0;
+        char path[1024];
+        snprintf(path, sizeof path, "%s/fixture_%u_big_endian.fbx", dir, versions[v]);
+        FILE *f = fbxw_write(&scene, &data, &size) == 0 ? fopen(path, "wb") : NULL;
+        if (!f || fwrite(data, 1, size, f) != size) failures++;
+        if (f) fclose(f);
+        free(data);
+    }
     char path[1024];
     snprintf(path, sizeof path, "%s/fixture_legacy61.fbx", dir);
     FILE *f = fopen(path, "wb");
@@ -827,8 +1437,11 @@ static int write_seeds(const char *dir)
 
 static const check_case cases[] = {
     CASE(test_formats_roundtrip), CASE(test_stacking_option), CASE(test_curves), CASE(test_blender_full_weights),
-    CASE(test_duplicate_full_weights), CASE(test_hostile_constructs), CASE(test_allocation_failures),
-    CASE(test_rotation_order), CASE(test_legacy_61_ascii), CASE(test_inherit_type),
+    CASE(test_duplicate_full_weights), CASE(test_tiny_full_weights), CASE(test_hostile_constructs),
+    CASE(test_allocation_failures), CASE(test_rotation_order), CASE(test_legacy_61_ascii), CASE(test_inherit_type),
+    CASE(test_empty_mesh_skipped), CASE(test_skipped_mesh_warnings),
+    CASE(test_ascii_array_comments), CASE(test_ascii_not_finite), CASE(test_binary_not_finite),
+    CASE(test_big_endian_twins),
 };
 
 int main(int argc, char **argv)

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include "check.h"
 #include "gltf_import.h"
@@ -185,6 +186,163 @@ static void test_missing_buffer_file(void)
     fixture_default(&f);
     json = edit(fixture_json(&f), "data:application/octet-stream;base64,", "x.bin#");
     expect_error(json, MK_ERROR_PARSE, "x.bin");
+}
+
+/* A node whose mesh has no morph targets is not imported (only morphing meshes are), but the
+ * user is told which one and why. */
+static void test_plain_mesh_warns(void)
+{
+    fixture f;
+    fixture_default(&f);
+    char *json = fixture_json(&f);
+    json = edit(json, "\"translation\":[1,2,3]}]", "\"translation\":[1,2,3]},{\"name\":\"rock\",\"mesh\":1}]");
+    json = edit(json, "\"extras\":{\"targetNames\":[\"up\"]}}]",
+                "\"extras\":{\"targetNames\":[\"up\"]}},{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":2}]}]");
+    mk_raw_asset raw;
+    mk_error err;
+    mk_result r = import_text(json, &raw, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    CHECK_EQ_INT(raw.mesh_count, 1);
+    int warned = 0;
+    for (uint32_t i = 0; i < raw.warning_count && i < MK_RAW_MAX_WARNINGS; i++)
+        warned |= strstr(raw.warnings[i].message, "'rock'") && strstr(raw.warnings[i].message, "no morph targets");
+    CHECK_MSG(warned, "no warning names the skipped node 'rock'");
+    mk_raw_free(&raw);
+    free(json);
+}
+
+/* ---- external URIs resolve against the glTF file's folder only ---- */
+
+static int write_file(const char *path, const void *data, size_t size)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) return 0;
+    int ok = fwrite(data, 1, size, f) == size;
+    return fclose(f) == 0 && ok;
+}
+
+/* The corpus AnimatedMorphCube .gltf text with its buffer URI replaced by `uri` (malloc'ed),
+ * and its .bin; NULL when the corpus is absent. */
+static char *cube_gltf(const char *uri, unsigned char **bin, size_t *bin_size)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/gltf/AnimatedMorphCube/glTF/AnimatedMorphCube.bin", check_corpus_dir());
+    *bin = check_read_file(path, bin_size);
+    snprintf(path, sizeof path, "%s/gltf/AnimatedMorphCube/glTF/AnimatedMorphCube.gltf", check_corpus_dir());
+    size_t size;
+    char *text = (char *)check_read_file(path, &size);
+    if (!text || !*bin) { free(text); free(*bin); *bin = NULL; return NULL; }
+    return edit(text, "\"uri\": \"AnimatedMorphCube.bin\"", uri);
+}
+
+/* Imports `path` and expects `code` with every needle in the message (code MK_OK: success). */
+static void expect_import(const char *path, mk_result code, const char *n1, const char *n2)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_error err = {0};
+    mk_result r = mk_import_gltf(path, NULL, &raw, &err);
+    CHECK_MSG(r == code, "%s: expected %s, got %s (%s)", path, mk_result_name(code), mk_result_name(r), err.message);
+    if (code != MK_OK) {
+        CHECK_MSG(strstr(err.message, n1) && (!n2 || strstr(err.message, n2)), "%s: message '%s' should name '%s' and '%s'",
+                  path, err.message, n1, n2 ? n2 : "");
+        printf("  %s\n", err.message);
+    } else {
+        CHECK_EQ_INT(raw.channel_count, 2);
+    }
+    mk_raw_free(&raw);
+}
+
+/* A .gltf copied into a folder without its .bin must not pick up a same-named .bin from the
+ * current directory: the error names the URI and the path tried. */
+static void test_buffer_not_from_working_directory(void)
+{
+    unsigned char *bin;
+    size_t bin_size;
+    char *json = cube_gltf("\"uri\": \"AnimatedMorphCube.bin\"", &bin, &bin_size);
+    if (!json) SKIP("corpus not found at %s", check_corpus_dir());
+    char gltf_dir[] = "/tmp/morphkit_nobin_XXXXXX", cwd_dir[] = "/tmp/morphkit_cwd_XXXXXX";
+    CHECK(mkdtemp(gltf_dir) && mkdtemp(cwd_dir));
+    char saved[4096], gltf_path[256], cwd_bin[256], next_bin[256], relative[256], tried[300], tried_relative[300];
+    CHECK(getcwd(saved, sizeof saved) != NULL);
+    snprintf(gltf_path, sizeof gltf_path, "%s/AnimatedMorphCube.gltf", gltf_dir);
+    snprintf(cwd_bin, sizeof cwd_bin, "%s/AnimatedMorphCube.bin", cwd_dir);
+    snprintf(next_bin, sizeof next_bin, "%s/AnimatedMorphCube.bin", gltf_dir);
+    snprintf(tried, sizeof tried, "'%s'", next_bin);
+    /* The same file by a relative path from the working directory (both folders are in /tmp). */
+    snprintf(relative, sizeof relative, "../%s/AnimatedMorphCube.gltf", gltf_dir + 5);
+    snprintf(tried_relative, sizeof tried_relative, "'../%s/AnimatedMorphCube.bin'", gltf_dir + 5);
+    CHECK(write_file(gltf_path, json, strlen(json)) && write_file(cwd_bin, bin, bin_size));
+    CHECK(chdir(cwd_dir) == 0);
+    expect_import(gltf_path, MK_ERROR_IO, "'AnimatedMorphCube.bin'", tried);
+    expect_import(relative, MK_ERROR_IO, "'AnimatedMorphCube.bin'", tried_relative);
+    /* With the .bin next to the .gltf it imports, from any working directory. */
+    CHECK(write_file(next_bin, bin, bin_size));
+    expect_import(gltf_path, MK_OK, NULL, NULL);
+    expect_import(relative, MK_OK, NULL, NULL);
+    CHECK(chdir(saved) == 0);
+    remove(next_bin);
+    remove(gltf_path);
+    remove(cwd_bin);
+    rmdir(gltf_dir);
+    rmdir(cwd_dir);
+    free(json);
+    free(bin);
+}
+
+/* data: URIs work from disk; relative URIs (also with "..") resolve against the .gltf's folder;
+ * absolute paths and other schemes are refused with an error naming the URI, even when the
+ * file they name exists. */
+static void test_external_uri_rules(void)
+{
+    unsigned char *bin;
+    size_t bin_size;
+    char *probe = cube_gltf("\"uri\": \"x\"", &bin, &bin_size);
+    if (!probe) SKIP("corpus not found at %s", check_corpus_dir());
+    free(probe);
+    char parent[] = "/tmp/morphkit_uris_XXXXXX", cwd_dir[] = "/tmp/morphkit_cwd_XXXXXX";
+    CHECK(mkdtemp(parent) && mkdtemp(cwd_dir));
+    char sub[256], bin_path[256], gltf_path[300], saved[4096], uri[400];
+    snprintf(sub, sizeof sub, "%s/sub", parent);
+    snprintf(bin_path, sizeof bin_path, "%s/AnimatedMorphCube.bin", parent);
+    snprintf(gltf_path, sizeof gltf_path, "%s/AnimatedMorphCube.gltf", sub);
+    CHECK(mkdir(sub, 0700) == 0 && write_file(bin_path, bin, bin_size));
+    free(bin);
+    CHECK(getcwd(saved, sizeof saved) != NULL);
+    CHECK(chdir(cwd_dir) == 0);
+    /* The buffer one folder up. */
+    char *json = cube_gltf("\"uri\": \"../AnimatedMorphCube.bin\"", &bin, &bin_size);
+    CHECK(json && write_file(gltf_path, json, strlen(json)));
+    expect_import(gltf_path, MK_OK, NULL, NULL);
+    free(json);
+    free(bin);
+    /* Absolute path to that same existing file, plain and percent-encoded, and as file: URI. */
+    static const char *const forms[3] = { "\"uri\": \"%s\"", "\"uri\": \"%%2F%s\"", "\"uri\": \"file://%s\"" };
+    for (int k = 0; k < 3; k++) {
+        snprintf(uri, sizeof uri, forms[k], k == 1 ? bin_path + 1 : bin_path);
+        json = cube_gltf(uri, &bin, &bin_size);
+        CHECK(json && write_file(gltf_path, json, strlen(json)));
+        expect_import(gltf_path, MK_ERROR_UNSUPPORTED, "AnimatedMorphCube.bin", k == 2 ? "scheme" : "absolute");
+        free(json);
+        free(bin);
+    }
+    /* A data: URI from disk (the fixture's buffer), imported from another working directory. */
+    fixture f;
+    fixture_default(&f);
+    json = fixture_json(&f);
+    CHECK(write_file(gltf_path, json, strlen(json)));
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_error err = {0};
+    CHECK_MSG(mk_import_gltf(gltf_path, NULL, &raw, &err) == MK_OK, "%s", err.message);
+    mk_raw_free(&raw);
+    free(json);
+    CHECK(chdir(saved) == 0);
+    remove(gltf_path);
+    remove(bin_path);
+    rmdir(sub);
+    rmdir(parent);
+    rmdir(cwd_dir);
 }
 
 static void test_index_out_of_range(void)
@@ -444,7 +602,8 @@ static void test_corpus_mutations(void)
     printf("  %d mutated imports without a crash\n", runs);
 }
 
-CHECK_MAIN(CASE(test_fixture_is_valid), CASE(test_missing_buffer_file), CASE(test_index_out_of_range),
+CHECK_MAIN(CASE(test_fixture_is_valid), CASE(test_missing_buffer_file), CASE(test_plain_mesh_warns),
+           CASE(test_buffer_not_from_working_directory), CASE(test_external_uri_rules), CASE(test_index_out_of_range),
            CASE(test_accessor_counts_disagree), CASE(test_not_finite), CASE(test_cubicspline_one_key),
            CASE(test_structure_errors), CASE(test_sidecar), CASE(test_allocation_failures),
            CASE(test_corpus_mutations))
