@@ -285,5 +285,16 @@ for v in verbs_all:
 rc, out, err = run("bench", "--vertices", "5000", "--channels", "4", "--active", "2", "--frames", "3")
 check("bench piped prints no progress", rc == 0 and err == "", err)
 
+if os.path.exists("/usr/bin/script"):
+    cmd = "'%s' bench --vertices 300000 --channels 10 --active 3 --frames 20" % mk
+    p = subprocess.run(["script", "-qec", cmd, "/dev/null"], capture_output=True, text=True, timeout=300)
+    check("bench on a terminal shows progress", "building the synthetic asset" in p.stdout and "timing passes" in p.stdout,
+          p.stdout[-500:])
+    p = subprocess.run(["script", "-qec", cmd + " --quiet", "/dev/null"], capture_output=True, text=True, timeout=300)
+    check("--quiet silences progress, not results", "timing passes" not in p.stdout and "ns_per_frame" in p.stdout,
+          p.stdout[-500:])
+else:
+    skip("progress on a terminal", "script(1) not found")
+
 print("%d passed, %d failed, %d skipped" % (passed, failed, skipped))
 sys.exit(1 if failed else 0)
