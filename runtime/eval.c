@@ -513,26 +513,56 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
 #endif
 }
 
+/* The frame's per-target coefficients in the job's scratch. */
+static void prepare_frame(const mk_eval_job *job, frame *f)
+{
+    const mk_asset *a = job->asset;
+    const mk_blob_mesh *m = &a->meshes[job->mesh];
+    mk_stacking stacking = job->stacking == MK_STACKING_ASSET ? (mk_stacking)m->stacking : job->stacking;
+    uint8_t *scratch = job->scratch;
+    f->asset = a;
+    f->mesh = m;
+    f->targets = &a->targets[m->first_target];
+    f->coef = (float *)(void *)scratch;
+    f->slerp_channel = (int32_t *)(void *)(scratch + align16((size_t)m->target_count * sizeof(float)));
+    f->spans = (channel_span *)(void *)(scratch + align16((size_t)m->target_count * sizeof(float))
+                                        + align16((size_t)m->target_count * sizeof(int32_t)));
+    f->slerp = job->normals != NULL && job->normal_mode == MK_NORMALS_SLERP;
+    compute_coefficients(f, job, stacking);
+}
+
 mk_result mk_eval_run(const mk_eval_job *job, mk_error *err)
 {
     mk_result r = mk_eval_validate(job, err);
     if (r != MK_OK || job_vertex_count(job) == 0) return r;
-    const mk_asset *a = job->asset;
-    const mk_blob_mesh *m = &a->meshes[job->mesh];
-    mk_stacking stacking = job->stacking == MK_STACKING_ASSET ? (mk_stacking)m->stacking : job->stacking;
-
-    uint8_t *scratch = job->scratch;
     frame f;
-    f.asset = a;
-    f.mesh = m;
-    f.targets = &a->targets[m->first_target];
-    f.coef = (float *)(void *)scratch;
-    f.slerp_channel = (int32_t *)(void *)(scratch + align16((size_t)m->target_count * sizeof(float)));
-    f.spans = (channel_span *)(void *)(scratch + align16((size_t)m->target_count * sizeof(float))
-                                       + align16((size_t)m->target_count * sizeof(int32_t)));
-    f.slerp = job->normals != NULL && job->normal_mode == MK_NORMALS_SLERP;
-    compute_coefficients(&f, job, stacking);
-
+    prepare_frame(job, &f);
     eval_blocks(job, &f);
     return MK_OK;
+}
+
+uint64_t mk_eval_traffic(const mk_eval_job *job)
+{
+    if (mk_eval_validate(job, NULL) != MK_OK || job_vertex_count(job) == 0) return 0;
+    frame f;
+    prepare_frame(job, &f);
+    const mk_blob_mesh *m = f.mesh;
+    const uint32_t first = job->first_vertex, n = job_vertex_count(job), end = first + n;
+    const uint32_t *block_first = (const uint32_t *)(job->asset->data + m->block_entries);
+    const mk_blob_entry *entries = (const mk_blob_entry *)(job->asset->data + m->entries);
+    uint32_t strip = 0;
+    if (!job->normals) strip |= MK_TARGET_HAS_NORMALS;
+    if (!job->tangents) strip |= MK_TARGET_HAS_TANGENTS;
+    const uint32_t b0 = first / MK_BLOCK_SIZE, b1 = (end + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
+    uint64_t bytes = 4u * (uint64_t)(b1 - b0 + 1);                      /* block table */
+    for (uint32_t e = block_first[b0]; e < block_first[b1]; e++) {
+        bytes += sizeof(mk_blob_entry);                                 /* every header is read */
+        if (f.coef[entries[e].target] == 0.0f) continue;
+        uint32_t flags = f.targets[entries[e].target].flags & ~strip;
+        bytes += mk_entry_data_size(flags, mk_popcount64(entries[e].mask));
+    }
+    /* Base arrays read and outputs written. */
+    bytes += (uint64_t)n * 12u * 2u * (job->normals ? 2u : 1u);
+    if (job->tangents) bytes += (uint64_t)n * 16u * 2u;
+    return bytes;
 }

@@ -133,7 +133,7 @@ typedef struct mk_blob_track {
 
 /* Smallest |full weight| and smallest gap between a channel's key points (including the
  * implicit 0): keeps span parameters finite for any reasonable weight. */
-#define MK_MIN_FULL_WEIGHT_GAP 1e-6f
+/* MK_MIN_FULL_WEIGHT_GAP is public (morphkit.h). */
 
 /* Bit helpers with a portable fallback (the runtime must build with any C11 compiler). */
 static inline uint32_t mk_popcount64(uint64_t x)

@@ -437,6 +437,11 @@ mk_result mk_asset_open(const void *data, size_t size, mk_asset *out, mk_error *
 
 static const char *string_at(const mk_asset *a, uint32_t offset) { return a->strings + offset; }
 
+int mk_is_blob(const void *data, size_t size)
+{
+    return data && size >= 8 && memcmp(data, MK_MAGIC, 8) == 0;
+}
+
 int mk_mesh_get(const mk_asset *a, uint32_t mesh, mk_mesh_info *out)
 {
     if (!a || !out || mesh >= a->mesh_count) return 0;
@@ -449,6 +454,8 @@ int mk_mesh_get(const mk_asset *a, uint32_t mesh, mk_mesh_info *out)
     out->first_channel = m->first_channel;
     out->channel_count = m->channel_count;
     out->target_count = m->target_count;
+    out->target_bytes = m->target_data_size;
+    out->entry_count = m->entry_count;
     out->stacking = (mk_stacking)m->stacking;
     out->has_normals = (m->flags & MK_MESH_HAS_NORMALS) != 0;
     out->has_tangents = (m->flags & MK_MESH_HAS_TANGENTS) != 0;

@@ -1,7 +1,7 @@
 #include <string.h>
 #include "asset_load.h"
-#include "format.h"
 
+/* A .morph blob is opened as it is; the first bytes tell. */
 static int is_morph(const char *path)
 {
     FILE *f = fopen(path, "rb");
@@ -9,7 +9,7 @@ static int is_morph(const char *path)
     char magic[8] = { 0 };
     size_t n = fread(magic, 1, 8, f);
     fclose(f);
-    return n == 8 && memcmp(magic, MK_MAGIC, 8) == 0;
+    return mk_is_blob(magic, n);
 }
 
 mk_result load_asset(const char *path, const mk_import_options *import, const mk_write_options *write,

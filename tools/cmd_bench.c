@@ -22,7 +22,6 @@
 #include <time.h>
 #include <unistd.h>
 #include "asset_load.h"
-#include "format.h"
 #include "frame.h"
 
 typedef struct bench_options {
@@ -306,34 +305,22 @@ static double least_thread_share(const bench_ctx *c)
     return total ? (double)least / (double)total : 0;
 }
 
-/* Bytes a frame must touch: block tables and entry headers of the mesh, the data of entries
- * whose target is active, base positions (+ normals) read and outputs written. */
-static double frame_bytes(const mk_asset *a, const float *weights, int normals)
+/* Bytes a frame must touch (mk_eval_traffic, summed over the meshes). */
+static double frame_bytes(const mk_asset *a, const float *weights, int normals, void *scratch)
 {
     double bytes = 0;
     for (uint32_t mi = 0; mi < a->mesh_count; mi++) {
-        const mk_blob_mesh *m = &a->meshes[mi];
-        uint8_t *active = calloc(m->target_count + 1u, 1);
-        for (uint32_t c = m->first_channel; c < m->first_channel + m->channel_count; c++) {
-            const mk_blob_channel *ch = &a->channels[c];
-            int32_t ia, ib;
-            float ca, cb;
-            if (weights[c] == 0) continue;
-            frame_channel_span(a, c, weights[c], &ia, &ca, &ib, &cb);
-            if (ia >= 0 && ca != 0) active[ch->first_target - m->first_target + (uint32_t)ia] = 1;
-            if (ib >= 0 && cb != 0) active[ch->first_target - m->first_target + (uint32_t)ib] = 1;
-        }
-        const mk_blob_entry *e = (const mk_blob_entry *)(a->data + m->entries);
-        bytes += 16.0 * (double)m->entry_count + 4.0 * (m->block_count + 1);
-        for (uint64_t k = 0; k < m->entry_count; k++) {
-            if (!active[e[k].target]) continue;
-            uint32_t flags = a->targets[m->first_target + e[k].target].flags;
-            if (!normals) flags &= ~(uint32_t)(MK_TARGET_HAS_NORMALS | MK_TARGET_HAS_TANGENTS);
-            bytes += (double)mk_entry_data_size(flags, mk_popcount64(e[k].mask));
-        }
-        int with_normals = normals && (m->flags & MK_MESH_HAS_NORMALS);
-        bytes += (double)m->vertex_count * 12.0 * 2 * (with_normals ? 2 : 1);
-        free(active);
+        mk_mesh_info m;
+        mk_mesh_get(a, mi, &m);
+        static float sink[3];
+        mk_eval_job job = {
+            .asset = a, .mesh = mi, .vertex_count = MK_VERTICES_TO_END, .weights = weights + m.first_channel,
+            .weight_count = m.channel_count, .scratch = scratch, .scratch_size = mk_eval_scratch_size(a, mi),
+            /* Output spans are only validated, never written. */
+            .positions = sink, .positions_stride = 12, .positions_size = SIZE_MAX,
+            .normals = normals && m.has_normals ? sink : NULL, .normals_stride = 12, .normals_size = SIZE_MAX,
+        };
+        bytes += (double)mk_eval_traffic(&job);
     }
     return bytes;
 }
@@ -348,7 +335,11 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
     mk_raw_init(&raw, NULL);
     mk_error err;
     if (mk_read_blob(a, &raw, &err)) { fprintf(stderr, "bench: %s\n", err.message); exit(1); }
-    /* Which targets are ever active: only those get dense arrays (memory). */
+    /* Which targets are ever active: only those get dense arrays (memory). Targets are
+     * numbered across the asset, channel by channel, as in the blob. */
+    uint32_t *first_target = calloc(raw.channel_count + 1u, sizeof *first_target);
+    if (!first_target) { fprintf(stderr, "bench: out of memory\n"); exit(1); }
+    for (uint32_t c = 0; c < raw.channel_count; c++) first_target[c + 1] = first_target[c] + raw.channels[c].target_count;
     double total = 0;
     *diff = 0;
     for (uint32_t mi = 0; mi < raw.mesh_count; mi++) {
@@ -373,8 +364,8 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
                         dp[3 * (size_t)t->indices[j] + (size_t)d] = t->positions[3 * (size_t)j + (size_t)d];
                         if (t->normals) dn[3 * (size_t)t->indices[j] + (size_t)d] = t->normals[3 * (size_t)j + (size_t)d];
                     }
-                dense_p[a->channels[c].first_target + k] = dp;
-                dense_n[a->channels[c].first_target + k] = dn;
+                dense_p[first_target[c] + k] = dp;
+                dense_n[first_target[c] + k] = dn;
             }
         }
         double best = INFINITY;
@@ -389,12 +380,11 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
                     int32_t ia, ib;
                     float ca, cb;
                     frame_channel_span(a, c, w[c], &ia, &ca, &ib, &cb);
-                    const uint32_t first_target = a->channels[c].first_target;
                     for (int side = 0; side < 2; side++) {
                         int32_t k = side ? ib : ia;
                         float coef = side ? cb : ca;
-                        if (k < 0 || !dense_p[first_target + (uint32_t)k]) continue;
-                        const float *dp = dense_p[first_target + (uint32_t)k], *dn = dense_n[first_target + (uint32_t)k];
+                        if (k < 0 || !dense_p[first_target[c] + (uint32_t)k]) continue;
+                        const float *dp = dense_p[first_target[c] + (uint32_t)k], *dn = dense_n[first_target[c] + (uint32_t)k];
                         for (size_t i = 0; i < 3 * n; i++) out_p[i] += coef * dp[i];
                         if (m->normals) for (size_t i = 0; i < 3 * n; i++) out_n[i] += coef * dn[i];
                     }
@@ -426,6 +416,7 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
         free(out_p);
         free(out_n);
     }
+    free(first_target);
     mk_raw_free(&raw);
     return total;
 }
@@ -597,7 +588,7 @@ static int run_bench(void *p)
         for (uint32_t t = 1; t < o.threads; t++) pthread_join(threads[t], NULL);
     }
     double bytes = 0;
-    for (uint32_t f = 0; f < frames; f++) bytes += frame_bytes(a, weights + (size_t)f * a->channel_count, 1);
+    for (uint32_t f = 0; f < frames; f++) bytes += frame_bytes(a, weights + (size_t)f * a->channel_count, 1, ctx.scratch[0]);
     bytes /= frames;
     for (int i = 0; i < 5; i++) copy_probe_sample(ctx.probe);
     double bandwidth = copy_probe_bandwidth(&probe);
@@ -615,7 +606,7 @@ static int run_bench(void *p)
                ns, ns_positions, bytes, bound_ns, bound_ns / ns, naive_ns, naive_ns / ns, ns_sequential / ns);
     } else {
         uint32_t vertices = 0;
-        for (uint32_t mi = 0; mi < a->mesh_count; mi++) vertices += a->meshes[mi].vertex_count;
+        for (uint32_t mi = 0; mi < a->mesh_count; mi++) { mk_mesh_info m; mk_mesh_get(a, mi, &m); vertices += m.vertex_count; }
         printf("asset: %s, %u meshes, %u vertices, %u channels, %u targets, blob %.1f MB (built in %.1f s)\n",
                file ? file : "synthetic", a->mesh_count, vertices, a->channel_count, a->target_count,
                (double)l.blob_size / 1e6, t_build / 1e9);

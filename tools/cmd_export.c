@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli.h"
-#include "gltf_import.h"
+#include "gltf_export.h"
 
 typedef struct export_args {
     const char *input, *output, *sidecar, *channels;

@@ -5,7 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include "asset_load.h"
-#include "format.h"
 #include "json_write.h"
 
 static void precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *floats, double *max_error_bound)
@@ -53,7 +52,7 @@ static void print_text(FILE *f, const loaded_asset *l, const char *path)
                m.stacking == MK_STACKING_SEQUENTIAL ? "sequential" : "additive");
         if (m.gltf_node >= 0) fprintf(f, ", glTF node %d mesh %d primitive %d", m.gltf_node, m.gltf_mesh, m.gltf_primitive);
         fprintf(f, "\n  target data: %llu bytes in %llu block entries\n",
-               (unsigned long long)a->meshes[i].target_data_size, (unsigned long long)a->meshes[i].entry_count);
+               (unsigned long long)m.target_bytes, (unsigned long long)m.entry_count);
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
             mk_channel_info ch;
             mk_channel_get(a, c, &ch);
@@ -115,7 +114,7 @@ static void print_json(FILE *f, const loaded_asset *l, const char *path)
         json_int(&w, "gltf_mesh", m.gltf_mesh);
         json_int(&w, "gltf_primitive", m.gltf_primitive);
         json_floats(&w, "world", m.world, 16);
-        json_int(&w, "target_bytes", (long long)a->meshes[i].target_data_size);
+        json_int(&w, "target_bytes", (long long)m.target_bytes);
         json_array(&w, "channels");
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
             mk_channel_info ch;

@@ -28,6 +28,7 @@
 #include <time.h>
 #include <unistd.h>
 #include "fbx_writer.h"
+#include "fbx_import.h"
 #include "import.h"
 
 static double now(void)

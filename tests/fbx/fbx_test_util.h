@@ -4,6 +4,7 @@
 #define MK_TESTS_FBX_UTIL_H
 
 #include "blob_io.h"
+#include "fbx_import.h"
 #include "import.h"
 
 /* Imports `data` (options may be NULL) into raw (initialized here). Returns the result. */

@@ -21,7 +21,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     options.max_input_size = (size_t)64 << 20;
     mk_error err;
     err.message[0] = 0;
-    mk_result r = mk_import_gltf_memory(data, size, NULL, &options, &raw, &err);
+    mk_result r = mk_import_gltf(data, size, &options, &raw, &err);
     if (r != MK_OK && err.message[0] == 0) abort();   /* an error must say what went wrong */
     mk_raw_free(&raw);
     return 0;

@@ -30,7 +30,7 @@ int gt_load(gt_model *m, const char *path, const char *sidecar, char *msg, size_
     mk_import_options o = {0};
     o.channels_sidecar = sidecar;
     mk_error err = {0};
-    if (mk_import_gltf(path, &o, &m->raw, &err) != MK_OK) {
+    if (mk_import_file(path, &o, &m->raw, &err) != MK_OK) {
         snprintf(msg, msg_size, "import: %s", err.message);
         return 1;
     }

@@ -6,7 +6,9 @@
 
 #include <cjson/cJSON.h>
 #include "blob_io.h"
+#include "gltf_export.h"
 #include "gltf_import.h"
+#include "import.h"
 #include "morphkit.h"
 
 typedef struct gt_model {

@@ -14,6 +14,7 @@
 #include <unistd.h>
 #include "check.h"
 #include "gltf_import.h"
+#include "import.h"
 
 /* ---- fixture ---- */
 
@@ -108,7 +109,7 @@ static mk_result import_text(const char *json, mk_raw_asset *raw, mk_error *err)
 {
     mk_raw_init(raw, NULL);
     memset(err, 0, sizeof *err);
-    return mk_import_gltf_memory(json, strlen(json), NULL, NULL, raw, err);
+    return mk_import_gltf(json, strlen(json), NULL, raw, err);
 }
 
 /* Imports json, expects `code` and a message containing `needle`; frees json. */
@@ -175,7 +176,7 @@ static void test_missing_buffer_file(void)
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err = {0};
-    mk_result r = mk_import_gltf(path, NULL, &raw, &err);
+    mk_result r = mk_import_file(path, NULL, &raw, &err);
     CHECK(r != MK_OK);
     CHECK_MSG(strstr(err.message, "no_such_buffer.bin") != NULL, "message: %s", err.message);
     printf("  %s\n", err.message);
@@ -241,7 +242,7 @@ static void expect_import(const char *path, mk_result code, const char *n1, cons
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err = {0};
-    mk_result r = mk_import_gltf(path, NULL, &raw, &err);
+    mk_result r = mk_import_file(path, NULL, &raw, &err);
     CHECK_MSG(r == code, "%s: expected %s, got %s (%s)", path, mk_result_name(code), mk_result_name(r), err.message);
     if (code != MK_OK) {
         CHECK_MSG(strstr(err.message, n1) && (!n2 || strstr(err.message, n2)), "%s: message '%s' should name '%s' and '%s'",
@@ -334,7 +335,7 @@ static void test_external_uri_rules(void)
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err = {0};
-    CHECK_MSG(mk_import_gltf(gltf_path, NULL, &raw, &err) == MK_OK, "%s", err.message);
+    CHECK_MSG(mk_import_file(gltf_path, NULL, &raw, &err) == MK_OK, "%s", err.message);
     mk_raw_free(&raw);
     free(json);
     CHECK(chdir(saved) == 0);
@@ -450,7 +451,7 @@ static void test_structure_errors(void)
     mk_raw_asset raw;
     mk_error err;
     mk_raw_init(&raw, NULL);
-    CHECK(mk_import_gltf_memory(bad, 12, NULL, NULL, &raw, &err) == MK_ERROR_TRUNCATED);
+    CHECK(mk_import_gltf(bad, 12, NULL, &raw, &err) == MK_ERROR_TRUNCATED);
     mk_raw_free(&raw);
     free(bad);
 }
@@ -460,7 +461,8 @@ static mk_result import_with_sidecar(const char *json, const char *sidecar, mk_r
 {
     mk_raw_init(raw, NULL);
     memset(err, 0, sizeof *err);
-    return mk_import_gltf_memory_sidecar(json, strlen(json), NULL, NULL, sidecar, strlen(sidecar), raw, err);
+    mk_import_options o = { .channels_sidecar_text = sidecar, .channels_sidecar_size = strlen(sidecar) };
+    return mk_import_gltf(json, strlen(json), &o, raw, err);
 }
 
 static void test_sidecar(void)
@@ -530,7 +532,7 @@ static void test_allocation_failures(void)
         mk_raw_asset raw;
         mk_raw_init(&raw, &al);
         mk_error err = {0};
-        mk_result r = mk_import_gltf_memory(data, size, NULL, NULL, &raw, &err);
+        mk_result r = mk_import_gltf(data, size, NULL, &raw, &err);
         CHECK_MSG(r == MK_OK || r == MK_ERROR_OUT_OF_MEMORY, "fail_after %llu: %s (%s)", (unsigned long long)k,
                   mk_result_name(r), err.message);
         if (r == MK_OK) ok++; else oom++;
@@ -560,7 +562,8 @@ static int mutate_one(const unsigned char *data, size_t size, const char *dir, s
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err = {0};
-    mk_result r = mk_import_gltf_memory(copy, new_size, dir, NULL, &raw, &err);
+    mk_import_options o = { .base_dir = dir };
+    mk_result r = mk_import_gltf(copy, new_size, &o, &raw, &err);
     int ok = r == MK_OK || err.message[0] != 0;   /* failure must say something */
     if (!ok) fprintf(stderr, "no message for %s (%zu bytes, %d flips)\n", dir, new_size, flips);
     mk_raw_free(&raw);

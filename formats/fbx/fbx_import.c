@@ -15,12 +15,8 @@ mk_result mk_import_fbx(const void *data, size_t size, const mk_import_options *
     mk_import_options defaults;
     memset(&defaults, 0, sizeof defaults);
     if (!options) options = &defaults;
-    size_t limit = options->max_input_size ? options->max_input_size : ((size_t)1 << 32);
-    if (size > limit)
-        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "FBX input of %zu bytes exceeds the limit of %zu", size, limit);
-    if (options->stacking != MK_STACKING_ASSET && options->stacking != MK_STACKING_ADDITIVE &&
-        options->stacking != MK_STACKING_SEQUENTIAL)
-        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "mk_import_fbx: unknown stacking %d", (int)options->stacking);
+    mk_result r = mk_import_options_check(options, size, "FBX", err);
+    if (r != MK_OK) return r;
     mk_error local;
     if (!err) err = &local;
     mk_arena scratch;
@@ -32,7 +28,7 @@ mk_result mk_import_fbx(const void *data, size_t size, const mk_import_options *
     doc.size = size;
     doc.err = err;
     doc.binary = fbx_is_binary(data, size);
-    mk_result r = doc.binary ? fbx_parse_binary(&doc) : fbx_parse_ascii(&doc);
+    r = doc.binary ? fbx_parse_binary(&doc) : fbx_parse_ascii(&doc);
     if (r == MK_OK && doc.root.child_count == 0)
         r = mk_error_set(err, MK_ERROR_PARSE, 0, "not an FBX file: no nodes found (%zu bytes)", size);
     if (r == MK_OK) {
@@ -41,5 +37,5 @@ mk_result mk_import_fbx(const void *data, size_t size, const mk_import_options *
     }
     fbx_doc_free(&doc);
     mk_arena_free_all(&scratch);
-    return r;
+    return r != MK_OK ? r : mk_import_finish(out, options, err);
 }

@@ -26,6 +26,10 @@ extern "C" {
 
 #define MK_FORMAT_VERSION 2u
 
+/* Consecutive key points of a channel (its full weights and the implicit 0) are at least this
+ * far apart, so span parameters stay finite (docs/semantics.md). */
+#define MK_MIN_FULL_WEIGHT_GAP 1e-6f
+
 /* Result codes. Each comment says what fixes it. */
 typedef enum mk_result {
     MK_OK = 0,
@@ -109,6 +113,9 @@ typedef struct mk_asset {
     uint32_t key_count;
 } mk_asset;
 
+/* Does data start like a .morph blob (its magic)? A cheap test before mk_asset_open. */
+int mk_is_blob(const void *data, size_t size);
+
 /* Validates the whole blob once (offsets, counts, indices, alignment, sorted data, finite
  * floats, strictly increasing full weights, checksum, version). After MK_OK the asset is safe
  * to use with any job; no hot path checks again. On failure *out is zeroed and err (optional)
@@ -125,6 +132,8 @@ typedef struct mk_mesh_info {
     uint32_t first_channel;       /* index of the mesh's first channel in the asset */
     uint32_t channel_count;
     uint32_t target_count;        /* targets of all the mesh's channels */
+    uint64_t target_bytes;        /* bytes of the mesh's block data (entry headers + deltas) */
+    uint64_t entry_count;         /* block entries: (target, 64-vertex block) pairs with data */
     mk_stacking stacking;         /* stored stacking: additive or sequential */
     int has_normals, has_tangents;
     int32_t gltf_node, gltf_mesh, gltf_primitive; /* -1 when not from glTF */
@@ -226,6 +235,11 @@ typedef struct mk_eval_job {
 size_t mk_eval_scratch_size(const mk_asset *asset, uint32_t mesh);
 mk_result mk_eval_validate(const mk_eval_job *job, mk_error *err);
 mk_result mk_eval_run(const mk_eval_job *job, mk_error *err);
+/* Bytes a valid job must move through memory for its weights: the block table and entry
+ * headers of its vertex range, the data of active targets (only the attributes it outputs),
+ * the base arrays it reads and the outputs it writes. 0 for an invalid or empty job. For
+ * budgeting memory bandwidth; it uses the job's scratch. */
+uint64_t mk_eval_traffic(const mk_eval_job *job);
 
 /* ---- Clip sampling job ---- */
 

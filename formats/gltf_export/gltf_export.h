@@ -1,23 +1,13 @@
-/* glTF import entry points beyond import.h: from memory (fuzzing, tests), and the exporter. */
-#ifndef MK_GLTF_IMPORT_H
-#define MK_GLTF_IMPORT_H
+/* The glTF writer: a raw model as glTF 2.0 (.glb or .gltf), plus the channel sidecar that lets
+ * a re-import restore progressive channels. Behaviour: docs/importing-gltf.md. */
+#ifndef MK_GLTF_EXPORT_H
+#define MK_GLTF_EXPORT_H
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#include "import.h"
-
-/* .gltf or .glb bytes (sniffed by the "glTF" magic). base_dir resolves external buffer URIs
- * (and only it: never the working directory; "" is the working directory); NULL refuses them.
- * options->channels_sidecar is read from its path when set. */
-mk_result mk_import_gltf_memory(const void *data, size_t size, const char *base_dir,
-                                const mk_import_options *options, mk_raw_asset *out, mk_error *err);
-
-/* Same with the sidecar given as text (size bytes) instead of a path; sidecar may be NULL. */
-mk_result mk_import_gltf_memory_sidecar(const void *data, size_t size, const char *base_dir,
-                                        const mk_import_options *options, const char *sidecar,
-                                        size_t sidecar_size, mk_raw_asset *out, mk_error *err);
+#include "raw.h"
 
 typedef struct mk_gltf_export_report {
     uint32_t meshes, targets, clips;
@@ -33,7 +23,7 @@ typedef enum mk_gltf_container {
 } mk_gltf_container;
 
 /* Exports raw as glTF into memory from arena: the file's bytes, and (when sidecar is not
- * NULL) the channel sidecar's JSON text that lets a re-import restore progressive channels. */
+ * NULL) the channel sidecar's JSON text. */
 mk_result mk_export_gltf_memory(const mk_raw_asset *raw, mk_gltf_container container, mk_arena *arena,
                                 void **gltf, size_t *gltf_size, char **sidecar, size_t *sidecar_size,
                                 mk_gltf_export_report *report, mk_error *err);

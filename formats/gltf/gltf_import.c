@@ -415,7 +415,7 @@ static mk_result import_primitive(importer *im, uint32_t node_index, uint32_t pr
     m->gltf_node = (int32_t)node_index;
     m->gltf_mesh = node->mesh;
     m->gltf_primitive = (int32_t)prim_index;
-    m->stacking = im->options && im->options->stacking ? im->options->stacking : MK_STACKING_ADDITIVE;
+    m->stacking = MK_STACKING_ADDITIVE;  /* mk_import_finish applies the option */
     if (sc && sc->stacking) m->stacking = (mk_stacking)sc->stacking;
     if ((r = build_triangles(im, p, vc, m, where, err)) != MK_OK) return r;
 
@@ -505,18 +505,16 @@ static mk_result import_doc(importer *im, mk_error *err)
                 im->out->clips[c].duration = im->sidecar->clips[c].duration;
             }
     }
-    mk_raw_sort_targets(im->out);
-    if ((r = mk_raw_group_channels(im->out, err)) != MK_OK) return r;
-    return mk_raw_validate(im->out, err);
+    return MK_OK;
 }
 
-mk_result mk_import_gltf_memory_sidecar(const void *data, size_t size, const char *base_dir,
-                                        const mk_import_options *options, const char *sidecar_text,
-                                        size_t sidecar_size, mk_raw_asset *out, mk_error *err)
+mk_result mk_import_gltf(const void *data, size_t size, const mk_import_options *options, mk_raw_asset *out,
+                         mk_error *err)
 {
     if (!out || (!data && size)) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "glTF import: invalid argument");
-    size_t limit = options && options->max_input_size ? options->max_input_size : ((size_t)1 << 32);
-    if (size > limit) return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "glTF input of %zu bytes exceeds the limit of %zu", size, limit);
+    mk_result r = mk_import_options_check(options, size, "glTF", err);
+    if (r != MK_OK) return r;
+    size_t limit = options && options->max_input_size ? options->max_input_size : MK_IMPORT_DEFAULT_MAX_INPUT;
     mk_arena tmp;
     mk_arena_init(&tmp, &out->arena.allocator);
     importer im;
@@ -525,55 +523,21 @@ mk_result mk_import_gltf_memory_sidecar(const void *data, size_t size, const cha
     im.out = out;
     im.options = options;
     mk_gltf_sidecar sc;
-    mk_result r = MK_OK;
-    if (sidecar_text) {
-        r = mk_gltf_sidecar_parse(&tmp, sidecar_text, sidecar_size, "sidecar", &sc, err);
+    const char *sidecar_text = options ? options->channels_sidecar_text : NULL;
+    size_t sidecar_size = options ? options->channels_sidecar_size : 0;
+    if (options && options->channels_sidecar) {
+        void *text;
+        r = mk_read_file(&tmp, options->channels_sidecar, (size_t)1 << 28, &text, &sidecar_size, err);
+        sidecar_text = text;
+    }
+    if (r == MK_OK && sidecar_text) {
+        r = mk_gltf_sidecar_parse(&tmp, sidecar_text, sidecar_size, options->channels_sidecar ? options->channels_sidecar : "sidecar",
+                                  &sc, err);
         im.sidecar = &sc;
     }
-    if (r == MK_OK) r = mk_gltf_doc_load(&tmp, data, size, -1, base_dir, limit, &im.doc, err);
+    if (r == MK_OK) r = mk_gltf_doc_load(&tmp, data, size, -1, options ? options->base_dir : NULL, limit, &im.doc, err);
     if (r == MK_OK) r = import_doc(&im, err);
     mk_gltf_doc_free(&im.doc);
     mk_arena_free_all(&tmp);
-    return r;
-}
-
-mk_result mk_import_gltf_memory(const void *data, size_t size, const char *base_dir,
-                                const mk_import_options *options, mk_raw_asset *out, mk_error *err)
-{
-    if (!options || !options->channels_sidecar)
-        return mk_import_gltf_memory_sidecar(data, size, base_dir, options, NULL, 0, out, err);
-    mk_arena tmp;
-    mk_arena_init(&tmp, out ? &out->arena.allocator : NULL);
-    void *sc; size_t scn;
-    mk_result r = mk_read_file(&tmp, options->channels_sidecar, 1u << 28, &sc, &scn, err);
-    if (r == MK_OK) r = mk_import_gltf_memory_sidecar(data, size, base_dir, options, sc, scn, out, err);
-    mk_arena_free_all(&tmp);
-    return r;
-}
-
-mk_result mk_import_gltf(const char *path, const mk_import_options *options, mk_raw_asset *out, mk_error *err)
-{
-    if (!path || !out) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "glTF import: invalid argument");
-    mk_arena tmp;
-    mk_arena_init(&tmp, &out->arena.allocator);
-    size_t limit = options && options->max_input_size ? options->max_input_size : ((size_t)1 << 32);
-    void *data; size_t size;
-    mk_result r = mk_read_file(&tmp, path, limit, &data, &size, err);
-    char *dir = NULL;
-    if (r == MK_OK) {
-        /* External buffers resolve relative to the file's directory. */
-        const char *slash = strrchr(path, '/');
-        dir = slash ? mk_arena_strndup(&tmp, path, (size_t)(slash - path + 1)) : mk_arena_strdup(&tmp, "");
-        if (!dir) r = mk_error_oom(err, "glTF path");
-    }
-    if (r == MK_OK) r = mk_import_gltf_memory(data, size, dir, options, out, err);
-    if (r != MK_OK && err) {
-        /* Prefix the file name once so the message says which file failed. */
-        char msg[sizeof err->message + 512];
-        snprintf(msg, sizeof msg, "%.500s: %s", path, err->message);
-        memcpy(err->message, msg, sizeof err->message - 1);
-        err->message[sizeof err->message - 1] = '\0';
-    }
-    mk_arena_free_all(&tmp);
-    return r;
+    return r != MK_OK ? r : mk_import_finish(out, options, err);
 }

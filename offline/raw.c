@@ -3,7 +3,6 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
-#include "format.h"
 #include "raw.h"
 
 void mk_raw_init(mk_raw_asset *raw, const mk_allocator *allocator)

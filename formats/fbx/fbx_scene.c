@@ -29,7 +29,6 @@
 #include "fbx_anim.h"
 #include "fbx_mesh.h"
 #include "fbx_transform.h"
-#include "format.h"
 
 enum {
     OBJ_OTHER, OBJ_MODEL, OBJ_MESH, OBJ_SHAPE, OBJ_BLEND, OBJ_CHANNEL, OBJ_STACK, OBJ_LAYER, OBJ_CURVE_NODE, OBJ_CURVE
@@ -894,7 +893,7 @@ static mk_result convert_meshes(scene *s)
         }
         mesh->name = dup_name(s, s->objects[o].name, s->objects[o].name_length);
         if (!mesh->name) { fbx_mesh_map_free(doc, &map); return mk_error_oom(doc->err, "FBX mesh"); }
-        mesh->stacking = s->options->stacking ? s->options->stacking : MK_STACKING_ADDITIVE;
+        mesh->stacking = MK_STACKING_ADDITIVE;  /* mk_import_finish applies the option */
         world_transform(s, o, mesh->world);
         if (!finite16(mesh->world)) {
             fbx_mesh_map_free(doc, &map);
@@ -1151,6 +1150,5 @@ mk_result fbx_convert(fbx_doc *doc, const mk_import_options *options, mk_raw_ass
     }
     if (r == MK_OK) r = convert_meshes(&s);
     if (r == MK_OK) r = doc->version >= 7000 ? animation_7x(&s) : animation_takes(&s);
-    if (r == MK_OK) r = mk_raw_group_channels(raw, doc->err);
     return r;
 }

@@ -12,7 +12,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
-#include "import.h"
+#include "fbx_import.h"
 
 /* Limits against hostile input (files from real tools are far below these). */
 #define FBX_MAX_DEPTH 64              /* node nesting */

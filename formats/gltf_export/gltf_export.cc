@@ -38,7 +38,7 @@
 #include <string>
 #include <vector>
 
-#include "gltf_import.h"
+#include "gltf_export.h"
 extern "C" {
 #include "blob_io.h"
 }

@@ -1,0 +1,15 @@
+/* Importing any source into the raw model: the one entry shape of every reader (FBX, glTF,
+ * .morph). mk_import_memory picks the reader by content; mk_import_file reads the file first,
+ * resolves glTF buffers against its folder and names the file in errors. */
+#ifndef MK_IMPORT_H
+#define MK_IMPORT_H
+
+#include "import_options.h"
+
+/* .morph blob, glTF (JSON or GLB) or FBX (binary or ASCII), told apart by content. out must
+ * be mk_raw_init'ed; warnings go to out->warnings. */
+mk_result mk_import_memory(const void *data, size_t size, const mk_import_options *options, mk_raw_asset *out,
+                           mk_error *err);
+mk_result mk_import_file(const char *path, const mk_import_options *options, mk_raw_asset *out, mk_error *err);
+
+#endif

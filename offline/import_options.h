@@ -1,0 +1,31 @@
+/* Options every importer takes (FBX, glTF, .morph), checked and applied in one place. Zero
+ * means the default for every field. */
+#ifndef MK_IMPORT_OPTIONS_H
+#define MK_IMPORT_OPTIONS_H
+
+#include "raw.h"
+
+typedef struct mk_import_options {
+    mk_stacking stacking;          /* stacking stored for every mesh; 0 = additive (.morph: as stored) */
+    int keep_shape_normals;        /* FBX: 0 = use shape normals only when present and non-zero */
+    int keep_plain_meshes;         /* 0 = meshes without morph targets are dropped, each named in a
+                                    * warning; 1 = kept (bakers start from them) */
+    size_t max_input_size;         /* bytes; 0 = 4 GiB */
+    const char *base_dir;          /* glTF: folder external buffer URIs resolve against (with or
+                                    * without a trailing '/'); NULL refuses external buffers.
+                                    * mk_import_file sets it to the file's folder. */
+    const char *channels_sidecar;  /* glTF: path of a sidecar JSON grouping targets into channels */
+    const char *channels_sidecar_text; /* ... or its text (channels_sidecar_size bytes) */
+    size_t channels_sidecar_size;
+} mk_import_options;
+
+#define MK_IMPORT_DEFAULT_MAX_INPUT ((size_t)4 << 30)
+
+/* Checks the options and the input size against the limit; every importer calls it first. */
+mk_result mk_import_options_check(const mk_import_options *options, size_t input_size, const char *format,
+                                  mk_error *err);
+/* Applies what every format shares to a freshly imported model (stacking, plain meshes), then
+ * sorts targets, groups channels by mesh and validates it; every importer calls it last. */
+mk_result mk_import_finish(mk_raw_asset *raw, const mk_import_options *options, mk_error *err);
+
+#endif
