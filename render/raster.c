@@ -39,9 +39,12 @@ float mkr_light_intensity(float n_dot_l)
     return n_dot_l >= 0 ? MKR_LIGHT_AMBIENT + MKR_LIGHT_KEY * n_dot_l : MKR_LIGHT_AMBIENT - MKR_LIGHT_FILL * n_dot_l;
 }
 
-/* floor(v / 16) and ceil(v / 16) for any sign. */
-static int64_t floor16(int64_t v) { return v >= 0 ? v / SUBPIXEL : -((-v + SUBPIXEL - 1) / SUBPIXEL); }
-static int64_t ceil16(int64_t v) { return -floor16(-v); }
+/* Pixel columns (or rows) whose centers 16 i + 8 lie at or after / at or before v (1/16
+ * pixel, |v| < 2^27): ceil((v - 8) / 16) and floor((v - 8) / 16), shifted through an offset
+ * that makes the shifted value non-negative. */
+#define CENTER_OFFSET ((int64_t)1 << 30)
+static int64_t first_center(int64_t v) { return ((v + 7 + CENTER_OFFSET) >> SUBPIXEL_BITS) - (CENTER_OFFSET >> SUBPIXEL_BITS); }
+static int64_t last_center(int64_t v) { return ((v - 8 + CENTER_OFFSET) >> SUBPIXEL_BITS) - (CENTER_OFFSET >> SUBPIXEL_BITS); }
 
 static int64_t min3(int64_t a, int64_t b, int64_t c) { return a < b ? (a < c ? a : c) : (b < c ? b : c); }
 static int64_t max3(int64_t a, int64_t b, int64_t c) { return a > b ? (a > c ? a : c) : (b > c ? b : c); }
@@ -120,14 +123,15 @@ mk_result mkr_draw_mesh(mkr_image *img, const mkr_camera *cam, const mkr_mesh_vi
     const int width = img->width;
 
     for (uint32_t t = 0; t < mesh->triangle_count; t++) {
-        uint32_t ia = mesh->triangles[3 * (size_t)t], ib = mesh->triangles[3 * (size_t)t + 1],
-                 ic = mesh->triangles[3 * (size_t)t + 2];
+        const uint32_t *tri = mesh->triangles + 3 * (size_t)t;
+        uint32_t ia = tri[0], ib = tri[1], ic = tri[2];
         const screen_vertex *a = &sv[ia], *b = &sv[ib], *c = &sv[ic];
         if (a->x == INT32_MIN || b->x == INT32_MIN || c->x == INT32_MIN) continue;
 
-        /* Bounding box of the pixel centers, clipped. */
-        int64_t x0 = ceil16(min3(a->x, b->x, c->x) - SUBPIXEL / 2), x1 = floor16(max3(a->x, b->x, c->x) - SUBPIXEL / 2);
-        int64_t y0 = ceil16(min3(a->y, b->y, c->y) - SUBPIXEL / 2), y1 = floor16(max3(a->y, b->y, c->y) - SUBPIXEL / 2);
+        /* The pixel centers in the bounding box, clipped. Most triangles of a dense mesh
+         * cover none or one, so everything else waits for the first covered pixel. */
+        int64_t x0 = first_center(min3(a->x, b->x, c->x)), x1 = last_center(max3(a->x, b->x, c->x));
+        int64_t y0 = first_center(min3(a->y, b->y, c->y)), y1 = last_center(max3(a->y, b->y, c->y));
         if (x0 < clip_x0) x0 = clip_x0;
         if (y0 < clip_y0) y0 = clip_y0;
         if (x1 >= clip_x1) x1 = clip_x1 - 1;
@@ -142,50 +146,55 @@ mk_result mkr_draw_mesh(mkr_image *img, const mkr_camera *cam, const mkr_mesh_vi
             uint32_t ti = ib; ib = ic; ic = ti;
             area = -area;
         }
-        const float inv_area = 1.0f / (float)area;
-
-        /* Face normal of the original winding, when there are no vertex normals. */
-        float face_intensity = 0;
-        if (!mesh->normals) {
-            const float *p0 = mesh->positions + 3 * (size_t)mesh->triangles[3 * (size_t)t];
-            const float *p1 = mesh->positions + 3 * (size_t)mesh->triangles[3 * (size_t)t + 1];
-            const float *p2 = mesh->positions + 3 * (size_t)mesh->triangles[3 * (size_t)t + 2];
-            float e1[3] = { p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2] };
-            float e2[3] = { p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2] };
-            float n[3] = { e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0] };
-            float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            float ndl = len > 0 ? (n[0] * light[0] + n[1] * light[1] + n[2] * light[2]) / len : 0;
-            face_intensity = mkr_light_intensity(ndl);
-        }
-
-        /* Vertex attributes in the (possibly swapped) order a, b, c. */
-        const float *na = NULL, *nb = NULL, *nc = NULL;
-        if (mesh->normals) {
-            na = mesh->normals + 3 * (size_t)ia, nb = mesh->normals + 3 * (size_t)ib, nc = mesh->normals + 3 * (size_t)ic;
-        }
-        float ca[3], cb[3], cc[3];
-        float sa = 0, sb = 0, sc = 0;
-        if (use_ramp) {
-            sa = (mesh->scalars[ia] - style->scalar_lo) * ramp_scale;
-            sb = (mesh->scalars[ib] - style->scalar_lo) * ramp_scale;
-            sc = (mesh->scalars[ic] - style->scalar_lo) * ramp_scale;
-        } else {
-            for (int k = 0; k < 3; k++) {
-                ca[k] = use_colors ? mesh->colors[3 * (size_t)ia + k] : style->color[k];
-                cb[k] = use_colors ? mesh->colors[3 * (size_t)ib + k] : style->color[k];
-                cc[k] = use_colors ? mesh->colors[3 * (size_t)ic + k] : style->color[k];
-            }
-        }
 
         /* Edge functions: e_bc weighs a, e_ca weighs b, e_ab weighs c. */
         int64_t px = SUBPIXEL * x0 + SUBPIXEL / 2, py = SUBPIXEL * y0 + SUBPIXEL / 2;
         edge ea = edge_setup(b, c, px, py), eb = edge_setup(c, a, px, py), ec = edge_setup(a, b, px, py);
+
+        /* Filled at the first covered pixel: vertex attributes in the (possibly swapped)
+         * order a, b, c. */
+        int ready = 0;
+        float inv_area = 0, face_intensity = 0;
+        const float *na = NULL, *nb = NULL, *nc = NULL;
+        float ca[3] = { 0 }, cb[3] = { 0 }, cc[3] = { 0 }, sa = 0, sb = 0, sc = 0;
+
         for (int64_t y = y0; y <= y1; y++) {
             int64_t wa = ea.value, wb = eb.value, wc = ec.value;
             float *depth = img->depth + (size_t)y * (size_t)width;
             uint8_t *row = img->pixels + 4 * (size_t)y * (size_t)width;
             for (int64_t x = x0; x <= x1; x++, wa += ea.step_x, wb += eb.step_x, wc += ec.step_x) {
                 if ((wa | wb | wc) < 0) continue;
+                if (!ready) {
+                    ready = 1;
+                    inv_area = 1.0f / (float)area;
+                    if (mesh->normals) {
+                        na = mesh->normals + 3 * (size_t)ia, nb = mesh->normals + 3 * (size_t)ib;
+                        nc = mesh->normals + 3 * (size_t)ic;
+                    } else {
+                        /* The face normal of the original winding. */
+                        const float *p0 = mesh->positions + 3 * (size_t)tri[0];
+                        const float *p1 = mesh->positions + 3 * (size_t)tri[1];
+                        const float *p2 = mesh->positions + 3 * (size_t)tri[2];
+                        float e1[3] = { p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2] };
+                        float e2[3] = { p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2] };
+                        float n[3] = { e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                                       e1[0] * e2[1] - e1[1] * e2[0] };
+                        float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+                        float ndl = len > 0 ? (n[0] * light[0] + n[1] * light[1] + n[2] * light[2]) / len : 0;
+                        face_intensity = mkr_light_intensity(ndl);
+                    }
+                    if (use_ramp) {
+                        sa = (mesh->scalars[ia] - style->scalar_lo) * ramp_scale;
+                        sb = (mesh->scalars[ib] - style->scalar_lo) * ramp_scale;
+                        sc = (mesh->scalars[ic] - style->scalar_lo) * ramp_scale;
+                    } else if (use_colors) {
+                        for (int k = 0; k < 3; k++) {
+                            ca[k] = mesh->colors[3 * (size_t)ia + k];
+                            cb[k] = mesh->colors[3 * (size_t)ib + k];
+                            cc[k] = mesh->colors[3 * (size_t)ic + k];
+                        }
+                    }
+                }
                 float la = (float)(wa - ea.bias) * inv_area, lb = (float)(wb - eb.bias) * inv_area;
                 float lc = 1.0f - la - lb;
                 float z = la * a->z + lb * b->z + lc * c->z;
@@ -204,17 +213,21 @@ mk_result mkr_draw_mesh(mkr_image *img, const mkr_camera *cam, const mkr_mesh_vi
                 intensity += unlit * (1.0f - intensity);
                 uint8_t *p = row + 4 * x;
                 if (use_ramp) {
-                    float s = la * sa + lb * sb + lc * sc;
+                    float v = la * sa + lb * sb + lc * sc;
                     /* NaN (a broken value) shows as the hot end. */
-                    int i = !(s < 255) ? 255 : s <= 0 ? 0 : (int)(s + 0.5f);
+                    int i = !(v < 255) ? 255 : v <= 0 ? 0 : (int)(v + 0.5f);
                     const uint8_t *rgb = style->ramp + 3 * i;
                     p[0] = to_byte(rgb[0] * intensity);
                     p[1] = to_byte(rgb[1] * intensity);
                     p[2] = to_byte(rgb[2] * intensity);
-                } else {
+                } else if (use_colors) {
                     p[0] = to_byte((la * ca[0] + lb * cb[0] + lc * cc[0]) * intensity);
                     p[1] = to_byte((la * ca[1] + lb * cb[1] + lc * cc[1]) * intensity);
                     p[2] = to_byte((la * ca[2] + lb * cb[2] + lc * cc[2]) * intensity);
+                } else {
+                    p[0] = to_byte(style->color[0] * intensity);
+                    p[1] = to_byte(style->color[1] * intensity);
+                    p[2] = to_byte(style->color[2] * intensity);
                 }
                 p[3] = 255;
             }
