@@ -188,7 +188,7 @@ static mk_result render(const mkr_sheet_desc *desc, int diff, mkr_image *out, mk
     mkr_image_clear(out, sheet_gutter);
     const int s = l.text_scale;
 
-    /* One camera for every cell, framed on the union of all frames. */
+    /* The union bounding box gives the diagonal the diff legend relates distances to. */
     float lo[3], hi[3];
     mkr_bounds_reset(lo, hi);
     for (uint32_t i = 0; i < desc->cell_count; i++)
@@ -198,6 +198,7 @@ static mk_result render(const mkr_sheet_desc *desc, int diff, mkr_image *out, mk
     if (lo[0] <= hi[0])
         diagonal = sqrt(((double)hi[0] - lo[0]) * ((double)hi[0] - lo[0]) + ((double)hi[1] - lo[1]) * ((double)hi[1] - lo[1]) +
                         ((double)hi[2] - lo[2]) * ((double)hi[2] - lo[2]));
+    /* One camera for every cell, framed on the points of all frames: motion shows. */
     mkr_camera cam = { 0 };
     mkr_camera_set_view(&cam, desc->view);
     float ext_lo[3], ext_hi[3];
