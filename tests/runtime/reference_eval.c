@@ -11,8 +11,8 @@
  *   - int16 deltas: each stored component is within the writer's reported error q of the
  *     exact delta, so a sum errs by q * sum |coefficients| (the stacked coefficient sum);
  *   - normalizing: a vector error e moves the direction of a vector of length L by at most
- *     asin(e / L); slerp's sensitivity to its ends and to float acos is bounded by sampling
- *     its weights over the angle's error interval (see slerp_error). */
+ *     asin(e / L); slerp's sensitivity to its ends and to the angle's rounding is bounded by
+ *     sampling its weights over the angle's error interval (see slerp_error). */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -161,11 +161,17 @@ static double stacking_beta(mk_stacking stacking, const mk_raw_channel *ch, doub
 
 /* ---- slerp ---- */
 
-/* Weights of n_a and n_b in slerp(n_a, n_b, t) at angle theta: sin((1-t)theta)/sin theta and
- * sin(t theta)/sin theta, or the lerp's 1 - t and t where sin theta < 1e-6. */
-static void slerp_weights(double theta, double t, double *wa, double *wb)
+/* sin theta = |n_a x n_b| */
+static double sin_between(const double *a, const double *b)
 {
-    double s = sin(theta);
+    double c[3] = { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
+    return length3(c);
+}
+
+/* Weights of n_a and n_b in slerp(n_a, n_b, t) at angle theta with sine s:
+ * sin((1 - t) theta) / s and sin(t theta) / s, or the lerp's 1 - t and t where s < 1e-6. */
+static void slerp_weights(double theta, double s, double t, double *wa, double *wb)
+{
     if (s < SLERP_MIN_SIN) {
         *wa = 1.0 - t;
         *wb = t;
@@ -175,48 +181,39 @@ static void slerp_weights(double theta, double t, double *wa, double *wb)
     }
 }
 
-static double slerp_angle(const double *na, const double *nb)
-{
-    double d = dot3(na, nb);
-    return acos(d > 1 ? 1 : d < -1 ? -1 : d);
-}
-
+/* theta = atan2(|n_a x n_b|, n_a . n_b) */
 static void slerp(const double *na, const double *nb, double t, double *out)
 {
-    double wa, wb;
-    slerp_weights(slerp_angle(na, nb), t, &wa, &wb);
+    double s = sin_between(na, nb), theta = atan2(s, dot3(na, nb)), wa, wb;
+    slerp_weights(theta, s, t, &wa, &wb);
     for (int k = 0; k < 3; k++) out[k] = wa * na[k] + wb * nb[k];
 }
 
 /* Bound on |float32 slerp - slerp| (bookkeeping). delta_a, delta_b bound the errors of the
- * runtime's unit ends. The angle the runtime computes errs by delta_a + delta_b plus float
- * acos's error: a few ulps of the dot product divided by sin theta, and near +-1 (where acos
- * is not Lipschitz) at most sqrt(2 * 16u) (the nearest float below 1 is 1 - 6e-8, acos of it
- * 3.4e-4). The weights are sampled at both ends of that interval (over so short an interval
- * the deviation grows monotonically: linearly, or quadratically from theta = 0); twice the
- * largest deviation is allowed.
- * Sets *unstable where float may choose the other branch of the sin theta < 1e-6 test at
- * nearly opposite ends (near parallel ends both branches agree). */
+ * runtime's unit ends; the angle it computes (atan2, accurate to a few ulps) errs by about
+ * delta_a + delta_b + 8u. In the slerp branch the weights are sampled at both ends of that
+ * interval (over so short an interval the deviation grows monotonically); twice the largest
+ * deviation is allowed. Sets *unstable where sin theta is so close to 1e-6 at nearly opposite
+ * ends that float may take the other branch (near parallel ends both branches agree). */
 static double slerp_error(const double *na, const double *nb, double t, double delta_a, double delta_b, int *unstable,
                           double *weight_sum)
 {
     const double u = UNIT_ROUNDOFF;
-    double theta = slerp_angle(na, nb), s = sin(theta), wa, wb;
-    slerp_weights(theta, t, &wa, &wb);
-    double delta = delta_a + delta_b;
-    double theta_error = delta + (s > 0.01 ? 8 * u / s : sqrt(32 * u));
-    if (theta > PI / 2 && s < SLERP_MIN_SIN + theta_error + 1e-3) *unstable = 1;
-    double deviation = 0;
+    double s = sin_between(na, nb), theta = atan2(s, dot3(na, nb)), wa, wb;
+    slerp_weights(theta, s, t, &wa, &wb);
     *weight_sum = fabs(wa) + fabs(wb);
-    for (int i = -1; i <= 1; i += 2) {
+    double delta = delta_a + delta_b, theta_error = delta + 8 * u;
+    if (theta > PI / 2 && fabs(s - SLERP_MIN_SIN) <= 2 * theta_error) *unstable = 1;
+    double deviation = 0;
+    for (int i = -1; i <= 1 && s >= SLERP_MIN_SIN; i += 2) {
         double th = theta + theta_error * i, a2, b2, e[3];
         th = th < 0 ? 0 : th > PI ? PI : th;
-        slerp_weights(th, t, &a2, &b2);
+        slerp_weights(th, sin(th), t, &a2, &b2);
         for (int k = 0; k < 3; k++) e[k] = (a2 - wa) * na[k] + (b2 - wb) * nb[k];
         double len = length3(e);
         if (len > deviation) deviation = len;
     }
-    return 2 * ((fabs(wa) + fabs(wb)) * delta + deviation) + 8 * u * (fabs(wa) + fabs(wb));
+    return 2 * (*weight_sum * delta + deviation) + 8 * u * *weight_sum;
 }
 
 /* Error bound of the runtime's unit vector normalize(x) (x = B_n + stored delta, exact value

@@ -19,8 +19,8 @@
  * The other cases pin what random assets rarely hit, against hand-computed values: sequential
  * stacking's beta (negative full weights, the first in-between, no positive full weight, both
  * clamps), slerp between two in-betweens, extrapolated, under sequential stacking, with
- * identical and opposite ends (the acos clamp and the lerp fallback), and normal deltas that
- * cancel the base normal. */
+ * identical, opposite and nearly opposite ends (the lerp fallback and its threshold), and
+ * normal deltas that cancel the base normal. */
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -628,34 +628,50 @@ static void test_slerp_spans(void)
     mk_raw_free(&raw);
 }
 
-/* Slerp ends that are identical (in float, their dot product may round past 1: acos needs the
- * clamp) and nearly opposite. Base normals +z; one channel with in-betweens at 0.5 and 1,
- * evaluated at w = 0.625, 0.75 and 2.5 (t = 1/4, 1/2, 4).
- *   v 0..63  identical ends: n_a = n_b = normalize(d) for random d: slerp = n_a for any t.
- *   v 64..   nearly opposite ends, n_a = +x and n_b at pi - eps from it towards +z: slerp
- *            turns +x towards +z by t (pi - eps); the lerp would stay near +x. Float acos
- *            amplifies the dot product's rounding (~2.4e-7) by 1 / sin theta, and the
- *            slerp's numerator has length sin theta ~ eps, so the runtime is good to about
- *            2.4e-7 / eps^2 rad: four times that is allowed. */
-static void test_slerp_clamp_and_fallback(void)
+/* Slerp ends that are identical, opposite and nearly opposite, alone and beside a second
+ * channel. Base normals +z; channel "ends" has in-betweens at 0.5 and 1 and is evaluated at
+ * w = 0.625, 0.75 and 2.5 (t = 1/4, 1/2, 4), giving the single-channel slerp S; channel "tilt"
+ * turns every normal to +y at w1 = 1 (displacement y - z), so n = normalize(S + w1 (0, 1, -1))
+ * for w1 = 0 and 1.
+ *   v 0..63    identical ends n_a = n_b = normalize(d) for random d (a float dot product of a
+ *              vector with itself may exceed 1): S = n_a for any t.
+ *   v 64..127  opposite ends in the xy plane, n_b = -n_a exactly: sin theta = 0, the lerp
+ *              S = (1 - 2t) n_a: at t = 1/2 with w1 = 0 the sum vanishes and the base normal is
+ *              kept, at t = 4 S = -7 n_a (its length matters beside "tilt").
+ *   v 128..    nearly opposite ends, n_a = +x and n_b at pi - eps from it towards +z (eps down
+ *              to 2e-6, just above the 1e-6 threshold): S turns +x towards +z by t (pi - eps),
+ *              where the lerp would stay near +x. The slerp weights are ~1/eps, so the float
+ *              rounding of the ends (~6e-8) moves S by ~1e-7 / eps: 1e-6 / eps rad is allowed. */
+static void test_slerp_identical_and_opposite_ends(void)
 {
-    enum { SAME = 64 };
-    static const double eps[] = { 0.1, 0.03, 0.01, 0.004, 0.002 };
-    const uint32_t near_count = sizeof eps / sizeof eps[0], n = SAME + near_count;
-    float positions[3 * 256] = { 0 }, normals[3 * 256], da[3 * 256], db[3 * 256], pa[3 * 256] = { 0 };
+    enum { SAME = 64, OPPOSITE = 64 };
+    static const double eps[] = { 0.1, 0.01, 1e-3, 1e-4, 1e-5, 2e-6 };
+    const uint32_t near_count = sizeof eps / sizeof eps[0], n = SAME + OPPOSITE + near_count;
+    float positions[3 * 256] = { 0 }, normals[3 * 256], da[3 * 256], db[3 * 256], pa[3 * 256] = { 0 }, tilt[3 * 256];
     uint32_t indices[256];
     rng r = { 7 };
     for (uint32_t v = 0; v < n; v++) {
         indices[v] = v;
         normals[3 * v] = normals[3 * v + 1] = 0;
         normals[3 * v + 2] = 1;
+        tilt[3 * v] = 0;
+        tilt[3 * v + 1] = 1;
+        tilt[3 * v + 2] = -1;
         float *a = da + 3 * v, *b = db + 3 * v;
         if (v < SAME) {
             for (int k = 0; k < 3; k++) a[k] = (float)uniform(&r, -1, 1);
             a[2] -= 1;   /* delta = d - B */
             memcpy(b, a, 12);
+        } else if (v < SAME + OPPOSITE) {
+            double phi = uniform(&r, 0, 2 * PI), len = uniform(&r, 0.2, 3);
+            a[0] = (float)(len * cos(phi));
+            a[1] = (float)(len * sin(phi));
+            a[2] = -1;   /* B + delta_a = (x, y, 0) exactly */
+            b[0] = -a[0];
+            b[1] = -a[1];
+            b[2] = -1;   /* B + delta_b = -(x, y, 0) exactly */
         } else {
-            double e = eps[v - SAME];
+            double e = eps[v - SAME - OPPOSITE];
             a[0] = 1, a[1] = 0, a[2] = -1;   /* n_a = +x */
             b[0] = (float)-cos(e), b[1] = 0, b[2] = (float)(sin(e) - 1);   /* n_b = (-cos e, 0, sin e) */
         }
@@ -663,30 +679,41 @@ static void test_slerp_clamp_and_fallback(void)
     mk_raw_asset raw;
     hand_mesh(&raw, n, positions, normals, NULL);
     hand_target ends[2] = { { 0.5f, n, indices, pa, da, NULL }, { 1.0f, n, indices, pa, db, NULL } };
+    hand_target tilts[1] = { { 1.0f, n, indices, pa, tilt, NULL } };
     hand_channel(&raw, "ends", 2, ends);
+    hand_channel(&raw, "tilt", 1, tilts);
     mk_arena arena;
     mk_arena_init(&arena, NULL);
     mk_asset asset;
     hand_open(&raw, MK_STACKING_ADDITIVE, &arena, &asset);
     static hand_frame f;
     static const float ws[] = { 0.625f, 0.75f, 2.5f };
-    for (int i = 0; i < 3; i++) {
-        const double t = (ws[i] - 0.5) / 0.5;
-        hand_eval(&raw, &asset, &ws[i], MK_STACKING_ASSET, MK_NORMALS_SLERP, &f);
-        for (uint32_t v = 0; v < n; v++) {
-            char label[96];
-            const float *a = da + 3 * v;
-            if (v < SAME) {
-                snprintf(label, sizeof label, "identical ends, t = %g", t);
-                expect_normal(&f, v, a[0], a[1], a[2] + 1.0, 1e-5, label);
-            } else if (t < 1) {
-                /* the angle of the stored ends, (1, 0, 0) and B + delta_b */
-                double e = atan2(1.0 + (double)db[3 * v + 2], -(double)db[3 * v]), angle = t * (PI - e);
-                snprintf(label, sizeof label, "nearly opposite ends, eps %g, t = %g", eps[v - SAME], t);
-                expect_normal(&f, v, cos(angle), 0, sin(angle), 4 * 2.4e-7 / (e * e) + 1e-6, label);
+    for (int i = 0; i < 3; i++)
+        for (int w1 = 0; w1 <= 1; w1++) {
+            const double t = (ws[i] - 0.5) / 0.5;
+            const float w[2] = { ws[i], (float)w1 };
+            hand_eval(&raw, &asset, w, MK_STACKING_ASSET, MK_NORMALS_SLERP, &f);
+            for (uint32_t v = 0; v < n; v++) {
+                char label[128];
+                const float *a = da + 3 * v;
+                if (v < SAME) {
+                    double len = sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (a[2] + 1.0) * (a[2] + 1.0));
+                    snprintf(label, sizeof label, "identical ends, t = %g, tilt %d", t, w1);
+                    expect_normal(&f, v, a[0] / len, a[1] / len + w1, (a[2] + 1.0) / len - w1, 1e-5, label);
+                } else if (v < SAME + OPPOSITE) {
+                    double len = sqrt((double)a[0] * a[0] + (double)a[1] * a[1]), k = (1 - 2 * t) / len;
+                    snprintf(label, sizeof label, "opposite ends, t = %g, tilt %d", t, w1);
+                    if (t == 0.5 && !w1) expect_kept_normal(&f, &raw, v, label);
+                    else expect_normal(&f, v, k * a[0], k * a[1] + w1, -w1, 1e-6, label);
+                } else if (t < 1) {
+                    /* the angle of the stored ends, (1, 0, 0) and B + delta_b */
+                    double e = atan2(1.0 + (double)db[3 * v + 2], -(double)db[3 * v]), angle = t * (PI - e);
+                    snprintf(label, sizeof label, "nearly opposite ends, eps %g, t = %g, tilt %d", eps[v - SAME - OPPOSITE], t,
+                             w1);
+                    expect_normal(&f, v, cos(angle), w1, sin(angle) - w1, 1e-6 / e + 1e-6, label);
+                }
             }
         }
-    }
     mk_arena_free_all(&arena);
     mk_raw_free(&raw);
 }
@@ -757,4 +784,4 @@ static void test_degenerate_normals(void)
 }
 
 CHECK_MAIN(CASE(test_random_assets), CASE(test_sequential_beta), CASE(test_slerp_spans),
-           CASE(test_slerp_clamp_and_fallback), CASE(test_degenerate_normals))
+           CASE(test_slerp_identical_and_opposite_ends), CASE(test_degenerate_normals))
