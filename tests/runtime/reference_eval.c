@@ -216,13 +216,15 @@ static double slerp_error(const double *na, const double *nb, double t, double d
     return 2 * (*weight_sum * delta + deviation) + 8 * u * *weight_sum;
 }
 
-/* Error bound of the runtime's unit vector normalize(x) (x = B_n + stored delta, exact value
- * x here): the stored delta's error plus float rounding of the sum, divided by |x|. Sets
- * *unstable when |x| is so close to 1e-8 that the fallback choice is uncertain. */
-static double unit_error(const double *x, double magnitude, double stored, int *unstable)
+/* Error bound of the runtime's unit vector normalize(x), x = B_n + delta (exact here): the
+ * stored delta's error (an int16 delta also rounds when scaled back, by u |delta|; a float
+ * one is read exactly), the float sum's rounding (u |x| per component, so an exact zero stays
+ * zero) and the normalization's (4u), divided by |x|. Sets *unstable when |x| is so close to
+ * 1e-8 that the fallback choice is uncertain. */
+static double unit_error(const double *x, double delta_length, double stored, int *unstable)
 {
     const double u = UNIT_ROUNDOFF;
-    double len = length3(x), e = sqrt(3.0) * stored + 4 * u * magnitude;
+    double len = length3(x), e = sqrt(3.0) * (stored > 0 ? stored + u * delta_length : 0.0) + sqrt(3.0) * u * len;
     if (fabs(len - SHORT_VECTOR) <= e + 0.01 * SHORT_VECTOR) *unstable = 1;
     return len < SHORT_VECTOR ? 4 * u : 2 * e / len + 4 * u;
 }
@@ -287,8 +289,8 @@ void ref_eval_vertex(const ref_job *job, uint32_t v, ref_vertex *out)
 
                     /* bookkeeping: this channel's Dn error, stacked like Dn */
                     double qa = s.a && s.a->normals ? job->stored.normal : 0, qb = s.b && s.b->normals ? job->stored.normal : 0;
-                    double ea = s.a ? unit_error(xa, length3(base_n) + length3(da), qa, &unstable) : 4 * u;
-                    double eb = s.b ? unit_error(xb, length3(base_n) + length3(db), qb, &unstable) : 4 * u;
+                    double ea = s.a ? unit_error(xa, length3(da), qa, &unstable) : 4 * u;
+                    double eb = s.b ? unit_error(xb, length3(db), qb, &unstable) : 4 * u;
                     double weight_sum;
                     slerp_err = (1.0 - beta) * slerp_err + slerp_error(na, nb, s.t, ea, eb, &unstable, &weight_sum) + 4 * u;
                     slerp_mag += weight_sum + 1;
