@@ -218,7 +218,8 @@ static void describe_asset(const mk_raw_asset *raw, const float *weights)
     }
 }
 
-/* Runs one runtime job over [first, first + count) and compares it with the reference. */
+/* Runs one runtime job over [first, first + count) and compares it with the reference.
+ * n and t may be NULL: those outputs are not requested. */
 static uint32_t run_job(const mk_asset *asset, const mk_raw_asset *raw, const float *weights, mk_stacking stacking,
                         mk_normal_mode mode, uint32_t first, uint32_t count, const ref_job *rj, const ref_vertex *expected,
                         void *scratch, size_t scratch_size, float *p, float *n, float *t, ref_mismatch *mismatch,
@@ -300,9 +301,11 @@ static int run_case(uint64_t seed, int verbose, totals *tot)
                         for (int range = 0; range < 2; range++) {
                             ref_mismatch mm;
                             tot->jobs++;
+                            /* Normals and tangents are optional outputs: mostly requested. */
+                            float *want_n = chance(&r, 0.8) ? nr : NULL, *want_t = chance(&r, 0.8) ? tg : NULL;
                             uint32_t bad = run_job(&assets[q], &raw, weights, job_stackings[js], (mk_normal_mode)mode,
                                                    ranges[range][0], ranges[range][1], &rj, expected, scratch,
-                                                   scratch_size, p, nr, tg, &mm, &tot->stats[q]);
+                                                   scratch_size, p, want_n, want_t, &mm, &tot->stats[q]);
                             if (!bad) continue;
                             failed++;
                             if (!case_failed++ || verbose) {
@@ -641,11 +644,12 @@ static void test_slerp_spans(void)
  *   v 128..    nearly opposite ends, n_a = +x and n_b at pi - eps from it towards +z (eps down
  *              to 2e-6, just above the 1e-6 threshold): S turns +x towards +z by t (pi - eps),
  *              where the lerp would stay near +x. The slerp weights are ~1/eps, so the float
- *              rounding of the ends (~6e-8) moves S by ~1e-7 / eps: 1e-6 / eps rad is allowed. */
+ *              rounding of the ends and of theta near pi (~1e-7) moves S by ~1e-7 / eps:
+ *              1e-6 / eps rad is allowed. At eps = 5e-7, below the threshold, S is the lerp. */
 static void test_slerp_identical_and_opposite_ends(void)
 {
     enum { SAME = 64, OPPOSITE = 64 };
-    static const double eps[] = { 0.1, 0.01, 1e-3, 1e-4, 1e-5, 2e-6 };
+    static const double eps[] = { 0.1, 0.01, 1e-3, 1e-4, 1e-5, 2e-6, 5e-7 };
     const uint32_t near_count = sizeof eps / sizeof eps[0], n = SAME + OPPOSITE + near_count;
     float positions[3 * 256] = { 0 }, normals[3 * 256], da[3 * 256], db[3 * 256], pa[3 * 256] = { 0 }, tilt[3 * 256];
     uint32_t indices[256];
@@ -706,11 +710,14 @@ static void test_slerp_identical_and_opposite_ends(void)
                     if (t == 0.5 && !w1) expect_kept_normal(&f, &raw, v, label);
                     else expect_normal(&f, v, k * a[0], k * a[1] + w1, -w1, 1e-6, label);
                 } else if (t < 1) {
-                    /* the angle of the stored ends, (1, 0, 0) and B + delta_b */
-                    double e = atan2(1.0 + (double)db[3 * v + 2], -(double)db[3 * v]), angle = t * (PI - e);
+                    /* the stored ends: (1, 0, 0) and B + delta_b, at pi - e from it */
+                    double bx = db[3 * v], bz = 1.0 + (double)db[3 * v + 2], len = sqrt(bx * bx + bz * bz);
+                    double e = atan2(bz, -bx), angle = t * (PI - e);
                     snprintf(label, sizeof label, "nearly opposite ends, eps %g, t = %g, tilt %d", eps[v - SAME - OPPOSITE], t,
                              w1);
-                    expect_normal(&f, v, cos(angle), w1, sin(angle) - w1, 1e-6 / e + 1e-6, label);
+                    if (sin(e) >= 1e-6) expect_normal(&f, v, cos(angle), w1, sin(angle) - w1, 1e-6 / e + 1e-6, label);
+                    else   /* below the threshold: the lerp */
+                        expect_normal(&f, v, (1 - t) + t * bx / len, w1, t * bz / len - w1, 1e-6, label);
                 }
             }
         }
@@ -719,37 +726,43 @@ static void test_slerp_identical_and_opposite_ends(void)
 }
 
 /* Normal deltas that cancel the base normal: nlerp keeps the base normal (as stored, even
- * when not unit) where B_n + d_n vanishes, and normalizes short but nonzero sums; slerp
- * replaces a vanishing span end by normalize(B_n). Tangent deltas likewise.
- *   v0: cancel -B; v1: cancel -B + (1e-5, 0, 0); v2: cancel -B, turn to +x;
- *   v3: base (0, 0, 2), cancel -B. Tangents (1, 0, 0, -1), cancel (-1, 0, 0) at v0. */
+ * when not unit) where B_n + d_n is shorter than 1e-8, and normalizes short sums above that;
+ * slerp replaces a span end shorter than 1e-8 by normalize(B_n) (not B_n). Tangent deltas
+ * likewise. Base normals +z except v3's (0, 0, 2); tangents (1, 0, 0, -1).
+ *   "cancel" (f = 1): -B_n at v0, v2, v3; -B_n + (1e-5, 0, 0) at v1 (above 1e-8);
+ *                     -B_n + (5e-9, 0, 0) at v4 (below 1e-8); tangent -(1, 0, 0) at v0.
+ *   "turn" (f = 1): to +x at v2 and v4, to 45 degrees between +z and +x at v3.
+ *   "cancel_below" (f = -1): -B_n at v3, so at w < 0 the vanishing end is span end a. */
 static void test_degenerate_normals(void)
 {
-    static const uint32_t idx[] = { 0, 1, 2, 3 }, idx2[] = { 2 };
-    static const float positions[12] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0 };
-    static const float normals[12] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 2 };
-    static const float tangents[16] = { 1, 0, 0, -1, 1, 0, 0, -1, 1, 0, 0, -1, 1, 0, 0, -1 };
+    static const uint32_t idx[] = { 0, 1, 2, 3, 4 }, idx_turn[] = { 2, 3, 4 }, idx3[] = { 3 };
+    static const float positions[15] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 0, 0 };
+    static const float normals[15] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 2, 0, 0, 1 };
+    static const float tangents[20] = { 1, 0, 0, -1, 1, 0, 0, -1, 1, 0, 0, -1, 1, 0, 0, -1, 1, 0, 0, -1 };
+    static const float zero[15] = { 0 };
     mk_raw_asset raw;
-    hand_mesh(&raw, 4, positions, normals, tangents);
-    hand_target cancel[1] = { { 1.0f, 4, idx, (const float[]){ 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0 },
-                                (const float[]){ 0, 0, -1, 1e-5f, 0, -1, 0, 0, -1, 0, 0, -2 },
-                                (const float[]){ -1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0 } } };
-    hand_target turn[1] = { { 1.0f, 1, idx2, (const float[]){ 0, 0, 0 }, (const float[]){ 1, 0, -1 }, NULL } };
+    hand_mesh(&raw, 5, positions, normals, tangents);
+    hand_target cancel[1] = { { 1.0f, 5, idx, zero, (const float[]){ 0, 0, -1, 1e-5f, 0, -1, 0, 0, -1, 0, 0, -2, 5e-9f, 0, -1 },
+                                (const float[]){ -1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0 } } };
+    hand_target turn[1] = { { 1.0f, 3, idx_turn, zero, (const float[]){ 1, 0, -1, 1, 0, -1, 1, 0, -1 }, NULL } };
+    hand_target cancel_below[1] = { { -1.0f, 1, idx3, zero, (const float[]){ 0, 0, -2 }, NULL } };
     hand_channel(&raw, "cancel", 1, cancel);
     hand_channel(&raw, "turn", 1, turn);
+    hand_channel(&raw, "cancel_below", 1, cancel_below);
     mk_arena arena;
     mk_arena_init(&arena, NULL);
     mk_asset asset;
     hand_open(&raw, MK_STACKING_ADDITIVE, &arena, &asset);
     static hand_frame f;
-    const double r = sqrt(0.5), tol = 2e-6;
+    const double r = sqrt(0.5), c8 = cos(PI / 8), s8 = sin(PI / 8), tol = 2e-6;
 
-    float w[2] = { 1, 0 };
+    float w[3] = { 1, 0, 0 };
     hand_eval(&raw, &asset, w, MK_STACKING_ASSET, MK_NORMALS_NLERP, &f);
     expect_kept_normal(&f, &raw, 0, "nlerp, sum exactly zero");
     expect_normal(&f, 1, 1, 0, 0, tol, "nlerp, sum of length 1e-5 (above 1e-8) is normalized");
     expect_kept_normal(&f, &raw, 2, "nlerp, sum exactly zero");
     expect_kept_normal(&f, &raw, 3, "nlerp, sum zero: the non-unit base normal is kept as stored");
+    expect_kept_normal(&f, &raw, 4, "nlerp, sum of length 5e-9 (below 1e-8): base kept");
     for (int k = 0; k < 3; k++) {
         CHECK(f.tangents[k] == tangents[k]);                 /* tangent sum zero: base kept */
         CHECK(f.ref[0].tangent[k] == tangents[k]);
@@ -759,6 +772,7 @@ static void test_degenerate_normals(void)
     expect_normal(&f, 0, 0, 0, 1, tol, "slerp, vanishing end replaced by normalize(B_n)");
     expect_normal(&f, 1, 1, 0, 0, tol, "slerp, end of length 1e-5 is normalized");
     expect_normal(&f, 3, 0, 0, 1, tol, "slerp, vanishing end, non-unit base");
+    expect_normal(&f, 4, 0, 0, 1, tol, "slerp, end of length 5e-9 replaced by normalize(B_n)");
 
     w[0] = 2;   /* extrapolated: nlerp sum -B; slerp of n0 with itself stays n0, of +z to +x turns 180 degrees */
     hand_eval(&raw, &asset, w, MK_STACKING_ASSET, MK_NORMALS_NLERP, &f);
@@ -767,12 +781,21 @@ static void test_degenerate_normals(void)
     expect_normal(&f, 0, 0, 0, 1, tol, "slerp at w = 2, vanishing end");
     expect_normal(&f, 1, 0, 0, -1, tol, "slerp at w = 2: +z through +x to -z");
 
-    w[0] = 0.5f;   /* v2: cancel's end vanishes (slerp: contributes nothing); turn at t = 1/2 */
+    w[0] = 0.5f;   /* cancel's end vanishes (slerp: contributes nothing); turn at t = 1/2 */
     w[1] = 0.5f;
     hand_eval(&raw, &asset, w, MK_STACKING_ASSET, MK_NORMALS_SLERP, &f);
     expect_normal(&f, 2, r, 0, r, tol, "slerp, a vanishing end beside another channel");
+    expect_normal(&f, 4, r, 0, r, tol, "slerp, an end below 1e-8 beside another channel");
+    /* v3: the vanishing end is normalize(B_n) = +z, not B_n = (0, 0, 2); turn slerps +z to 22.5
+     * degrees: B_n + (sin, 0, cos - 1) of 22.5 degrees */
+    expect_normal(&f, 3, s8, 0, 1 + c8, tol, "slerp, vanishing end b of a non-unit base beside another channel");
     hand_eval(&raw, &asset, w, MK_STACKING_ASSET, MK_NORMALS_NLERP, &f);
     expect_normal(&f, 2, 1, 0, 0, tol, "nlerp, half cancelled beside another channel: (0.5, 0, 0)");
+    const float below[3] = { 0, 0.5f, -0.5f };   /* v3: cancel_below's end a vanishes, t = 1/2 */
+    hand_eval(&raw, &asset, below, MK_STACKING_ASSET, MK_NORMALS_SLERP, &f);
+    expect_normal(&f, 3, s8, 0, 1 + c8, tol, "slerp, vanishing end a of a non-unit base beside another channel");
+    hand_eval(&raw, &asset, below, MK_STACKING_ASSET, MK_NORMALS_NLERP, &f);
+    expect_normal(&f, 3, 0.5, 0, 0.5, tol, "nlerp, half cancelled from below beside another channel");
     w[0] = 1;
     w[1] = 1;
     hand_eval(&raw, &asset, w, MK_STACKING_ASSET, MK_NORMALS_NLERP, &f);
