@@ -306,16 +306,25 @@ static void normalize3(float *v, const float *fallback)
     v[0] *= inv; v[1] *= inv; v[2] *= inv;
 }
 
-/* Slerp of unit vectors; t may lie outside [0, 1] (extrapolation along the great circle). */
+/* Slerp of unit vectors; t may lie outside [0, 1] (extrapolation along the great circle).
+ * The angle is atan2(|a x b|, a . b) and sin theta = |a x b|, not acos(a . b): in float acos
+ * cannot tell angles within 3.4e-4 of 0 or pi apart (the float below 1 is 1 - 6e-8, and acos
+ * of it 3.4e-4), so exactly opposite ends whose dot product rounded to -0.99999994 took the
+ * slerp branch with sin theta = 3.4e-4 instead of the lerp, and the slerp of nearly opposite
+ * ends erred by ~1e-7 / sin^2 theta. The cross product of parallel or opposite float vectors
+ * is 0 (or a rounding residue), and atan2 keeps the angle accurate everywhere. */
 static void slerp3(const float *a, const float *b, float t, float *out)
 {
-    float d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    d = d > 1 ? 1 : d < -1 ? -1 : d;
-    float theta = acosf(d);
-    float s = sinf(theta);
+    const float d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    const float c[3] = { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
+    const float s = sqrtf(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
     float wa, wb;
-    if (s < 1e-6f) { wa = 1.0f - t; wb = t; }   /* nearly parallel: lerp is exact enough */
-    else { wa = sinf((1.0f - t) * theta) / s; wb = sinf(t * theta) / s; }
+    if (s < 1e-6f) { wa = 1.0f - t; wb = t; }   /* parallel or opposite: the lerp */
+    else {
+        const float theta = atan2f(s, d);
+        wa = sinf((1.0f - t) * theta) / s;
+        wb = sinf(t * theta) / s;
+    }
     for (int k = 0; k < 3; k++) out[k] = wa * a[k] + wb * b[k];
 }
 
