@@ -75,7 +75,7 @@ static void check_mesh(const char *name, const char *frame_file, const mk_raw_as
     for (int stacking = MK_STACKING_ADDITIVE; stacking <= MK_STACKING_SEQUENTIAL; stacking++)
         for (int mode = MK_NORMALS_NLERP; mode <= MK_NORMALS_SLERP; mode++) {
             const float *w = weights + m.first_channel;
-            mk_eval_job job = { .asset = asset, .mesh = mi, .weights = w, .weight_count = m.channel_count,
+            mk_eval_job job = { .asset = asset, .mesh = mi, .vertex_count = MK_VERTICES_TO_END, .weights = w, .weight_count = m.channel_count,
                                 .stacking = (mk_stacking)stacking, .normal_mode = (mk_normal_mode)mode,
                                 .scratch = scratch, .scratch_size = scratch_size, .positions = p,
                                 .positions_size = 12u * (size_t)n, .normals = m.has_normals ? nr : NULL,

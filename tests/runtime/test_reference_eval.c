@@ -232,7 +232,7 @@ static uint32_t run_job(const mk_asset *asset, const mk_raw_asset *raw, const fl
                         .positions_size = 12u * (size_t)count, .normals = m->normals ? n : NULL,
                         .normals_size = 12u * (size_t)count, .tangents = m->tangents ? t : NULL,
                         .tangents_size = 16u * (size_t)count };
-    if (count == m->vertex_count - first && (first & 1)) job.vertex_count = 0;   /* 0: to the end of the mesh */
+    if (count == m->vertex_count - first && (first & 1)) job.vertex_count = MK_VERTICES_TO_END;
     mk_error err;
     if (mk_eval_run(&job, &err) != MK_OK) {
         *mismatch = (ref_mismatch){ first, err.message, 0, 0, 0, 0 };
@@ -442,7 +442,7 @@ static void hand_eval(const mk_raw_asset *raw, const mk_asset *asset, const floa
 {
     const mk_raw_mesh *m = &raw->meshes[0];
     _Alignas(16) unsigned char scratch[4096];
-    mk_eval_job job = { .asset = asset, .weights = weights, .weight_count = raw->channel_count, .stacking = job_stacking,
+    mk_eval_job job = { .asset = asset, .vertex_count = MK_VERTICES_TO_END, .weights = weights, .weight_count = raw->channel_count, .stacking = job_stacking,
                         .normal_mode = mode, .scratch = scratch, .scratch_size = sizeof scratch,
                         .positions = f->positions, .positions_size = sizeof f->positions,
                         .normals = m->normals ? f->normals : NULL, .normals_size = sizeof f->normals,
