@@ -11,9 +11,6 @@
 extern const cli_verb cli_verb_import, cli_verb_info, cli_verb_play, cli_verb_bake, cli_verb_export,
     cli_verb_conform, cli_verb_bench;
 
-/* Loads any supported input (.morph, .fbx, .gltf, .glb) into a raw model. */
-mk_result cli_load_raw(const char *path, const mk_import_options *options, mk_raw_asset *raw,
-                       mk_error *err);
 /* Prints the warnings of a raw model to stderr ("warning: ..."); nothing when there are none. */
 void cli_print_warnings(const mk_raw_asset *raw);
 /* Prints "morphkit <verb>: <error message>" to stderr; returns 1 (2 for invalid arguments). */

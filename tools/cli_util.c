@@ -4,13 +4,6 @@
 #include <unistd.h>
 #include "cli.h"
 
-mk_result cli_load_raw(const char *path, const mk_import_options *options, mk_raw_asset *raw, mk_error *err)
-{
-    mk_result r = mk_import_file(path, options, raw, err);
-    if (r == MK_OK) r = mk_raw_group_channels(raw, err);
-    return r;
-}
-
 void cli_print_warnings(const mk_raw_asset *raw)
 {
     uint32_t shown = raw->warning_count < MK_RAW_MAX_WARNINGS ? raw->warning_count : MK_RAW_MAX_WARNINGS;

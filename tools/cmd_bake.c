@@ -90,7 +90,7 @@ static int run_bake(void *p)
     mk_raw_init(&raw, NULL);
     mk_error err;
     mk_import_options io = { .keep_plain_meshes = 1 };  /* a plain mesh is a baker's natural input */
-    mk_result r = cli_load_raw(a->input, &io, &raw, &err);
+    mk_result r = mk_import_file(a->input, &io, &raw, &err);
     if (r != MK_OK) { mk_raw_free(&raw); return cli_fail(verb->name, &err); }
     void *recipe = NULL;
     size_t recipe_size = 0;

@@ -21,7 +21,8 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
-#include "asset_load.h"
+#include "asset.h"
+#include "cli.h"
 #include "frame.h"
 
 typedef struct bench_options {
@@ -328,7 +329,7 @@ static double frame_bytes(const mk_asset *a, const float *weights, int normals, 
 /* The naive baseline: dense float deltas for every target, a loop over all vertices for
  * each active target, then normals normalized. Returns ns per frame; checks its output
  * against the runtime's (max abs difference into *diff). */
-static double naive_frames(const loaded_asset *l, const float *weight_sets, uint32_t frames, double *diff)
+static double naive_frames(const pb_asset *l, const float *weight_sets, uint32_t frames, double *diff)
 {
     const mk_asset *a = &l->asset;
     mk_raw_asset raw;
@@ -379,7 +380,7 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
                     if (w[c] == 0) continue;
                     int32_t ia, ib;
                     float ca, cb;
-                    frame_channel_span(a, c, w[c], &ia, &ca, &ib, &cb);
+                    pb_channel_span(a, c, w[c], &ia, &ca, &ib, &cb);
                     for (int side = 0; side < 2; side++) {
                         int32_t k = side ? ib : ia;
                         float coef = side ? cb : ca;
@@ -402,7 +403,7 @@ static double naive_frames(const loaded_asset *l, const float *weight_sets, uint
         total += best;
         /* Check: the last frame against the runtime. */
         float *rp = malloc(12 * n), *rn = malloc(12 * n);
-        if (frame_eval_mesh(a, mi, weight_sets + (size_t)(frames - 1) * a->channel_count, MK_STACKING_ADDITIVE,
+        if (pb_eval_mesh(a, mi, weight_sets + (size_t)(frames - 1) * a->channel_count, MK_STACKING_ADDITIVE,
                             MK_NORMALS_NLERP, rp, m->normals ? rn : NULL, &err) == MK_OK)
             for (size_t i = 0; i < 3 * n; i++) {
                 double d = fabs((double)rp[i] - out_p[i]);
@@ -494,21 +495,21 @@ static int run_bench(void *p)
     }
     cli_progress progress;
     cli_progress_init(&progress, args->quiet || args->json);
-    loaded_asset l;
+    pb_asset l;
     mk_error err;
     memset(&l, 0, sizeof l);
     mk_result r;
     double t_build = now_ns();
     cli_progress_update(&progress, file ? "loading the asset" : "building the synthetic asset", -1);
     if (file) {
-        r = load_asset(file, NULL, NULL, &l, &err);
+        r = pb_asset_load(file, NULL, NULL, &l, &err);
     } else {
         mk_raw_init(&l.raw, NULL);
         r = build_synthetic(&o, &l.raw, &err);
         if (!r) r = mk_write_blob(&l.raw, NULL, &l.raw.arena, &l.blob, &l.blob_size, &l.report, &err);
         if (!r) r = mk_asset_open(l.blob, l.blob_size, &l.asset, &err);
     }
-    if (r) { loaded_asset_free(&l); return cli_fail(verb->name, &err); }
+    if (r) { pb_asset_free(&l); return cli_fail(verb->name, &err); }
     t_build = now_ns() - t_build;
     const mk_asset *a = &l.asset;
 
@@ -523,7 +524,7 @@ static int run_bench(void *p)
             mk_clip_info clip;
             double t = 0;
             if (mk_clip_get(a, 0, &clip)) t = clip.start + clip.duration * (float)f / (float)(frames > 1 ? frames - 1 : 1);
-            frame_weights(a, a->clip_count ? 0 : -1, t, w, &err);
+            pb_frame_weights(a, a->clip_count ? 0 : -1, t, w, &err);
         } else {
             for (uint32_t k = 0; k < o.active; k++) {
                 uint32_t c = (k * 97u) % a->channel_count;
@@ -633,6 +634,6 @@ static int run_bench(void *p)
     free(threads);
     free(workers);
     free(weights);
-    loaded_asset_free(&l);
+    pb_asset_free(&l);
     return 0;
 }

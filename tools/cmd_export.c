@@ -74,7 +74,7 @@ static int run_export(void *p)
     void *gltf = NULL;
     char *sidecar = NULL;
     size_t gltf_size = 0, sidecar_size = 0;
-    mk_result r = cli_load_raw(a->input, &io, &raw, &err);
+    mk_result r = mk_import_file(a->input, &io, &raw, &err);
     cli_print_warnings(&raw);
     if (r == MK_OK)
         r = mk_export_gltf_memory(&raw, container, &raw.arena, &gltf, &gltf_size, count == 2 ? &sidecar : NULL,

@@ -66,7 +66,7 @@ static int run_import(void *p)
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err;
-    mk_result r = cli_load_raw(a->input, &io, &raw, &err);
+    mk_result r = mk_import_file(a->input, &io, &raw, &err);
     cli_print_warnings(&raw);
     void *blob = NULL;
     size_t size = 0;

@@ -4,7 +4,8 @@
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
-#include "asset_load.h"
+#include "asset.h"
+#include "cli.h"
 #include "json_write.h"
 
 static void precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *floats, double *max_error_bound)
@@ -28,7 +29,7 @@ static void precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *float
     }
 }
 
-static void print_text(FILE *f, const loaded_asset *l, const char *path)
+static void print_text(FILE *f, const pb_asset *l, const char *path)
 {
     const mk_asset *a = &l->asset;
     uint32_t nq, nf;
@@ -76,7 +77,7 @@ static void print_text(FILE *f, const loaded_asset *l, const char *path)
     }
 }
 
-static void print_json(FILE *f, const loaded_asset *l, const char *path)
+static void print_json(FILE *f, const pb_asset *l, const char *path)
 {
     const mk_asset *a = &l->asset;
     uint32_t nq, nf;
@@ -190,19 +191,19 @@ static int run_info(void *p)
     const char *inputs[] = { a->input };
     int status = cli_output_check(verb, &out, "-o", a->output, NULL, "a description", 1, inputs, 1);
     if (status >= 0) return status;
-    loaded_asset l;
+    pb_asset l;
     mk_error err;
-    if (load_asset(a->input, NULL, NULL, &l, &err)) { loaded_asset_free(&l); return cli_fail(verb->name, &err); }
+    if (pb_asset_load(a->input, NULL, NULL, &l, &err)) { pb_asset_free(&l); return cli_fail(verb->name, &err); }
     char *text = NULL;
     size_t size = 0;
     FILE *f = open_memstream(&text, &size);
-    if (!f) { loaded_asset_free(&l); fprintf(stderr, "morphkit info: out of memory\n"); return CLI_EXIT_FAILURE; }
+    if (!f) { pb_asset_free(&l); fprintf(stderr, "morphkit info: out of memory\n"); return CLI_EXIT_FAILURE; }
     if (a->json) print_json(f, &l, a->input); else print_text(f, &l, a->input);
     fclose(f);
     out.file.data = text;
     out.file.size = size;
     status = cli_write_outputs(verb, &out, 1);
     free(text);
-    loaded_asset_free(&l);
+    pb_asset_free(&l);
     return status;
 }

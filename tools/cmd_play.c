@@ -3,7 +3,8 @@
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
-#include "asset_load.h"
+#include "asset.h"
+#include "cli.h"
 #include "frame.h"
 #include "json_write.h"
 #include "weights_arg.h"
@@ -149,17 +150,17 @@ static int run_play(void *p)
     mk_stacking stacking = !args->stacking_given ? MK_STACKING_ASSET : args->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
     mk_normal_mode nmode = args->normals ? MK_NORMALS_SLERP : MK_NORMALS_NLERP;
 
-    loaded_asset l;
+    pb_asset l;
     mk_error err;
-    if (load_asset(args->input, NULL, NULL, &l, &err)) { loaded_asset_free(&l); return cli_fail(verb->name, &err); }
+    if (pb_asset_load(args->input, NULL, NULL, &l, &err)) { pb_asset_free(&l); return cli_fail(verb->name, &err); }
     const mk_asset *a = &l.asset;
     int32_t clip = -1;
     if (args->clip) {
         clip = find_clip(verb, a, args->clip);
-        if (clip < 0) { loaded_asset_free(&l); return CLI_EXIT_USAGE; }
+        if (clip < 0) { pb_asset_free(&l); return CLI_EXIT_USAGE; }
     } else if (args->time_given) {
         if (!a->clip_count) {
-            loaded_asset_free(&l);
+            pb_asset_free(&l);
             return cli_usage_error(verb, "--time: %s has no clip to sample", args->input);
         }
         clip = 0;
@@ -169,7 +170,7 @@ static int run_play(void *p)
     char *text = NULL, why[1024];
     size_t text_size = 0;
     if (!weights || !pos || !nrm) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
-    if (frame_weights(a, clip, args->time, weights, &err)) { status = cli_fail(verb->name, &err); goto done; }
+    if (pb_frame_weights(a, clip, args->time, weights, &err)) { status = cli_fail(verb->name, &err); goto done; }
     if (args->weights && weights_arg_apply(a, args->weights, weights, why, sizeof why) != 0) {
         status = cli_usage_error(verb, "--weights: %s", why);
         goto done;
@@ -180,8 +181,8 @@ static int run_play(void *p)
         pos[i] = malloc(12u * (size_t)m.vertex_count);
         nrm[i] = m.has_normals ? malloc(12u * (size_t)m.vertex_count) : NULL;
         if (!pos[i] || (m.has_normals && !nrm[i])) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
-        if (frame_eval_mesh(a, i, weights, stacking, nmode, pos[i], nrm[i], &err)) { status = cli_fail(verb->name, &err); goto done; }
-        if (!args->space) frame_to_world(m.world, pos[i], nrm[i], m.vertex_count);
+        if (pb_eval_mesh(a, i, weights, stacking, nmode, pos[i], nrm[i], &err)) { status = cli_fail(verb->name, &err); goto done; }
+        if (!args->space) pb_to_world(m.world, pos[i], nrm[i], m.vertex_count);
     }
     FILE *f = open_memstream(&text, &text_size);
     if (!f) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
@@ -215,6 +216,6 @@ done:
     free(pos);
     free(nrm);
     free(weights);
-    loaded_asset_free(&l);
+    pb_asset_free(&l);
     return status;
 }

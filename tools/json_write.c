@@ -84,6 +84,12 @@ void json_int(json_writer *w, const char *key, long long value)
     fprintf(w->f, "%lld", value);
 }
 
+void json_null(json_writer *w, const char *key)
+{
+    element(w, key);
+    fputs("null", w->f);
+}
+
 void json_bool(json_writer *w, const char *key, int value)
 {
     element(w, key);

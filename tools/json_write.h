@@ -20,6 +20,7 @@ void json_string(json_writer *w, const char *key, const char *value);
 void json_number(json_writer *w, const char *key, double value);
 void json_int(json_writer *w, const char *key, long long value);
 void json_bool(json_writer *w, const char *key, int value);
+void json_null(json_writer *w, const char *key);
 /* An array of floats on one line. */
 void json_floats(json_writer *w, const char *key, const float *values, size_t count);
 

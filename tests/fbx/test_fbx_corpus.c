@@ -1,186 +1,53 @@
-/* FBX import against the shared corpus: every "fbx" case of cases.json is imported with
- * mk_import_fbx, evaluated through the runtime (float blob, mk_sample_run on clip 0 at the
- * frame time, or the default weights for a "time": null frame: the static state), moved to
- * world space with the mesh's world transform and compared per control point with the
- * reference (ufbx JSON frames and the authoring tools' OBJ exports) at the case's tolerance
- * plus float32 rounding. SKIPs when the corpus is absent. */
+/* FBX import against the shared corpus: every "fbx" case of cases.json is imported, written as
+ * a float blob and checked frame by frame with the conformance check `morphkit conform` uses
+ * (playback/conform.c: the static state for "time": null, the first stack otherwise; world
+ * space; per control point; case tolerance plus float32 rounding), and facts the frames do not
+ * show (names, in-between order). SKIPs when the corpus is absent. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <cjson/cJSON.h>
 #include "check.h"
+#include "conform.h"
 #include "fbx_test_util.h"
-
-static cJSON *read_json(const char *path)
-{
-    size_t size;
-    unsigned char *text = check_read_file(path, &size);
-    if (!text) return NULL;
-    cJSON *json = cJSON_ParseWithLength((const char *)text, size);
-    free(text);
-    return json;
-}
-
-/* OBJ `v` lines (world positions, one per FBX control point). */
-static double *read_obj(const char *path, uint32_t *count)
-{
-    size_t size;
-    unsigned char *text = check_read_file(path, &size);
-    if (!text) return NULL;
-    double *v = malloc((size / 4 + 3) * sizeof(double));
-    uint32_t n = 0;
-    char *line = (char *)text;
-    char *end = (char *)text + size;
-    while (v && line < end) {
-        char *next = memchr(line, '\n', (size_t)(end - line));
-        if (!next) next = end;
-        if (next - line > 2 && line[0] == 'v' && line[1] == ' ') {
-            char buffer[256];
-            size_t len = (size_t)(next - line) < sizeof buffer - 1 ? (size_t)(next - line) : sizeof buffer - 1;
-            memcpy(buffer, line, len);
-            buffer[len] = 0;
-            double x, y, z;
-            if (sscanf(buffer + 2, "%lf %lf %lf", &x, &y, &z) == 3) {
-                v[3 * n] = x;
-                v[3 * n + 1] = y;
-                v[3 * n + 2] = z;
-                n++;
-            }
-        }
-        line = next + 1;
-    }
-    free(text);
-    *count = n;
-    return v;
-}
-
-/* Results are float32: nothing can be closer to a reference coordinate than half a float32
- * ulp of it, so that much is allowed on top of the case's tolerance. */
-static double float32_half_ulp(double x)
-{
-    int exponent;
-    frexp(fabs(x), &exponent);
-    return x != 0 ? ldexp(1.0, exponent - 25) : 0.0;
-}
-
-static void run_case(const char *corpus, const cJSON *c, double *worst)
-{
-    const char *name = cJSON_GetObjectItem(c, "name")->valuestring;
-    const char *source = cJSON_GetObjectItem(c, "source")->valuestring;
-    const cJSON *reference = cJSON_GetObjectItem(c, "reference");
-    double tolerance = cJSON_GetObjectItem(reference, "tolerance")->valuedouble;
-    const char *kind = cJSON_GetObjectItem(reference, "kind")->valuestring;
-    char path[1024];
-    snprintf(path, sizeof path, "%s/%s", corpus, source);
-    size_t size;
-    unsigned char *data = check_read_file(path, &size);
-    CHECK_MSG(data != NULL, "%s: cannot read %s", name, path);
-    if (!data) return;
-    mk_raw_asset raw;
-    mk_error err;
-    mk_result r = ft_import(data, size, NULL, &raw, &err);
-    free(data);
-    CHECK_MSG(r == MK_OK, "%s: import failed: %s", name, err.message);
-    if (r != MK_OK) { mk_raw_free(&raw); return; }
-    CHECK_MSG(mk_raw_validate(&raw, &err) == MK_OK, "%s: invalid raw model: %s", name, err.message);
-    const cJSON *frame;
-    cJSON_ArrayForEach(frame, cJSON_GetObjectItem(c, "frames")) {
-        const cJSON *time = cJSON_GetObjectItem(frame, "time");
-        snprintf(path, sizeof path, "%s/%s", corpus, cJSON_GetObjectItem(frame, "file")->valuestring);
-        int clip = cJSON_IsNumber(time) ? 0 : -1;
-        float t = cJSON_IsNumber(time) ? (float)time->valuedouble : 0.0f;
-        if (clip >= 0 && raw.clip_count == 0) {
-            CHECK_MSG(0, "%s: frame at %g s but the import has no clip", name, t);
-            continue;
-        }
-        if (strcmp(kind, "obj") == 0) {
-            uint32_t n = 0;
-            double *ref = read_obj(path, &n);
-            CHECK_MSG(ref != NULL, "%s: cannot read %s", name, path);
-            /* The OBJ frames are of the one mesh with channels. */
-            int32_t mesh = -1;
-            for (uint32_t m = 0; m < raw.mesh_count && mesh < 0; m++)
-                for (uint32_t k = 0; k < raw.channel_count; k++)
-                    if (raw.channels[k].mesh == m) { mesh = (int32_t)m; break; }
-            CHECK(mesh >= 0);
-            float *ours = NULL;
-            uint32_t cps = 0;
-            if (ref && mesh >= 0 && ft_eval_control_points(&raw, (uint32_t)mesh, clip, t, NULL, 1, &ours, &cps) == 0) {
-                CHECK_EQ_INT(cps, n);
-                double err_max = 0;
-                for (uint32_t i = 0; i < 3 * n && cps == n; i++)
-                    err_max = fmax(err_max, fabs((double)ours[i] - ref[i]) - float32_half_ulp(ref[i]));
-                CHECK_MSG(err_max <= tolerance, "%s %s: max error %g > %g", name, path, err_max, tolerance);
-                if (err_max > *worst) *worst = err_max;
-            } else {
-                CHECK_MSG(0, "%s: evaluation failed", name);
-            }
-            free(ours);
-            free(ref);
-            continue;
-        }
-        cJSON *json = read_json(path);
-        CHECK_MSG(json != NULL, "%s: cannot read %s", name, path);
-        if (!json) continue;
-        const cJSON *rm;
-        cJSON_ArrayForEach(rm, cJSON_GetObjectItem(json, "meshes")) {
-            const char *node = cJSON_GetObjectItem(rm, "node")->valuestring;
-            const cJSON *channels = cJSON_GetObjectItem(rm, "channels");
-            int32_t mesh = ft_find_mesh(&raw, node);
-            if (mesh < 0) {
-                CHECK_MSG(cJSON_GetArraySize(channels) == 0, "%s: mesh '%s' with channels not imported", name, node);
-                continue;
-            }
-            /* Channel names and count as ufbx reports them. */
-            uint32_t ours_channels = 0;
-            for (uint32_t k = 0; k < raw.channel_count; k++) ours_channels += raw.channels[k].mesh == (uint32_t)mesh;
-            CHECK_MSG(ours_channels == (uint32_t)cJSON_GetArraySize(channels), "%s '%s': %u channels, reference %d", name,
-                      node, ours_channels, cJSON_GetArraySize(channels));
-            float *ours = NULL;
-            uint32_t cps = 0;
-            if (ft_eval_control_points(&raw, (uint32_t)mesh, clip, t, NULL, 1, &ours, &cps) != 0) {
-                CHECK_MSG(0, "%s: evaluation failed", name);
-                continue;
-            }
-            const cJSON *positions = cJSON_GetObjectItem(rm, "positions");
-            CHECK_EQ_INT(3 * cps, cJSON_GetArraySize(positions));
-            double err_max = 0;
-            int i = 0;
-            const cJSON *e;
-            cJSON_ArrayForEach(e, positions) {
-                if ((uint32_t)i < 3 * cps)
-                    err_max = fmax(err_max, fabs(ours[i] - e->valuedouble) - float32_half_ulp(e->valuedouble));
-                i++;
-            }
-            CHECK_MSG(err_max <= tolerance, "%s %s '%s': max error %g > %g", name, path, node, err_max, tolerance);
-            if (err_max > *worst) *worst = err_max;
-            free(ours);
-        }
-        cJSON_Delete(json);
-    }
-    mk_raw_free(&raw);
-}
 
 static void test_corpus_frames(void)
 {
     const char *corpus = check_corpus_dir();
-    char path[1024];
+    char path[4200];
     snprintf(path, sizeof path, "%s/cases.json", corpus);
-    cJSON *cases = read_json(path);
-    if (!cases) SKIP("corpus not found at %s", corpus);
-    double worst = 0;
-    int count = 0;
-    const cJSON *c;
-    cJSON_ArrayForEach(c, cJSON_GetObjectItem(cases, "cases")) {
-        const cJSON *format = cJSON_GetObjectItem(c, "format");
-        if (!cJSON_IsString(format) || strcmp(format->valuestring, "fbx") != 0) continue;
-        run_case(corpus, c, &worst);
-        count++;
+    pb_manifest manifest;
+    mk_error err;
+    if (pb_manifest_read(path, &manifest, &err) != MK_OK) {
+        pb_manifest_free(&manifest);
+        SKIP("corpus not found at %s", corpus);
     }
-    CHECK(count > 0);
-    fprintf(stderr, "fbx corpus: %d cases, worst position error %.3g\n", count, worst);
-    cJSON_Delete(cases);
+    double worst = 0, worst_weight = 0;
+    int cases = 0, frames = 0;
+    mk_write_options wo = { .precision = MK_PRECISION_FLOAT };
+    for (uint32_t i = 0; i < manifest.case_count; i++) {
+        const pb_case *c = &manifest.cases[i];
+        if (c->gltf) continue;
+        cases++;
+        pb_manifest_path(&manifest, c->source, path, sizeof path);
+        pb_asset asset;
+        mk_result r = pb_asset_load(path, NULL, &wo, &asset, &err);
+        CHECK_MSG(r == MK_OK, "%s: import failed: %s", c->name, err.message);
+        for (uint32_t k = 0; r == MK_OK && k < c->frame_count; k++) {
+            pb_frame_result res;
+            pb_conform_frame(&manifest, c, &c->frames[k], &asset, NULL, &res);
+            CHECK_MSG(res.passed, "%s %s: position error %g (allowed %g), weight error %g%s%s", c->name, c->frames[k].file,
+                      res.position_error, res.allowed, res.weight_error, res.failure[0] ? ": " : "", res.failure);
+            if (res.position_error > worst) worst = res.position_error;
+            if (res.weight_error > worst_weight) worst_weight = res.weight_error;
+            frames++;
+        }
+        pb_asset_free(&asset);
+    }
+    CHECK(cases > 0);
+    fprintf(stderr, "fbx corpus: %d cases, %d frames, worst position error %.3g, worst weight error %.3g\n", cases, frames,
+            worst, worst_weight);
+    pb_manifest_free(&manifest);
 }
 
 /* Facts the frames do not show: names, in-between order, quirks. */

@@ -15,19 +15,22 @@ static void test_corpus_references(void)
     const char *corpus = check_corpus_dir();
     char path[1024];
     snprintf(path, sizeof path, "%s/cases.json", corpus);
-    cJSON *cases = gt_read_json(path);
-    if (!cases) SKIP("corpus not found at %s", corpus);
+    pb_manifest manifest;
+    mk_error err;
+    if (pb_manifest_read(path, &manifest, &err) != MK_OK) {
+        pb_manifest_free(&manifest);
+        SKIP("corpus not found at %s", corpus);
+    }
     int n = 0, frames = 0;
     double wp = 0, wn = 0;
-    const cJSON *c;
-    cJSON_ArrayForEach(c, cJSON_GetObjectItem(cases, "cases")) {
-        if (strcmp(cJSON_GetObjectItem(c, "format")->valuestring, "gltf") != 0) continue;
-        gt_check_case(corpus, c, NULL, &wp, &wn, &frames);
+    for (uint32_t i = 0; i < manifest.case_count; i++) {
+        if (!manifest.cases[i].gltf) continue;
+        gt_check_case(&manifest, &manifest.cases[i], NULL, &wp, &wn, &frames);
         n++;
     }
     CHECK(n >= 8);
-    printf("  %d glTF cases, %d frames: max position error %.3g, max normal direction error %.3g\n", n, frames, wp, wn);
-    cJSON_Delete(cases);
+    printf("  %d glTF cases, %d frames: max position error %.3g, max normal angle %.3g deg\n", n, frames, wp, wn);
+    pb_manifest_free(&manifest);
 }
 
 /* ---- variants ---- */

@@ -46,27 +46,29 @@ static void check_valid(const char *path)
 static void test_round_trip_corpus(void)
 {
     const char *corpus = check_corpus_dir();
-    char path[1024], out[1024], side[1024], msg[512];
+    char path[4200], out[1024], side[1024], msg[512];
     snprintf(path, sizeof path, "%s/cases.json", corpus);
-    cJSON *cases = gt_read_json(path);
-    if (!cases) SKIP("corpus not found at %s", corpus);
+    pb_manifest manifest;
+    mk_error err = {0};
+    if (pb_manifest_read(path, &manifest, &err) != MK_OK) {
+        pb_manifest_free(&manifest);
+        SKIP("corpus not found at %s", corpus);
+    }
     int n = 0, frames = 0;
     double wp = 0, wn = 0;
-    const cJSON *c;
-    cJSON_ArrayForEach(c, cJSON_GetObjectItem(cases, "cases")) {
-        if (strcmp(cJSON_GetObjectItem(c, "format")->valuestring, "gltf") != 0) continue;
-        const char *name = cJSON_GetObjectItem(c, "name")->valuestring;
-        snprintf(path, sizeof path, "%s/%s", corpus, cJSON_GetObjectItem(c, "source")->valuestring);
+    for (uint32_t i = 0; i < manifest.case_count; i++) {
+        const pb_case *c = &manifest.cases[i];
+        if (!c->gltf) continue;
+        pb_manifest_path(&manifest, c->source, path, sizeof path);
         for (int variant = 0; variant < 2; variant++) {
             const char *ext = variant ? "gltf" : "glb";
             gt_model orig;
-            if (gt_load(&orig, path, NULL, msg, sizeof msg)) { CHECK_MSG(0, "%s: %s", name, msg); gt_free(&orig); continue; }
-            snprintf(out, sizeof out, "%s_%s.%s", out_prefix(), name, ext);
-            snprintf(side, sizeof side, "%s_%s.%s.channels.json", out_prefix(), name, ext);
-            mk_error err = {0};
+            if (gt_load(&orig, path, NULL, msg, sizeof msg)) { CHECK_MSG(0, "%s: %s", c->name, msg); gt_free(&orig); continue; }
+            snprintf(out, sizeof out, "%s_%s.%s", out_prefix(), c->name, ext);
+            snprintf(side, sizeof side, "%s_%s.%s.channels.json", out_prefix(), c->name, ext);
             mk_gltf_export_report rep;
             mk_result r = mk_export_gltf(&orig.raw, out, side, &rep, &err);
-            CHECK_MSG(r == MK_OK, "%s: export: %s", name, err.message);
+            CHECK_MSG(r == MK_OK, "%s: export: %s", c->name, err.message);
             gt_free(&orig);
             if (r != MK_OK) continue;
             check_valid(out);
@@ -74,9 +76,9 @@ static void test_round_trip_corpus(void)
             for (int with_sidecar = 1; with_sidecar >= 0; with_sidecar--) {
                 gt_model back;
                 if (gt_load(&back, out, with_sidecar ? side : NULL, msg, sizeof msg)) {
-                    CHECK_MSG(0, "%s re-import: %s", name, msg);
+                    CHECK_MSG(0, "%s re-import: %s", c->name, msg);
                 } else {
-                    gt_check_case(corpus, c, &back, &wp, &wn, &frames);
+                    gt_check_case(&manifest, c, &back, &wp, &wn, &frames);
                 }
                 gt_free(&back);
             }
@@ -86,9 +88,9 @@ static void test_round_trip_corpus(void)
         n++;
     }
     CHECK(n >= 8);
-    printf("  %d cases exported as .glb and .gltf, %d re-imported frames: max position error %.3g, normal direction %.3g\n",
+    printf("  %d cases exported as .glb and .gltf, %d re-imported frames: max position error %.3g, normal angle %.3g deg\n",
            n, frames, wp, wn);
-    cJSON_Delete(cases);
+    pb_manifest_free(&manifest);
 }
 
 /* ---- a synthetic asset with what glTF cannot say directly ---- */

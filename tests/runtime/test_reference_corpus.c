@@ -8,56 +8,28 @@
  * reference's derived tolerances. SKIPs when the corpus is absent. */
 #include <stdlib.h>
 #include <string.h>
-#include <cjson/cJSON.h>
 #include "check.h"
 #include "blob_io.h"
+#include "conform.h"
 #include "import.h"
 #include "reference_eval.h"
-
-static cJSON *read_json(const char *path)
-{
-    size_t size;
-    unsigned char *text = check_read_file(path, &size);
-    if (!text) return NULL;
-    cJSON *json = cJSON_ParseWithLength((const char *)text, size);
-    free(text);
-    return json;
-}
 
 typedef struct corpus_totals {
     int frames, jobs;
     ref_stats stats[2];
 } corpus_totals;
 
-/* The frame's asset-wide weights, as the conformance run picks them: a frame with "time": null
- * or with forced "weights" is the static state (channel defaults; forced weights replace each
- * mesh's channels in order); otherwise the named "clip", or for FBX the first clip, is sampled
- * at the time. */
-static int frame_weights(const mk_asset *a, const cJSON *frame, int gltf, float *weights)
+/* The frame's asset-wide weights as the conformance check plays it (pb_conform_weights: the
+ * static state for "time": null or forced weights, else the clip at the time), with forced
+ * weights replacing each mesh's channels in order. */
+static int frame_weights(const pb_case *c, const pb_frame_spec *f, const mk_asset *a, float *weights)
 {
-    const cJSON *time = cJSON_GetObjectItem(frame, "time"), *clip = cJSON_GetObjectItem(frame, "clip"),
-                *forced = cJSON_GetObjectItem(frame, "weights");
-    for (uint32_t c = 0; c < a->channel_count; c++) {
-        mk_channel_info info;
-        mk_channel_get(a, c, &info);
-        weights[c] = info.default_weight;
-    }
-    int32_t clip_index = -1;
-    if (cJSON_IsNumber(time) && !forced)
-        clip_index = cJSON_IsNumber(clip) ? clip->valueint : !gltf && a->clip_count ? 0 : -1;
-    if (clip_index >= (int32_t)a->clip_count) return 0;
-    if (clip_index >= 0) {
-        mk_sample_job job = { .asset = a, .clip = (uint32_t)clip_index, .time = time->valuedouble, .weights = weights,
-                              .weight_count = a->channel_count };
-        mk_error err;
-        if (mk_sample_run(&job, &err) != MK_OK) return 0;
-    }
-    for (uint32_t mi = 0; forced && mi < a->mesh_count; mi++) {
+    mk_error err;
+    if (pb_conform_weights(c, f, a, weights, &err) != MK_OK) return 0;
+    for (uint32_t mi = 0; f->forced && mi < a->mesh_count; mi++) {
         mk_mesh_info m;
         mk_mesh_get(a, mi, &m);
-        uint32_t k = 0;
-        for (const cJSON *v = cJSON_IsArray(forced) ? forced->child : NULL; v && k < m.channel_count; v = v->next, k++)
-            weights[m.first_channel + k] = (float)v->valuedouble;
+        for (uint32_t k = 0; k < f->forced_count && k < m.channel_count; k++) weights[m.first_channel + k] = (float)f->forced[k];
     }
     return 1;
 }
@@ -105,19 +77,15 @@ static void check_mesh(const char *name, const char *frame_file, const mk_raw_as
     free(scratch);
 }
 
-static void run_case(const char *corpus, const cJSON *c, corpus_totals *tot)
+static void run_case(const pb_manifest *manifest, const pb_case *c, corpus_totals *tot)
 {
-    const char *name = cJSON_GetStringValue(cJSON_GetObjectItem(c, "name"));
-    const char *source = cJSON_GetStringValue(cJSON_GetObjectItem(c, "source"));
-    const char *format = cJSON_GetStringValue(cJSON_GetObjectItem(c, "format"));
-    const int gltf = format && !strcmp(format, "gltf");
-    char path[2048];
-    snprintf(path, sizeof path, "%s/%s", corpus, source ? source : "");
+    const char *name = c->name;
+    char path[4200];
+    pb_manifest_path(manifest, c->source, path, sizeof path);
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err;
     mk_result r = mk_import_file(path, NULL, &raw, &err);
-    if (r == MK_OK) r = mk_raw_group_channels(&raw, &err);
     CHECK_MSG(r == MK_OK, "%s: import %s: %s", name, path, err.message);
     if (r != MK_OK) { mk_raw_free(&raw); return; }
 
@@ -137,11 +105,9 @@ static void run_case(const char *corpus, const cJSON *c, corpus_totals *tot)
         if (q) stored[q] = (ref_stored_error){ report.max_position_error, report.max_normal_error, report.max_tangent_error };
     }
     float *weights = calloc(assets[0].channel_count + 1u, sizeof(float));
-    const cJSON *frame;
-    cJSON_ArrayForEach(frame, cJSON_GetObjectItem(c, "frames")) {
-        const char *file = cJSON_GetStringValue(cJSON_GetObjectItem(frame, "file"));
-        const char *short_name = file && strrchr(file, '/') ? strrchr(file, '/') + 1 : file ? file : "?";
-        int ok = frame_weights(&assets[0], frame, gltf, weights);
+    for (uint32_t k = 0; k < c->frame_count; k++) {
+        const char *short_name = pb_frame_label(&c->frames[k]);
+        int ok = frame_weights(c, &c->frames[k], &assets[0], weights);
         CHECK_MSG(ok, "%s %s: no weights for the frame (clip missing or sampling failed)", name, short_name);
         if (!ok) continue;
         tot->frames++;
@@ -162,13 +128,16 @@ static void test_corpus_other_modes(void)
     const char *corpus = check_corpus_dir();
     char path[2048];
     snprintf(path, sizeof path, "%s/cases.json", corpus);
-    cJSON *cases = read_json(path);
-    if (!cases) SKIP("corpus not found at %s", corpus);
+    pb_manifest manifest;
+    mk_error err;
+    if (pb_manifest_read(path, &manifest, &err) != MK_OK) {
+        pb_manifest_free(&manifest);
+        SKIP("corpus not found at %s", corpus);
+    }
     corpus_totals tot;
     memset(&tot, 0, sizeof tot);
-    const cJSON *c;
-    cJSON_ArrayForEach(c, cJSON_GetObjectItem(cases, "cases")) run_case(corpus, c, &tot);
-    cJSON_Delete(cases);
+    for (uint32_t i = 0; i < manifest.case_count; i++) run_case(&manifest, &manifest.cases[i], &tot);
+    pb_manifest_free(&manifest);
     CHECK(tot.frames > 0);
     printf("corpus: %d frames, %d jobs (additive/sequential x nlerp/slerp x float/q16), %llu + %llu vertices "
            "compared, %llu + %llu unstable normals skipped\n",

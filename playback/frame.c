@@ -1,8 +1,9 @@
 #include <math.h>
 #include <stdlib.h>
+#include "alloc.h"
 #include "frame.h"
 
-mk_result frame_weights(const mk_asset *asset, int32_t clip, double time, float *weights, mk_error *err)
+mk_result pb_frame_weights(const mk_asset *asset, int32_t clip, double time, float *weights, mk_error *err)
 {
     for (uint32_t c = 0; c < asset->channel_count; c++) {
         mk_channel_info info;
@@ -15,19 +16,18 @@ mk_result frame_weights(const mk_asset *asset, int32_t clip, double time, float 
     return mk_sample_run(&job, err);
 }
 
-mk_result frame_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
+mk_result pb_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
                           mk_normal_mode normals_mode, float *positions, float *normals, mk_error *err)
 {
     mk_mesh_info m;
-    if (!mk_mesh_get(asset, mesh, &m)) {
-        err->code = MK_ERROR_OUT_OF_RANGE;
-        return MK_ERROR_OUT_OF_RANGE;
-    }
+    if (!mk_mesh_get(asset, mesh, &m))
+        return mk_error_set(err, MK_ERROR_OUT_OF_RANGE, UINT64_MAX, "mesh %u does not exist (%u meshes)", mesh, asset->mesh_count);
     size_t scratch_size = mk_eval_scratch_size(asset, mesh);
-    void *scratch = aligned_alloc(16, (scratch_size + 15) & ~(size_t)15);
-    if (!scratch) return MK_ERROR_OUT_OF_MEMORY;
+    void *scratch = aligned_alloc(16, (scratch_size + 31) & ~(size_t)15);   /* never 0 bytes */
+    if (!scratch) return mk_error_oom(err, "evaluation scratch");
     mk_eval_job job = {
-        .asset = asset, .mesh = mesh, .vertex_count = MK_VERTICES_TO_END, .weights = weights + m.first_channel, .weight_count = m.channel_count,
+        .asset = asset, .mesh = mesh, .vertex_count = MK_VERTICES_TO_END,
+        .weights = weights + m.first_channel, .weight_count = m.channel_count,
         .stacking = stacking, .normal_mode = normals_mode, .scratch = scratch, .scratch_size = scratch_size,
         .positions = positions, .positions_size = (size_t)m.vertex_count * 12,
         .normals = m.has_normals ? normals : NULL, .normals_size = (size_t)m.vertex_count * 12,
@@ -37,7 +37,7 @@ mk_result frame_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *wei
     return r;
 }
 
-void frame_channel_span(const mk_asset *asset, uint32_t channel, float w, int32_t *ia, float *ca, int32_t *ib,
+void pb_channel_span(const mk_asset *asset, uint32_t channel, float w, int32_t *ia, float *ca, int32_t *ib,
                         float *cb)
 {
     mk_channel_info ch;
@@ -53,7 +53,7 @@ void frame_channel_span(const mk_asset *asset, uint32_t channel, float w, int32_
     if (full != small) free(full);
 }
 
-void frame_to_world(const float w[16], float *positions, float *normals, uint32_t count)
+void pb_to_world(const float w[16], float *positions, float *normals, uint32_t count)
 {
     /* Column-major: x' = w[0] x + w[4] y + w[8] z + w[12]. */
     double a = w[0], b = w[4], c = w[8], d = w[1], e = w[5], f = w[9], g = w[2], h = w[6], i = w[10];

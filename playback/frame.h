@@ -1,0 +1,24 @@
+/* One evaluated frame of an asset through the runtime's public jobs: weights from a clip or
+ * the defaults, a mesh's positions and normals, the world transform. Shared by play, conform,
+ * bench, render and the tests. */
+#ifndef MK_PB_FRAME_H
+#define MK_PB_FRAME_H
+
+#include "morphkit.h"
+
+/* weights (asset channel count) = channel defaults, then the clip sampled at time if clip >= 0. */
+mk_result pb_frame_weights(const mk_asset *asset, int32_t clip, double time, float *weights, mk_error *err);
+
+/* Evaluates mesh positions (and normals if non-NULL and the mesh has them) for asset-wide
+ * weights. stacking 0 = the blob's. Scratch is allocated here (tools may allocate). */
+mk_result pb_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
+                       mk_normal_mode normals_mode, float *positions, float *normals, mk_error *err);
+
+/* mk_channel_span for asset channel `channel` at weight w (any number of in-betweens): the
+ * two contributing targets as indices into the channel's targets (-1 = implicit zero key). */
+void pb_channel_span(const mk_asset *asset, uint32_t channel, float w, int32_t *ia, float *ca, int32_t *ib, float *cb);
+
+/* In place: p = W p (points), n = normalize((W^-1)^T n). */
+void pb_to_world(const float world[16], float *positions, float *normals, uint32_t count);
+
+#endif
