@@ -33,9 +33,4 @@ mk_result mk_cage_eval(void *binding, double amplitude, double *positions, doubl
                        double *tangents, uint32_t *inverted, mk_error *err);
 void mk_cage_unbind(mk_cage_binding *binding);
 
-/* Reads the vertices ("v") and faces ("f", polygons fan-triangulated, negative indices
- * relative) of a Wavefront OBJ file into arena memory. */
-mk_result mk_read_obj(const char *path, mk_arena *arena, double **vertices, uint32_t *vertex_count,
-                      uint32_t **triangles, uint32_t *triangle_count, mk_error *err);
-
 #endif

@@ -17,6 +17,7 @@
 #include "ffd.h"
 #include "inbetween.h"
 #include "laplacian.h"
+#include "obj.h"
 
 #define PI 3.14159265358979323846
 
@@ -462,8 +463,13 @@ static mk_result load_cage_file(recipe_ctx *ctx, const cJSON *ch, const char *pa
     if (name[0] == '/' || !*dir) snprintf(full, sizeof full, "%s", name);
     else snprintf(full, sizeof full, "%s/%s", dir, name);
     mk_error inner;
-    if (mk_read_obj(full, ctx->scratch, verts, nv, tris, nt, &inner) != MK_OK)
+    mk_obj obj;
+    if (mk_obj_read(full, ctx->scratch, &obj, &inner) != MK_OK)
         return mk_error_set(ctx->err, inner.code, inner.offset, "%s.%s: %s", path, field, inner.message);
+    *verts = obj.positions;
+    *nv = obj.vertex_count;
+    *tris = obj.triangles;
+    *nt = obj.triangle_count;
     return MK_OK;
 }
 

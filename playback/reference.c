@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "blob_io.h"
+#include "obj.h"
 #include "reference.h"
 
 #define REFERENCE_MAX_BYTES ((size_t)1 << 30)
@@ -94,38 +95,21 @@ static mk_result read_json_mesh(pb_reference *r, const char *path, pb_reference_
     return MK_OK;
 }
 
-/* OBJ: every "v x y z" line in order is a point; "vn" lines, when as many, its normals. */
-static mk_result read_obj(pb_reference *r, const char *path, char *text, size_t size, mk_error *err)
+/* OBJ: its vertices in order are the points; its normals, when one per vertex, theirs. */
+static mk_result read_obj(pb_reference *r, const char *path, mk_error *err)
 {
-    size_t v = 0, vn = 0;
-    for (size_t i = 0; i + 1 < size; i++)
-        if ((i == 0 || text[i - 1] == '\n') && text[i] == 'v') {
-            if (text[i + 1] == ' ') v++;
-            else if (text[i + 1] == 'n' && i + 2 < size && text[i + 2] == ' ') vn++;
-        }
+    mk_obj obj;
+    mk_result res = mk_obj_read(path, &r->arena, &obj, err);
+    if (res != MK_OK) return res;
     pb_ref_mesh *m = r->meshes = mk_arena_array(&r->arena, 1, sizeof(pb_ref_mesh));
-    double *p = mk_arena_array(&r->arena, 3 * v + 3, sizeof(double)), *n = vn == v && v ? mk_arena_array(&r->arena, 3 * vn, sizeof(double)) : NULL;
-    if (!m || !p || (vn == v && v && !n)) return mk_error_oom(err, "reference frame");
+    if (!m) return mk_error_oom(err, "reference frame");
     r->mesh_count = 1;
     m->label = "obj";
     m->gltf_node = m->gltf_mesh = m->gltf_primitive = -1;
     m->has_channels = 1;  /* an OBJ frame is of the mesh with channels */
-    size_t pi = 0, ni = 0, line_no = 0;
-    for (char *line = text, *next; line && *line; line = next) {
-        next = strchr(line, '\n');
-        if (next) *next++ = 0;
-        line_no++;
-        double x, y, z;
-        int normal = line[0] == 'v' && line[1] == 'n' && line[2] == ' ';
-        if (!(line[0] == 'v' && line[1] == ' ') && !normal) continue;
-        if (sscanf(line + (normal ? 3 : 2), "%lf %lf %lf", &x, &y, &z) != 3 || !isfinite(x) || !isfinite(y) || !isfinite(z))
-            return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%.200s: line %zu: expected three finite numbers", path, line_no);
-        double *dst = normal ? (n ? &n[3 * ni++] : NULL) : &p[3 * pi++];
-        if (dst) { dst[0] = x; dst[1] = y; dst[2] = z; }
-    }
-    m->positions = p;
-    m->normals = n;
-    m->point_count = (uint32_t)pi;
+    m->positions = obj.positions;
+    m->normals = obj.normals;
+    m->point_count = obj.vertex_count;
     return MK_OK;
 }
 
@@ -133,11 +117,11 @@ mk_result pb_reference_read(const char *path, pb_reference_kind kind, pb_referen
 {
     memset(out, 0, sizeof *out);
     mk_arena_init(&out->arena, NULL);
+    if (kind == PB_REF_OBJ) return read_obj(out, path, err);
     void *data;
     size_t size;
     mk_result r = mk_read_file(&out->arena, path, REFERENCE_MAX_BYTES, &data, &size, err);
     if (r != MK_OK) return r;
-    if (kind == PB_REF_OBJ) return read_obj(out, path, data, size, err);
     const char *end = NULL;
     cJSON *root = cJSON_ParseWithLengthOpts(data, size, &end, 0);
     if (!root)
