@@ -25,7 +25,7 @@
  */
 #include <math.h>
 #include <string.h>
-#include "laplacian_internal.h"
+#include "surface_edit_internal.h"
 #include "bake_util.h"
 
 /* Largest-eigenvalue eigenvector of a symmetric 4x4 matrix by cyclic Jacobi rotations. */
@@ -129,7 +129,7 @@ static mk_result global_step(mk_surface_edit *s, int identity, mk_error *err)
                 double Rs[9];
                 const double *Ri = s->rotations + 9 * (size_t)i, *Rj = s->rotations + 9 * (size_t)j;
                 for (int q = 0; q < 9; q++) Rs[q] = 0.5 * (Ri[q] + Rj[q]);
-                mk_mat3_mul_vec(r, Rs, e);
+                mat3_mul_vec(r, Rs, e);
             }
             for (int c = 0; c < 3; c++) acc[c] += w * r[c];
             /* Hard constraints: move the known column to the right-hand side. */
@@ -140,7 +140,7 @@ static mk_result global_step(mk_surface_edit *s, int identity, mk_error *err)
             for (int c = 0; c < 3; c++) acc[c] += w2 * s->target[3 * (size_t)i + c];
         for (int c = 0; c < 3; c++) b[(size_t)c * nu + u] = acc[c];
     }
-    mk_result r = mk_edit_solve(s, err);
+    mk_result r = edit_solve(s, err);
     if (r != MK_OK) return r;
     const double *x = s->x->x;
     for (uint32_t v = 0; v < n; v++)
@@ -245,13 +245,13 @@ static void local_step(mk_surface_edit *s)
     }
 }
 
-mk_result mk_arap_iterate(mk_surface_edit *s, mk_error *err)
+mk_result edit_arap_solve(mk_surface_edit *s, mk_error *err)
 {
     mk_result r = global_step(s, 1, err);
     for (uint32_t it = 0; r == MK_OK && it < s->params.iterations; it++) {
-        double t0 = mk_bake_now();
+        double t0 = bake_now();
         local_step(s);
-        s->local_seconds += mk_bake_now() - t0;
+        s->local_seconds += bake_now() - t0;
         r = global_step(s, 0, err);
     }
     return r;

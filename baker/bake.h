@@ -3,7 +3,7 @@
  * Every baker turns a deformation of one mesh into an ordinary channel: one or more targets
  * (in-betweens with full weights in (0, 1], the last one at 1), so the runtime plays a baked
  * channel like an authored shape. The recipe format is documented in docs/baking.md; the
- * per-algorithm C APIs are in barr.h, ffd.h, cage_mvc.h, laplacian.h and inbetween.h.
+ * per-algorithm C APIs are in barr.h, ffd.h, cage_mvc.h, surface_edit.h and inbetween.h.
  */
 #ifndef MK_BAKE_H
 #define MK_BAKE_H
@@ -49,14 +49,9 @@ typedef struct mk_bake_options {
     int untrusted;
 } mk_bake_options;
 
-/* Applies a JSON recipe (docs/baking.md) to raw. progress(user, fraction) may be NULL.
- * All or nothing: on error raw keeps its channels as they were and err names the field. */
+/* Applies a JSON recipe (docs/baking.md) to raw. options may be NULL (defaults). All or
+ * nothing: on error raw keeps its channels as they were and err names the field. */
 mk_result mk_bake_recipe(mk_raw_asset *raw, const char *recipe_json, size_t recipe_size,
-                         void (*progress)(void *user, const char *stage, double fraction),
-                         void *user, mk_bake_report *report, mk_error *err);
-
-/* The same with options (base directory, per-channel reports). options may be NULL. */
-mk_result mk_bake_recipe_ex(mk_raw_asset *raw, const char *recipe_json, size_t recipe_size,
-                            const mk_bake_options *options, mk_bake_report *report, mk_error *err);
+                         const mk_bake_options *options, mk_bake_report *report, mk_error *err);
 
 #endif

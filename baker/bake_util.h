@@ -1,38 +1,38 @@
 /* Small shared pieces of the bakers: 3-vector / 3x3 helpers (double precision, row-major
  * 3x3 as m[3*row + col]), mesh bounding box, and normals recomputed from a deformed surface.
  * Internal to baker/ (not installed). */
-#ifndef MK_BAKE_UTIL_H
-#define MK_BAKE_UTIL_H
+#ifndef BAKE_UTIL_H
+#define BAKE_UTIL_H
 
 #include <math.h>
 #include "raw.h"
 
-static inline double mk_dot3(const double a[3], const double b[3])
+static inline double vec3_dot(const double a[3], const double b[3])
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
-static inline void mk_cross3(double out[3], const double a[3], const double b[3])
+static inline void vec3_cross(double out[3], const double a[3], const double b[3])
 {
     double x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2],
            z = a[0] * b[1] - a[1] * b[0];
     out[0] = x; out[1] = y; out[2] = z;
 }
-static inline double mk_len3(const double a[3]) { return sqrt(mk_dot3(a, a)); }
+static inline double vec3_length(const double a[3]) { return sqrt(vec3_dot(a, a)); }
 /* Normalizes in place; returns the old length (0 leaves the vector unchanged). */
-static inline double mk_normalize3(double a[3])
+static inline double vec3_normalize(double a[3])
 {
-    double l = mk_len3(a);
+    double l = vec3_length(a);
     if (l > 0) { a[0] /= l; a[1] /= l; a[2] /= l; }
     return l;
 }
-static inline void mk_mat3_mul_vec(double out[3], const double m[9], const double v[3])
+static inline void mat3_mul_vec(double out[3], const double m[9], const double v[3])
 {
     double x = m[0] * v[0] + m[1] * v[1] + m[2] * v[2];
     double y = m[3] * v[0] + m[4] * v[1] + m[5] * v[2];
     double z = m[6] * v[0] + m[7] * v[1] + m[8] * v[2];
     out[0] = x; out[1] = y; out[2] = z;
 }
-static inline void mk_mat3_mul(double out[9], const double a[9], const double b[9])
+static inline void mat3_mul(double out[9], const double a[9], const double b[9])
 {
     double r[9];
     for (int i = 0; i < 3; i++)
@@ -40,14 +40,14 @@ static inline void mk_mat3_mul(double out[9], const double a[9], const double b[
             r[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j];
     for (int i = 0; i < 9; i++) out[i] = r[i];
 }
-static inline double mk_mat3_det(const double m[9])
+static inline double mat3_det(const double m[9])
 {
     return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
            m[2] * (m[3] * m[7] - m[4] * m[6]);
 }
 /* cof(J) = det(J) J^-T without a division: (Ja) x (Jb) = cof(J)(a x b), so cof(J) n is the
  * normal transform that stays consistent with the winding of deformed triangles. */
-static inline void mk_mat3_cofactor(double out[9], const double m[9])
+static inline void mat3_cofactor(double out[9], const double m[9])
 {
     double c[9];
     c[0] = m[4] * m[8] - m[5] * m[7]; c[1] = m[5] * m[6] - m[3] * m[8]; c[2] = m[3] * m[7] - m[4] * m[6];
@@ -56,7 +56,7 @@ static inline void mk_mat3_cofactor(double out[9], const double m[9])
     for (int i = 0; i < 9; i++) out[i] = c[i];
 }
 /* Rotation matrix about a unit axis by angle (radians), right-hand rule. */
-static inline void mk_mat3_rotation(double out[9], const double axis[3], double angle)
+static inline void mat3_rotation(double out[9], const double axis[3], double angle)
 {
     double c = cos(angle), s = sin(angle), t = 1 - c;
     double x = axis[0], y = axis[1], z = axis[2];
@@ -66,47 +66,44 @@ static inline void mk_mat3_rotation(double out[9], const double axis[3], double 
 }
 
 /* Scale-free conditioning of a Jacobian, r = det J / (|J|_F / sqrt 3)^3: 1 for a rotation,
- * <= 0 when the map folds. Vertices with r <= MK_BAKE_DEGENERATE_R get their normal from the
+ * <= 0 when the map folds. Vertices with r <= BAKE_DEGENERATE_R get their normal from the
  * deformed surface instead of cof(J) n (notes: "Policy when det J <= 0"). */
-#define MK_BAKE_DEGENERATE_R 1e-6
-double mk_bake_jacobian_quality(const double J[9]);
+#define BAKE_DEGENERATE_R 1e-6
+double bake_jacobian_quality(const double J[9]);
 
 /* Axis-aligned bounds of the mesh's base positions and the diagonal length (> 0 is not
  * guaranteed: a single point has diagonal 0). */
-void mk_bake_bounds(const mk_raw_mesh *mesh, double min[3], double max[3], double *diagonal);
+void bake_bounds(const mk_raw_mesh *mesh, double min[3], double max[3], double *diagonal);
 
 /* Normals recomputed from deformed positions (3 doubles per vertex) with the base triangles,
  * area-weighted, for the vertices where flags[v] != 0 (flags NULL: all). Render vertices with
  * the same base position and base normal are smoothed together, so UV seams do not show and
  * hard edges stay hard. Writes unit normals into normals_out (3 per vertex) for those vertices;
  * a vertex without any non-degenerate triangle keeps its base normal. Uses `arena` for scratch. */
-mk_result mk_bake_surface_normals(const mk_raw_mesh *mesh, const double *positions,
+mk_result bake_surface_normals(const mk_raw_mesh *mesh, const double *positions,
                                   const unsigned char *flags, double *normals_out, mk_arena *arena,
                                   mk_error *err);
 
-/* Welds render vertices that share the exact same base position (bitwise float equality):
- * weld[v] = welded index, returns the welded count. Laplacian/ARAP solve on welded topology so
- * that render meshes split at UV/normal seams do not fall apart (notes A4.1). NULL on OOM. */
-uint32_t *mk_bake_weld(const mk_raw_mesh *mesh, mk_arena *arena, uint32_t *welded_count);
+
 
 /* A deformation given point by point with its Jacobian (FFD, Barr): out = f_a(p),
- * J = df_a/dp (row-major). mk_pointwise_eval turns it into mesh positions, normals
+ * J = df_a/dp (row-major). bake_pointwise_eval turns it into mesh positions, normals
  * n' = normalize(cof(J) n) and tangents t' = J t orthogonalized against n' (w is kept by the
  * runtime), with the det J <= 0 policy: such vertices are counted in *inverted and take their
- * normal from the deformed surface (mk_bake_surface_normals). */
-typedef void (*mk_point_map)(const void *user, double amplitude, const double p[3], double out[3],
+ * normal from the deformed surface (bake_surface_normals). */
+typedef void (*bake_point_map)(const void *user, double amplitude, const double p[3], double out[3],
                              double J[9]);
-typedef struct mk_pointwise {
+typedef struct bake_pointwise {
     const mk_raw_mesh *mesh;
-    mk_point_map map;
+    bake_point_map map;
     const void *user;
     mk_arena *scratch;         /* for the per-evaluation flags */
-} mk_pointwise;
-/* Matches mk_deformer.eval (user = mk_pointwise *). */
-mk_result mk_pointwise_eval(void *pointwise, double amplitude, double *positions, double *normals,
+} bake_pointwise;
+/* Matches mk_deformer.eval (user = bake_pointwise *). */
+mk_result bake_pointwise_eval(void *pointwise, double amplitude, double *positions, double *normals,
                             double *tangents, uint32_t *inverted, mk_error *err);
 
 /* Seconds from a wall clock (timespec_get, C11). */
-double mk_bake_now(void);
+double bake_now(void);
 
 #endif

@@ -35,7 +35,7 @@ mk_result mk_barr_prepare(mk_barr *b, mk_error *err)
     if (!isfinite(b->angle) || !isfinite(b->scale))
         return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX, "angle/scale: not finite");
     double axis[3] = { b->axis[0], b->axis[1], b->axis[2] };
-    if (!(mk_normalize3(axis) > 1e-30))
+    if (!(vec3_normalize(axis) > 1e-30))
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "axis: zero vector");
     if (!(b->range[1] > b->range[0]))
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
@@ -45,12 +45,12 @@ mk_result mk_barr_prepare(mk_barr *b, mk_error *err)
     double e1[3], e2[3];
     if (b->op == MK_BARR_BEND) {
         /* z = direction minus its axis component. */
-        double d = mk_dot3(b->direction, axis);
+        double d = vec3_dot(b->direction, axis);
         for (int c = 0; c < 3; c++) e2[c] = b->direction[c] - d * axis[c];
-        if (!(mk_normalize3(e2) > 1e-12 * (1 + mk_len3(b->direction))))
+        if (!(vec3_normalize(e2) > 1e-12 * (1 + vec3_length(b->direction))))
             return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
                                 "direction: zero or parallel to the axis");
-        mk_cross3(e1, axis, e2);  /* x = y x z: right-handed (x, y, z) */
+        vec3_cross(e1, axis, e2);  /* x = y x z: right-handed (x, y, z) */
         for (int c = 0; c < 3; c++) {
             b->frame[c] = e1[c]; b->frame[3 + c] = axis[c]; b->frame[6 + c] = e2[c];
             b->direction[c] = e2[c];
@@ -60,15 +60,15 @@ mk_result mk_barr_prepare(mk_barr *b, mk_error *err)
         int k = fabs(axis[0]) < 0.9 ? 0 : 1;
         double t[3] = { 0, 0, 0 };
         t[k] = 1;
-        double d = mk_dot3(t, axis);
+        double d = vec3_dot(t, axis);
         for (int c = 0; c < 3; c++) e1[c] = t[c] - d * axis[c];
-        mk_normalize3(e1);
-        mk_cross3(e2, axis, e1);
+        vec3_normalize(e1);
+        vec3_cross(e2, axis, e1);
         for (int c = 0; c < 3; c++) {
             b->frame[c] = e1[c]; b->frame[3 + c] = e2[c]; b->frame[6 + c] = axis[c];
         }
     }
-    double ca = mk_dot3(b->center, axis);
+    double ca = vec3_dot(b->center, axis);
     b->local_min = b->range[0] - ca;
     b->local_max = b->range[1] - ca;
     return MK_OK;
@@ -87,7 +87,7 @@ void mk_barr_map(const void *user, double amplitude, const double p[3], double o
     const double *R = b->frame;
     double d[3] = { p[0] - b->center[0], p[1] - b->center[1], p[2] - b->center[2] };
     double l[3], o[3], Jl[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
-    mk_mat3_mul_vec(l, R, d);
+    mat3_mul_vec(l, R, d);
     double len = b->local_max - b->local_min;
     if (b->op == MK_BARR_TWIST || b->op == MK_BARR_TAPER) {
         double x = l[0], y = l[1], z = l[2];
@@ -134,9 +134,9 @@ void mk_barr_map(const void *user, double amplitude, const double p[3], double o
     /* Back to world: out = c + R^T o, J = R^T Jl R. */
     double Rt[9] = { R[0], R[3], R[6], R[1], R[4], R[7], R[2], R[5], R[8] };
     double w[3];
-    mk_mat3_mul_vec(w, Rt, o);
+    mat3_mul_vec(w, Rt, o);
     for (int c = 0; c < 3; c++) out[c] = b->center[c] + w[c];
     double tmp[9];
-    mk_mat3_mul(tmp, Jl, R);
-    mk_mat3_mul(J, Rt, tmp);
+    mat3_mul(tmp, Jl, R);
+    mat3_mul(J, Rt, tmp);
 }

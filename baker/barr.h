@@ -29,7 +29,7 @@ typedef struct mk_barr {
 mk_result mk_barr_prepare(mk_barr *barr, mk_error *err);
 
 /* Deforms one point at amplitude a (angle -> a*angle, scale -> 1 + a*(scale - 1)) and gives
- * the Jacobian J = dout/dp (row-major 3x3). user is a const mk_barr * (mk_point_map). */
+ * the Jacobian J = dout/dp (row-major 3x3). user is a const mk_barr * (bake_point_map). */
 void mk_barr_map(const void *barr, double amplitude, const double p[3], double out[3], double J[9]);
 
 #endif

@@ -39,7 +39,7 @@ void mk_mvc_coordinates(const mk_cage *cage, const double x[3], double eps_d, do
     for (uint32_t j = 0; j < nv; j++) {
         const double *p = cage->rest + 3 * (size_t)j;
         double d[3] = { p[0] - x[0], p[1] - x[1], p[2] - x[2] };
-        if (mk_len3(d) < eps_d) { w[j] = 1; return; }
+        if (vec3_length(d) < eps_d) { w[j] = 1; return; }
     }
     for (uint32_t t = 0; t < cage->triangle_count; t++) {
         const uint32_t *tri = cage->triangles + 3 * (size_t)t;
@@ -47,12 +47,12 @@ void mk_mvc_coordinates(const mk_cage *cage, const double x[3], double eps_d, do
         for (int i = 0; i < 3; i++) {
             const double *p = cage->rest + 3 * (size_t)tri[i];
             for (int k = 0; k < 3; k++) u[i][k] = p[k] - x[k];
-            d[i] = mk_normalize3(u[i]);
+            d[i] = vec3_normalize(u[i]);
         }
         for (int i = 0; i < 3; i++) {
             int a = (i + 1) % 3, b = (i + 2) % 3;
             double e[3] = { u[a][0] - u[b][0], u[a][1] - u[b][1], u[a][2] - u[b][2] };
-            l[i] = mk_len3(e);
+            l[i] = vec3_length(e);
             th[i] = 2 * asin(fmin(1.0, l[i] / 2));
         }
         double h = (th[0] + th[1] + th[2]) / 2;
@@ -131,8 +131,8 @@ mk_result mk_cage_validate(const mk_cage *cage, mk_error *err)
         const double *a = cage->rest + 3 * (size_t)tri[0], *b = cage->rest + 3 * (size_t)tri[1],
                      *c = cage->rest + 3 * (size_t)tri[2];
         double bc[3];
-        mk_cross3(bc, b, c);
-        volume += mk_dot3(a, bc) / 6;
+        vec3_cross(bc, b, c);
+        volume += vec3_dot(a, bc) / 6;
     }
     qsort(edges, ne, sizeof *edges, edge_cmp);
     for (size_t i = 0; i < ne; i++) {
@@ -189,7 +189,7 @@ mk_result mk_cage_bind(const mk_raw_mesh *mesh, const mk_cage *cage, const mk_al
             b->moves[3 * j + (size_t)c] = cage->deformed[3 * j + (size_t)c] - v;
         }
     double diag[3] = { hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2] };
-    double eps_d = 1e-8 * mk_len3(diag);
+    double eps_d = 1e-8 * vec3_length(diag);
     for (size_t v = 0; v < n; v++) {
         const float *p = mesh->positions + 3 * v;
         double x[3] = { p[0], p[1], p[2] };

@@ -48,16 +48,16 @@ mk_result mk_ffd_prepare(mk_ffd_lattice *f, mk_error *err)
     }
     const double *S = f->axes[0], *T = f->axes[1], *U = f->axes[2];
     double TxU[3], SxU[3], SxT[3];
-    mk_cross3(TxU, T, U);
-    mk_cross3(SxU, S, U);
-    mk_cross3(SxT, S, T);
-    double det = mk_dot3(TxU, S);
-    double scale = mk_len3(S) * mk_len3(T) * mk_len3(U);
+    vec3_cross(TxU, T, U);
+    vec3_cross(SxU, S, U);
+    vec3_cross(SxT, S, T);
+    double det = vec3_dot(TxU, S);
+    double scale = vec3_length(S) * vec3_length(T) * vec3_length(U);
     if (!(fabs(det) > 1e-9 * scale) || !(scale > 0))
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
                             "lattice: axes S, T, U are degenerate (they span no volume)");
     /* Each numerator and denominator uses the same cross product: the signs cancel. */
-    double dt = mk_dot3(SxU, T), du = mk_dot3(SxT, U);
+    double dt = vec3_dot(SxU, T), du = vec3_dot(SxT, U);
     for (int c = 0; c < 3; c++) {
         f->inverse[c] = TxU[c] / det;
         f->inverse[3 + c] = SxU[c] / dt;
@@ -75,7 +75,7 @@ mk_result mk_ffd_prepare(mk_ffd_lattice *f, mk_error *err)
 void mk_ffd_parameters(const mk_ffd_lattice *f, const double p[3], double stu[3])
 {
     double d[3] = { p[0] - f->origin[0], p[1] - f->origin[1], p[2] - f->origin[2] };
-    mk_mat3_mul_vec(stu, f->inverse, d);
+    mat3_mul_vec(stu, f->inverse, d);
 }
 
 /* Bernstein basis of degree `deg` at s and its derivative. */
@@ -174,7 +174,7 @@ void mk_ffd_map(const void *user, double amplitude, const double p[3], double ou
             }
         }
     double GM[9];
-    mk_mat3_mul(GM, G, f->inverse);
+    mat3_mul(GM, G, f->inverse);
     for (int c = 0; c < 3; c++) out[c] = p[c] + amplitude * disp[c];
     for (int i = 0; i < 9; i++) J[i] += amplitude * GM[i];
 }

@@ -29,7 +29,7 @@ void mk_ffd_control_point(const mk_ffd_lattice *lattice, uint32_t i, uint32_t j,
 mk_result mk_ffd_prepare(mk_ffd_lattice *lattice, mk_error *err);
 
 /* Deforms one point with the displacements scaled by the amplitude and gives the Jacobian
- * (row-major). user is a const mk_ffd_lattice * (mk_point_map). */
+ * (row-major). user is a const mk_ffd_lattice * (bake_point_map). */
 void mk_ffd_map(const void *lattice, double amplitude, const double p[3], double out[3], double J[9]);
 
 /* Lattice parameters (s, t, u) of a point: (s,t,u) = M^-1 (X - X0). */

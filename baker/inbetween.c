@@ -171,7 +171,7 @@ static int vertex_moved(const mk_raw_mesh *mesh, size_t v, const double *pos, co
         if (nrm) dn = fmax(dn, fabs(nrm[i] - mesh->normals[i]));
         if (tan) dt = fmax(dt, fabs(tan[i] - mesh->tangents[4 * v + (size_t)c]));
     }
-    return mk_len3(dp) > eps_p || dn > eps_n || dt > eps_n;
+    return vec3_length(dp) > eps_p || dn > eps_n || dt > eps_n;
 }
 
 static mk_result write_target(mk_raw_asset *raw, mk_raw_channel *channel, uint32_t mesh_index,
@@ -258,7 +258,7 @@ static mk_result bake_channel(mk_raw_asset *raw, uint32_t mesh_index, const char
     if (fixed > 256)
         return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "inbetweens: %u is above 256", fixed);
     double bmin[3], bmax[3], diagonal;
-    mk_bake_bounds(mesh, bmin, bmax, &diagonal);
+    bake_bounds(mesh, bmin, bmax, &diagonal);
     if (!(diagonal > 0)) diagonal = 1;  /* single point: report errors in mesh units */
 
     sampler s;

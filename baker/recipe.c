@@ -16,7 +16,7 @@
 #include "cage_mvc.h"
 #include "ffd.h"
 #include "inbetween.h"
-#include "laplacian.h"
+#include "surface_edit.h"
 #include "obj.h"
 
 #define PI 3.14159265358979323846
@@ -186,7 +186,7 @@ static mk_result parse_selection(recipe_ctx *ctx, const mk_raw_mesh *mesh, const
         for (size_t v = 0; v < n; v++) {
             const float *p = mesh->positions + 3 * v;
             double d[3] = { p[0] - c[0], p[1] - c[1], p[2] - c[2] };
-            if (mk_dot3(d, d) <= radius * radius) PUSH(v);
+            if (vec3_dot(d, d) <= radius * radius) PUSH(v);
         }
     } else {
         double lo[3], hi[3];
@@ -223,7 +223,7 @@ static mk_result parse_rotate(recipe_ctx *ctx, const cJSON *obj, const char *pat
     int got = get_vec3(ctx, rot, rpath, "axis", axis);
     if (got < 0) return ctx->err->code;
     if (got == 0) return field_error(ctx, rpath, "axis", "missing%s", NULL);
-    if (!(mk_normalize3(axis) > 0)) return field_error(ctx, rpath, "axis", "is a zero vector%s", NULL);
+    if (!(vec3_normalize(axis) > 0)) return field_error(ctx, rpath, "axis", "is a zero vector%s", NULL);
     double deg = 0;
     if ((r = get_number(ctx, rot, rpath, "degrees", &deg, 1)) != MK_OK) return r;
     *angle = deg * PI / 180;
@@ -247,7 +247,7 @@ static mk_result parse_axis(recipe_ctx *ctx, const cJSON *obj, const char *path,
         return MK_OK;
     }
     if (parse_vec3_item(ctx, item, path, "axis", axis) != MK_OK) return ctx->err->code;
-    if (!(mk_len3(axis) > 0)) return field_error(ctx, path, "axis", "is a zero vector%s", NULL);
+    if (!(vec3_length(axis) > 0)) return field_error(ctx, path, "axis", "is a zero vector%s", NULL);
     return MK_OK;
 }
 
@@ -262,11 +262,11 @@ static mk_result parse_barr(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch
     mk_result r = parse_axis(ctx, ch, path, b->axis);
     if (r != MK_OK) return r;
     double bmin[3], bmax[3], diag;
-    mk_bake_bounds(mesh, bmin, bmax, &diag);
+    bake_bounds(mesh, bmin, bmax, &diag);
     for (int c = 0; c < 3; c++) b->center[c] = 0.5 * (bmin[c] + bmax[c]);
     if (get_vec3(ctx, ch, path, "center", b->center) < 0) return ctx->err->code;
     double axis_unit[3] = { b->axis[0], b->axis[1], b->axis[2] };
-    mk_normalize3(axis_unit);
+    vec3_normalize(axis_unit);
     const cJSON *range = cJSON_GetObjectItemCaseSensitive(ch, "range");
     if (range) {
         if (!cJSON_IsArray(range) || cJSON_GetArraySize(range) != 2 ||
@@ -281,7 +281,7 @@ static mk_result parse_barr(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch
     } else {
         for (uint32_t v = 0; v < mesh->vertex_count; v++) {
             const float *p = mesh->positions + 3 * (size_t)v;
-            double pd[3] = { p[0], p[1], p[2] }, a = mk_dot3(pd, axis_unit);
+            double pd[3] = { p[0], p[1], p[2] }, a = vec3_dot(pd, axis_unit);
             if (v == 0 || a < b->range[0]) b->range[0] = a;
             if (v == 0 || a > b->range[1]) b->range[1] = a;
         }
@@ -369,7 +369,7 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
         mk_result r = get_number(ctx, ch, path, "padding", &padding, 0);
         if (r != MK_OK) return r;
         if (padding < 0) return field_error(ctx, path, "padding", "must be >= 0%s", NULL);
-        mk_bake_bounds(mesh, bmin, bmax, &diag);
+        bake_bounds(mesh, bmin, bmax, &diag);
         double pad = padding * diag;
         for (int a = 0; a < 3; a++) {
             f->origin[a] = bmin[a] - pad;
@@ -423,7 +423,7 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
         if (get_vec3(ctx, mv, mpath, "translate", translate) < 0) return ctx->err->code;
         if ((r = parse_rotate(ctx, mv, mpath, axis, &angle, rpivot, pivot)) != MK_OK) return r;
         double R[9];
-        mk_mat3_rotation(R, axis, angle);
+        mat3_rotation(R, axis, angle);
         /* P <- rotate(scale(P about pivot)) about rotate.pivot, then translate. */
         for (uint32_t k = lo[2]; k <= hi[2]; k++)
             for (uint32_t j = lo[1]; j <= hi[1]; j++)
@@ -431,7 +431,7 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
                     double *p = current + 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k));
                     double q[3], o[3];
                     for (int c = 0; c < 3; c++) q[c] = pivot[c] + scale[c] * (p[c] - pivot[c]) - rpivot[c];
-                    mk_mat3_mul_vec(o, R, q);
+                    mat3_mul_vec(o, R, q);
                     for (int c = 0; c < 3; c++) p[c] = rpivot[c] + o[c] + translate[c];
                 }
     }
@@ -691,10 +691,10 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
     mk_raw_asset *raw = ctx->raw;
     const mk_raw_mesh *mesh = &raw->meshes[plan->mesh];
     const mk_bake_options *o = ctx->options;
-    double t0 = mk_bake_now();
+    double t0 = bake_now();
     mk_deformer deformer;
     memset(&deformer, 0, sizeof deformer);
-    mk_pointwise pw = { mesh, NULL, NULL, ctx->scratch };
+    bake_pointwise pw = { mesh, NULL, NULL, ctx->scratch };
     mk_cage_binding *binding = NULL;
     mk_surface_edit *edit = NULL;
     mk_result r = MK_OK;
@@ -704,11 +704,11 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
     switch (plan->op) {
     case OP_TAPER: case OP_TWIST: case OP_BEND:
         pw.map = mk_barr_map; pw.user = &plan->barr;
-        deformer.eval = mk_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
+        deformer.eval = bake_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
         break;
     case OP_FFD:
         pw.map = mk_ffd_map; pw.user = &plan->ffd;
-        deformer.eval = mk_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
+        deformer.eval = bake_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
         break;
     case OP_CAGE:
         if (o && o->progress) o->progress(o->user, "binding cage", 0);
@@ -752,7 +752,7 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
     cr.error_measured_on_grid = res.error_on_grid;
     cr.moved_vertices = res.moved_vertices;
     cr.inverted_vertices = res.inverted_vertices;
-    cr.seconds = mk_bake_now() - t0;
+    cr.seconds = bake_now() - t0;
     if (o && o->channel_done) o->channel_done(o->user, &cr);
     report->channels_added++;
     report->targets_added += res.targets;
@@ -797,8 +797,8 @@ done:
     return r;
 }
 
-mk_result mk_bake_recipe_ex(mk_raw_asset *raw, const char *recipe_json, size_t recipe_size,
-                            const mk_bake_options *options, mk_bake_report *report, mk_error *err)
+mk_result mk_bake_recipe(mk_raw_asset *raw, const char *recipe_json, size_t recipe_size,
+                         const mk_bake_options *options, mk_bake_report *report, mk_error *err)
 {
     mk_bake_report local;
     if (!report) report = &local;
@@ -821,15 +821,4 @@ mk_result mk_bake_recipe_ex(mk_raw_asset *raw, const char *recipe_json, size_t r
     }
     mk_arena_free_all(&scratch);
     return r;
-}
-
-mk_result mk_bake_recipe(mk_raw_asset *raw, const char *recipe_json, size_t recipe_size,
-                         void (*progress)(void *user, const char *stage, double fraction),
-                         void *user, mk_bake_report *report, mk_error *err)
-{
-    mk_bake_options o;
-    memset(&o, 0, sizeof o);
-    o.progress = progress;
-    o.user = user;
-    return mk_bake_recipe_ex(raw, recipe_json, recipe_size, &o, report, err);
 }

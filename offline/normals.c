@@ -18,13 +18,10 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include "raw.h"
+#include "mesh_groups.h"
 
 typedef struct topology {
-    uint32_t group_count;
-    uint32_t *group_of;        /* per vertex */
-    uint32_t *group_vert_first, *group_verts;  /* CSR group -> vertices */
-    uint32_t *group_tri_first, *group_tris;    /* CSR group -> triangles */
+    mk_normal_groups g;        /* smoothing groups (mesh_groups.h) */
     double *face;              /* per triangle: area-weighted base face normal (cross product) */
     float *base_normal;        /* per group, unit */
 } topology;
@@ -40,35 +37,13 @@ typedef struct work {
 
 static void face_normal(const float *p0, const float *p1, const float *p2, double out[3])
 {
-    double e1[3] = { p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2] };
-    double e2[3] = { p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2] };
+    /* In double, as mk_face_normal computes the base faces, so an unmoved triangle's normal
+     * delta is exactly zero. */
+    double e1[3] = { (double)p1[0] - p0[0], (double)p1[1] - p0[1], (double)p1[2] - p0[2] };
+    double e2[3] = { (double)p2[0] - p0[0], (double)p2[1] - p0[1], (double)p2[2] - p0[2] };
     out[0] = e1[1] * e2[2] - e1[2] * e2[1];
     out[1] = e1[2] * e2[0] - e1[0] * e2[2];
     out[2] = e1[0] * e2[1] - e1[1] * e2[0];
-}
-
-static int same_normal(const float *a, const float *b)
-{
-    return fabsf(a[0] - b[0]) <= 1e-5f && fabsf(a[1] - b[1]) <= 1e-5f && fabsf(a[2] - b[2]) <= 1e-5f;
-}
-
-/* CSR from a key per item: first[key..key+1) lists the items with that key, in item order. */
-static int build_csr(mk_arena *arena, const uint32_t *key, uint32_t items, uint32_t keys, uint32_t **first_out,
-                     uint32_t **list_out)
-{
-    uint32_t *first = mk_arena_array(arena, (size_t)keys + 1, sizeof *first);
-    uint32_t *list = mk_arena_array(arena, items ? items : 1, sizeof *list);
-    if (!first || !list) return 0;
-    for (uint32_t i = 0; i < items; i++) first[key[i] + 1]++;
-    for (uint32_t k = 0; k < keys; k++) first[k + 1] += first[k];
-    uint32_t *fill = mk_arena_array(arena, keys ? keys : 1, sizeof *fill);
-    if (!fill) return 0;
-    memcpy(fill, first, (size_t)keys * sizeof *fill);
-    for (uint32_t i = 0; i < items; i++) list[fill[key[i]]++] = i;
-    mk_arena_release(arena, fill);
-    *first_out = first;
-    *list_out = list;
-    return 1;
 }
 
 /* Unit normal of group g: the sum of its triangles' face normals, taking a triangle's
@@ -77,8 +52,8 @@ static void group_normal(const topology *topo, uint32_t g, const int32_t *tri_sl
                          float out[3])
 {
     double sum[3] = { 0, 0, 0 };
-    for (uint32_t k = topo->group_tri_first[g]; k < topo->group_tri_first[g + 1]; k++) {
-        uint32_t t = topo->group_tris[k];
+    for (uint32_t k = topo->g.group_tri_first[g]; k < topo->g.group_tri_first[g + 1]; k++) {
+        uint32_t t = topo->g.group_tris[k];
         const double *n = tri_slot && tri_slot[t] >= 0 ? &deformed[3u * (uint32_t)tri_slot[t]] : &topo->face[3u * t];
         sum[0] += n[0]; sum[1] += n[1]; sum[2] += n[2];
     }
@@ -87,60 +62,17 @@ static void group_normal(const topology *topo, uint32_t g, const int32_t *tri_sl
     out[0] = (float)(sum[0] / len); out[1] = (float)(sum[1] / len); out[2] = (float)(sum[2] / len);
 }
 
-static int build_topology(mk_arena *arena, const mk_raw_mesh *m, topology *topo)
+static mk_result build_topology(mk_arena *arena, const mk_raw_mesh *m, topology *topo, mk_error *err)
 {
-    uint32_t n = m->vertex_count;
     memset(topo, 0, sizeof *topo);
-    topo->group_of = mk_arena_array(arena, n, sizeof(uint32_t));
-    if (!topo->group_of) return 0;
-    if (m->control_points && m->control_point_count) {
-        uint32_t *cp_first, *cp_verts;
-        if (!build_csr(arena, m->control_points, n, m->control_point_count, &cp_first, &cp_verts)) return 0;
-        for (uint32_t cp = 0; cp < m->control_point_count; cp++) {
-            uint32_t start = topo->group_count;
-            for (uint32_t k = cp_first[cp]; k < cp_first[cp + 1]; k++) {
-                uint32_t v = cp_verts[k], g = UINT32_MAX;
-                if (m->normals)
-                    for (uint32_t j = cp_first[cp]; j < k; j++)
-                        if (same_normal(&m->normals[3u * cp_verts[j]], &m->normals[3u * v])) { g = topo->group_of[cp_verts[j]]; break; }
-                if (!m->normals && k > cp_first[cp]) g = start;
-                topo->group_of[v] = g != UINT32_MAX ? g : topo->group_count++;
-            }
-        }
-        mk_arena_release(arena, cp_first);
-        mk_arena_release(arena, cp_verts);
-    } else {
-        for (uint32_t v = 0; v < n; v++) topo->group_of[v] = v;
-        topo->group_count = n;
-    }
-    if (!build_csr(arena, topo->group_of, n, topo->group_count, &topo->group_vert_first, &topo->group_verts)) return 0;
-    /* group -> triangles: each triangle once per distinct corner group. */
-    uint32_t *tri_group = mk_arena_array(arena, 3 * (size_t)m->triangle_count + 1, sizeof(uint32_t));
-    uint32_t *tri_index = mk_arena_array(arena, 3 * (size_t)m->triangle_count + 1, sizeof(uint32_t));
-    if (!tri_group || !tri_index) return 0;
-    uint32_t pairs = 0;
-    for (uint32_t t = 0; t < m->triangle_count; t++) {
-        uint32_t g0 = topo->group_of[m->triangles[3u * t]], g1 = topo->group_of[m->triangles[3u * t + 1]],
-                 g2 = topo->group_of[m->triangles[3u * t + 2]];
-        tri_group[pairs] = g0; tri_index[pairs++] = t;
-        if (g1 != g0) { tri_group[pairs] = g1; tri_index[pairs++] = t; }
-        if (g2 != g0 && g2 != g1) { tri_group[pairs] = g2; tri_index[pairs++] = t; }
-    }
-    uint32_t *slots;
-    if (!build_csr(arena, tri_group, pairs, topo->group_count, &topo->group_tri_first, &slots)) return 0;
-    for (uint32_t k = 0; k < pairs; k++) slots[k] = tri_index[slots[k]];
-    topo->group_tris = slots;
-    mk_arena_release(arena, tri_group);
-    mk_arena_release(arena, tri_index);
+    mk_result r = mk_normal_groups_build(m, MK_GROUP_BY_CONTROL_POINT, arena, &topo->g, err);
+    if (r != MK_OK) return r;
     topo->face = mk_arena_array(arena, (size_t)m->triangle_count * 3 + 3, sizeof(double));
-    topo->base_normal = mk_arena_array(arena, (size_t)topo->group_count * 3 + 3, sizeof(float));
-    if (!topo->face || !topo->base_normal) return 0;
-    for (uint32_t t = 0; t < m->triangle_count; t++) {
-        const uint32_t *tri = &m->triangles[3u * t];
-        face_normal(&m->positions[3u * tri[0]], &m->positions[3u * tri[1]], &m->positions[3u * tri[2]], &topo->face[3u * t]);
-    }
-    for (uint32_t g = 0; g < topo->group_count; g++) group_normal(topo, g, NULL, NULL, &topo->base_normal[3u * g]);
-    return 1;
+    topo->base_normal = mk_arena_array(arena, (size_t)topo->g.group_count * 3 + 3, sizeof(float));
+    if (!topo->face || !topo->base_normal) return mk_error_oom(err, "computing target normals");
+    for (uint32_t t = 0; t < m->triangle_count; t++) mk_face_normal(m, NULL, t, &topo->face[3u * t]);
+    for (uint32_t g = 0; g < topo->g.group_count; g++) group_normal(topo, g, NULL, NULL, &topo->base_normal[3u * g]);
+    return MK_OK;
 }
 
 /* Tangent re-orthogonalized against normal n: normalize(t - n (n.t)); t unchanged if degenerate. */
@@ -170,16 +102,16 @@ static mk_result compute_target(mk_raw_asset *raw, const mk_raw_mesh *m, const t
     uint32_t tri_count = 0, group_count = 0, extra = 0;
     /* Triangles with a moved corner (found through the moved vertices' groups). */
     for (uint32_t j = 0; j < t->count; j++) {
-        uint32_t g = topo->group_of[t->indices[j]];
-        for (uint32_t k = topo->group_tri_first[g]; k < topo->group_tri_first[g + 1]; k++) {
-            uint32_t tri = topo->group_tris[k];
+        uint32_t g = topo->g.group_of[t->indices[j]];
+        for (uint32_t k = topo->g.group_tri_first[g]; k < topo->g.group_tri_first[g + 1]; k++) {
+            uint32_t tri = topo->g.group_tris[k];
             if (w->tri_slot[tri] >= 0) continue;
             const uint32_t *c = &m->triangles[3u * tri];
             if (w->moved[c[0]] < 0 && w->moved[c[1]] < 0 && w->moved[c[2]] < 0) continue;
             w->tri_slot[tri] = (int32_t)tri_count;
             w->tris[tri_count++] = tri;
             for (int q = 0; q < 3; q++) {
-                uint32_t gc = topo->group_of[c[q]];
+                uint32_t gc = topo->g.group_of[c[q]];
                 if (w->group_slot[gc] < 0) { w->group_slot[gc] = (int32_t)group_count; w->groups[group_count++] = gc; }
             }
         }
@@ -200,8 +132,8 @@ static mk_result compute_target(mk_raw_asset *raw, const mk_raw_mesh *m, const t
     for (uint32_t k = 0; k < group_count; k++) {
         group_normal(topo, w->groups[k], w->tri_slot, deformed, &group_new[3u * k]);
         uint32_t g = w->groups[k];
-        for (uint32_t i = topo->group_vert_first[g]; i < topo->group_vert_first[g + 1]; i++) {
-            uint32_t v = topo->group_verts[i];
+        for (uint32_t i = topo->g.group_vert_first[g]; i < topo->g.group_vert_first[g + 1]; i++) {
+            uint32_t v = topo->g.group_verts[i];
             if (w->moved[v] < 0 && !w->vert_mark[v]) { w->vert_mark[v] = 1; w->extra[extra++] = v; }
         }
     }
@@ -224,7 +156,7 @@ static mk_result compute_target(mk_raw_asset *raw, const mk_raw_mesh *m, const t
         uint32_t src = a;
         if (from_moved) memcpy(&positions[3u * out], &t->positions[3u * a++], 3 * sizeof(float));
         else b++;
-        uint32_t g = topo->group_of[v];
+        uint32_t g = topo->g.group_of[v];
         const float *nb = &topo->base_normal[3u * g];
         const float *nt = w->group_slot[g] >= 0 ? &group_new[3u * (uint32_t)w->group_slot[g]] : nb;
         for (int d = 0; d < 3; d++) normals[3u * out + (uint32_t)d] = nt[d] - nb[d];
@@ -269,31 +201,32 @@ mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int fo
     mk_arena *arena = &raw->arena;
     topology topo;
     work w;
-    if (!build_topology(arena, m, &topo)) return mk_error_oom(err, "building mesh topology");
+    mk_result r = build_topology(arena, m, &topo, err);
+    if (r != MK_OK) return r;
     w.moved = mk_arena_array(arena, m->vertex_count, sizeof(int32_t));
     w.vert_mark = mk_arena_array(arena, m->vertex_count, 1);
     w.extra = mk_arena_array(arena, m->vertex_count, sizeof(uint32_t));
-    w.group_slot = mk_arena_array(arena, topo.group_count + 1u, sizeof(int32_t));
-    w.groups = mk_arena_array(arena, topo.group_count + 1u, sizeof(uint32_t));
+    w.group_slot = mk_arena_array(arena, topo.g.group_count + 1u, sizeof(int32_t));
+    w.groups = mk_arena_array(arena, topo.g.group_count + 1u, sizeof(uint32_t));
     w.tri_slot = mk_arena_array(arena, (size_t)m->triangle_count + 1, sizeof(int32_t));
     w.tris = mk_arena_array(arena, (size_t)m->triangle_count + 1, sizeof(uint32_t));
     if (!w.moved || !w.vert_mark || !w.extra || !w.group_slot || !w.groups || !w.tri_slot || !w.tris)
         return mk_error_oom(err, "computing target normals");
     for (uint32_t v = 0; v < m->vertex_count; v++) w.moved[v] = -1;
-    for (uint32_t g = 0; g < topo.group_count; g++) w.group_slot[g] = -1;
+    for (uint32_t g = 0; g < topo.g.group_count; g++) w.group_slot[g] = -1;
     for (uint32_t t = 0; t < m->triangle_count; t++) w.tri_slot[t] = -1;
     for (uint32_t c = 0; c < raw->channel_count; c++) {
         if (raw->channels[c].mesh != mesh) continue;
         for (uint32_t k = 0; k < raw->channels[c].target_count; k++) {
             mk_raw_target *t = &raw->channels[c].targets[k];
             if (!force && t->normals) continue;
-            mk_result r = compute_target(raw, m, &topo, t, &w, err);
+            r = compute_target(raw, m, &topo, t, &w, err);
             if (r) return r;
         }
     }
     /* Work and topology memory is only needed here: give it back (lowers the import peak). */
-    void *scratch[] = { w.moved, w.vert_mark, w.extra, w.group_slot, w.groups, w.tri_slot, w.tris, topo.group_of,
-                        topo.group_vert_first, topo.group_verts, topo.group_tri_first, topo.group_tris, topo.face,
+    void *scratch[] = { w.moved, w.vert_mark, w.extra, w.group_slot, w.groups, w.tri_slot, w.tris, topo.g.group_of,
+                        topo.g.group_vert_first, topo.g.group_verts, topo.g.group_tri_first, topo.g.group_tris, topo.face,
                         topo.base_normal };
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
     return MK_OK;

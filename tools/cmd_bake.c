@@ -101,7 +101,7 @@ static int run_bake(void *p)
     dir_of(a->recipe, dir, sizeof dir);
     mk_bake_options bo = { .base_dir = dir, .progress = on_progress, .channel_done = on_channel, .user = &ui };
     mk_bake_report report;
-    r = mk_bake_recipe_ex(&raw, recipe, recipe_size, &bo, &report, &err);
+    r = mk_bake_recipe(&raw, recipe, recipe_size, &bo, &report, &err);
     if (r != MK_OK) { cli_print_warnings(&raw); mk_raw_free(&raw); return cli_fail(verb->name, &err); }
     if (!a->all_meshes) mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");
     cli_print_warnings(&raw);

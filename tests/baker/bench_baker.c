@@ -25,9 +25,9 @@ static int run(const char *label, const char *recipe, uint32_t rings, uint32_t s
     mk_bake_options o = { .channel_done = on_channel, .user = &u };
     mk_error err;
     mk_bake_report rep;
-    double t0 = mk_bake_now();
-    mk_result r = mk_bake_recipe_ex(&raw, recipe, strlen(recipe), &o, &rep, &err);
-    double total = mk_bake_now() - t0;
+    double t0 = bake_now();
+    mk_result r = mk_bake_recipe(&raw, recipe, strlen(recipe), &o, &rep, &err);
+    double total = bake_now() - t0;
     if (r != MK_OK) { fprintf(stderr, "%s: %s\n", label, err.message); mk_raw_free(&raw); return 1; }
     const mk_bake_channel_report *c = &u.last;
     printf("%-22s %6u vertices %7u triangles: factorizations %u, factor %.3f s, %u solves x 3 rhs "

@@ -14,14 +14,14 @@
 #include "ffd.h"
 #include "fixtures.h"
 #include "inbetween.h"
-#include "laplacian.h"
+#include "surface_edit.h"
 
 #define PI 3.14159265358979323846
 
 static double diag_of(const mk_raw_mesh *m)
 {
     double lo[3], hi[3], d;
-    mk_bake_bounds(m, lo, hi, &d);
+    bake_bounds(m, lo, hi, &d);
     return d;
 }
 
@@ -41,7 +41,7 @@ static double max_delta(const mk_raw_channel *ch)
 static mk_result bake(mk_raw_asset *raw, const char *recipe, mk_error *err)
 {
     mk_bake_report rep;
-    return mk_bake_recipe(raw, recipe, strlen(recipe), NULL, NULL, &rep, err);
+    return mk_bake_recipe(raw, recipe, strlen(recipe), NULL, &rep, err);
 }
 
 static const mk_raw_channel *find_channel(const mk_raw_asset *raw, const char *name)
@@ -127,7 +127,7 @@ static void ffd_affine_control_points_reproduce_the_affine_map(void)
             for (uint32_t i = 0; i < f.dims[0]; i++) {
                 double p[3], q[3];
                 mk_ffd_control_point(&f, i, j, k, p);
-                mk_mat3_mul_vec(q, A, p);
+                mat3_mul_vec(q, A, p);
                 size_t idx = 3 * (i + f.dims[0] * ((size_t)j + f.dims[1] * k));
                 for (int c = 0; c < 3; c++) disp[idx + c] = q[c] + b[c] - p[c];
             }
@@ -138,7 +138,7 @@ static void ffd_affine_control_points_reproduce_the_affine_map(void)
     for (uint32_t v = 0; v < m->vertex_count; v++) {
         double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, out[3], J[9], q[3];
         mk_ffd_map(&f, 1.0, p, out, J);
-        mk_mat3_mul_vec(q, A, p);
+        mat3_mul_vec(q, A, p);
         for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(out[c] - (q[c] + b[c])));
         for (int i = 0; i < 9; i++) worstJ = fmax(worstJ, fabs(J[i] - A[i]));
     }
@@ -155,7 +155,7 @@ static void ffd_affine_control_points_reproduce_the_affine_map(void)
 }
 
 /* Finite-difference Jacobian of a point map; normals cof(J_fd) n. */
-static void fd_normal(mk_point_map map, const void *user, double a, const double p[3], const double n[3],
+static void fd_normal(bake_point_map map, const void *user, double a, const double p[3], const double n[3],
                       double out[3])
 {
     double J[9], h = 1e-6;
@@ -167,13 +167,13 @@ static void fd_normal(mk_point_map map, const void *user, double a, const double
         for (int r = 0; r < 3; r++) J[3 * r + c] = (op[r] - om[r]) / (2 * h);
     }
     double cof[9];
-    mk_mat3_cofactor(cof, J);
-    mk_mat3_mul_vec(out, cof, n);
-    mk_normalize3(out);
+    mat3_cofactor(cof, J);
+    mat3_mul_vec(out, cof, n);
+    vec3_normalize(out);
 }
 
 /* Every target normal of channel ch (base + delta, normalized) against cof(J_fd) n. */
-static double normal_error(const mk_raw_mesh *m, const mk_raw_channel *ch, mk_point_map map, const void *user)
+static double normal_error(const mk_raw_mesh *m, const mk_raw_channel *ch, bake_point_map map, const void *user)
 {
     double worst = 0;
     for (uint32_t t = 0; t < ch->target_count; t++) {
@@ -185,7 +185,7 @@ static double normal_error(const mk_raw_mesh *m, const mk_raw_channel *ch, mk_po
             double n[3] = { m->normals[3 * v], m->normals[3 * v + 1], m->normals[3 * v + 2] }, fd[3], got[3];
             fd_normal(map, user, tg->full_weight, p, n, fd);
             for (int c = 0; c < 3; c++) got[c] = n[c] + tg->normals[3 * k + (uint32_t)c];
-            mk_normalize3(got);
+            vec3_normalize(got);
             for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(got[c] - fd[c]));
         }
     }
@@ -223,7 +223,7 @@ static void ffd_and_barr_normals_match_finite_differences(void)
                    .angle = PI / 2, .direction = { 1, 0, 0 } };
     /* the fixture's bbox centre is (0, 0, 2) up to float rounding of cos/sin */
     double lo[3], hi[3], d;
-    mk_bake_bounds(m, lo, hi, &d);
+    bake_bounds(m, lo, hi, &d);
     for (int c = 0; c < 3; c++) tw.center[c] = tp.center[c] = bd.center[c] = 0.5 * (lo[c] + hi[c]);
     CHECK(mk_barr_prepare(&tw, &err) == MK_OK);
     CHECK(mk_barr_prepare(&tp, &err) == MK_OK);
@@ -249,8 +249,8 @@ static void ffd_and_barr_normals_match_finite_differences(void)
                 t[c] = m->tangents[4 * v + (uint32_t)c] + tg->tangents[3 * k + (uint32_t)c];
                 n[c] = m->normals[3 * v + (uint32_t)c] + tg->normals[3 * k + (uint32_t)c];
             }
-            worst = fmax(worst, fabs(mk_len3(t) - 1));
-            worst = fmax(worst, fabs(mk_dot3(t, n)));
+            worst = fmax(worst, fabs(vec3_length(t) - 1));
+            worst = fmax(worst, fabs(vec3_dot(t, n)));
         }
         CHECK_MSG(worst < 1e-5, "twisted tangents off by %g", worst);
     }
@@ -399,7 +399,7 @@ static void mvc_reproduces_linear_functions_inside_and_outside(void)
     /* an affine motion of the cage moves embedded points by the same map */
     double A[9] = { 1.2, 0.1, 0, -0.1, 0.9, 0.2, 0.05, 0, 1.1 }, tr[3] = { 0.4, 0.1, -0.3 };
     for (int j = 0; j < 6; j++) {
-        mk_mat3_mul_vec(def + 3 * j, A, v + 3 * j);
+        mat3_mul_vec(def + 3 * j, A, v + 3 * j);
         for (int c = 0; c < 3; c++) def[3 * j + c] += tr[c];
     }
     double worst_aff = 0;
@@ -409,7 +409,7 @@ static void mvc_reproduces_linear_functions_inside_and_outside(void)
         mk_mvc_coordinates(&cage, p, 1e-8, w);
         double out[3] = { 0, 0, 0 };
         for (int j = 0; j < 6; j++) for (int c = 0; c < 3; c++) out[c] += w[j] * def[3 * j + c];
-        mk_mat3_mul_vec(q, A, p);
+        mat3_mul_vec(q, A, p);
         for (int c = 0; c < 3; c++) worst_aff = fmax(worst_aff, fabs(out[c] - q[c] - tr[c]));
     }
     CHECK_MSG(worst_aff < 1e-9, "affine cage motion error %g", worst_aff);
@@ -559,14 +559,14 @@ static double arap_rigid_error(int iterations)
     if (r == MK_OK) {
         m = &raw.meshes[0];
         double axis[3] = { 1, 1, 0.5 }, R[9];
-        mk_normalize3(axis);
-        mk_mat3_rotation(R, axis, 50 * PI / 180);
+        vec3_normalize(axis);
+        mat3_rotation(R, axis, 50 * PI / 180);
         double *pos = malloc(3 * m->vertex_count * sizeof(double));
         last_target_positions(m, &raw.channels[0], pos);
         worst = 0;
         for (uint32_t v = 0; v < m->vertex_count; v++) {
             double d[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] - 1.5 }, q[3];
-            mk_mat3_mul_vec(q, R, d);
+            mat3_mul_vec(q, R, d);
             double expect[3] = { q[0] + 0.3, q[1] - 0.2, q[2] + 1.5 + 0.5 };
             for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(pos[3 * v + c] - expect[c]));
         }
@@ -631,7 +631,7 @@ static void twist_180_auto_inbetweens_play_back_within_tolerance(void)
     const char *recipe = "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"twist\", \"op\": \"twist\","
                          " \"axis\": \"z\", \"angle\": 180, \"inbetweens\": \"auto\", \"tolerance\": 0.001}]}";
     mk_bake_report rep;
-    mk_result r = mk_bake_recipe(&raw, recipe, strlen(recipe), NULL, NULL, &rep, &err);
+    mk_result r = mk_bake_recipe(&raw, recipe, strlen(recipe), NULL, &rep, &err);
     CHECK_MSG(r == MK_OK, "bake: %s", err.message);
     if (r != MK_OK) { mk_raw_free(&raw); return; }
     const mk_raw_mesh *m = &raw.meshes[0];
@@ -659,7 +659,7 @@ static void twist_180_auto_inbetweens_play_back_within_tolerance(void)
 
     mk_barr tw = { .op = MK_BARR_TWIST, .axis = { 0, 0, 1 }, .angle = PI };
     double lo[3], hi[3];
-    mk_bake_bounds(m, lo, hi, &d);
+    bake_bounds(m, lo, hi, &d);
     for (int c = 0; c < 3; c++) tw.center[c] = 0.5 * (lo[c] + hi[c]);
     tw.range[0] = lo[2]; tw.range[1] = hi[2];
     CHECK(mk_barr_prepare(&tw, &err) == MK_OK);
@@ -836,7 +836,7 @@ static void sample_recipes_bake(void)
             o.base_dir = dir;
             mk_bake_report rep;
             mk_error err;
-            mk_result r = mk_bake_recipe_ex(&raw, (const char *)json, size, &o, &rep, &err);
+            mk_result r = mk_bake_recipe(&raw, (const char *)json, size, &o, &rep, &err);
             CHECK_MSG(r == MK_OK, "%s: %s", names[k], err.message);
             CHECK(rep.channels_added >= 1);
             CHECK(r != MK_OK || mk_raw_validate(&raw, &err) == MK_OK);
@@ -869,7 +869,7 @@ static void folding_bend_is_reported_and_stays_finite(void)
     o.channel_done = record_channel;
     o.user = &rep;
     mk_error err;
-    mk_result r = mk_bake_recipe_ex(&raw, recipe, strlen(recipe), &o, NULL, &err);
+    mk_result r = mk_bake_recipe(&raw, recipe, strlen(recipe), &o, NULL, &err);
     CHECK_MSG(r == MK_OK, "bake: %s", err.message);
     CHECK(rep.inverted_vertices > 0);
     CHECK(raw.warning_count > 0);

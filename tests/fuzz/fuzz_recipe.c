@@ -55,7 +55,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     options.untrusted = 1;
     mk_bake_report report;
     mk_error err;
-    mk_result r = mk_bake_recipe_ex(&raw, (const char *)data, size, &options, &report, &err);
+    mk_result r = mk_bake_recipe(&raw, (const char *)data, size, &options, &report, &err);
     if (r != MK_OK && raw.channel_count != 0) abort();  /* all-or-nothing violated */
     if (r == MK_OK && mk_raw_validate(&raw, &err) != MK_OK) abort();  /* baked something invalid */
     mk_raw_free(&raw);

@@ -1,7 +1,7 @@
 /* Laplacian surface editing and as-rigid-as-possible deformation with handles and anchors,
  * solved with CHOLMOD (one factorization per bake). See laplacian.c and arap.c. */
-#ifndef MK_LAPLACIAN_H
-#define MK_LAPLACIAN_H
+#ifndef MK_SURFACE_EDIT_H
+#define MK_SURFACE_EDIT_H
 
 #include "raw.h"
 

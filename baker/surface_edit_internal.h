@@ -1,9 +1,9 @@
-/* Shared state of laplacian.c and arap.c (internal to baker/). */
-#ifndef MK_LAPLACIAN_INTERNAL_H
-#define MK_LAPLACIAN_INTERNAL_H
+/* Surface editing internals: the core state and the functions its methods share (baker/ only). */
+#ifndef MK_SURFACE_EDIT_INTERNAL_H
+#define MK_SURFACE_EDIT_INTERNAL_H
 
 #include <suitesparse/cholmod.h>
-#include "laplacian.h"
+#include "surface_edit.h"
 
 struct mk_surface_edit {
     mk_arena arena;
@@ -34,11 +34,20 @@ struct mk_surface_edit {
     mk_solver_stats stats;
 };
 
-/* Solves the factored system for the right-hand sides in edit->rhs (3 columns) into edit->x. */
-mk_result mk_edit_solve(mk_surface_edit *edit, mk_error *err);
+/* ---- the core (surface_edit.c) ---- */
+
+/* Row v of L = I - D^-1 W as (column, value) pairs: writes count entries, column v first. */
+uint32_t edit_laplacian_row(const mk_surface_edit *edit, uint32_t v, uint32_t *cols, double *vals);
 /* Constrained positions of every constrained welded vertex at amplitude a into edit->target. */
-void mk_edit_targets(mk_surface_edit *edit, double amplitude);
-/* ARAP: local/global iterations from edit->solution (holds the initial guess). */
-mk_result mk_arap_iterate(mk_surface_edit *edit, mk_error *err);
+void edit_targets(mk_surface_edit *edit, double amplitude);
+/* Solves the factored system for the right-hand sides in edit->rhs (3 columns) into edit->x. */
+mk_result edit_solve(mk_surface_edit *edit, mk_error *err);
+
+/* ---- the methods, leaves on the core (edit.c picks one) ---- */
+
+/* Laplacian editing (laplacian.c): edit->solution from edit->target. */
+mk_result edit_laplacian_solve(mk_surface_edit *edit, mk_error *err);
+/* ARAP (arap.c): local/global iterations from the solve with identity rotations. */
+mk_result edit_arap_solve(mk_surface_edit *edit, mk_error *err);
 
 #endif

@@ -1,0 +1,45 @@
+/* Which render vertices belong together: welding by position, and smoothing groups for
+ * normals. One definition shared by the importer's target normals and the bakers' normals from
+ * deformed surfaces, so seams and hard edges behave the same everywhere.
+ *
+ * A smoothing group is the set of render vertices with the same key (the same control point,
+ * or the same base position bit for bit) and the same base normal (within 1e-5 per
+ * component): vertices split only for UVs share a normal, vertices split for a hard edge keep
+ * theirs. A group's normal is the normalized sum of the area-weighted face normals (cross
+ * products) of the triangles around it. */
+#ifndef MK_MESH_GROUPS_H
+#define MK_MESH_GROUPS_H
+
+#include "raw.h"
+
+typedef enum mk_grouping {
+    MK_GROUP_BY_CONTROL_POINT = 0,   /* the importer's rule (falls back to positions without control points) */
+    MK_GROUP_BY_POSITION = 1         /* bit-identical base positions (-0 == +0) */
+} mk_grouping;
+
+typedef struct mk_normal_groups {
+    uint32_t group_count;
+    uint32_t *group_of;                      /* per render vertex */
+    uint32_t *group_vert_first, *group_verts; /* CSR: group -> its vertices */
+    uint32_t *group_tri_first, *group_tris;   /* CSR: group -> triangles with a corner in it (once each) */
+} mk_normal_groups;
+
+/* Welds render vertices with bit-identical base positions: weld[v] = welded index, numbered in
+ * order of first render vertex; returns NULL on OOM. */
+uint32_t *mk_mesh_weld(const mk_raw_mesh *mesh, mk_arena *arena, uint32_t *welded_count);
+
+/* Builds the smoothing groups of a mesh (memory from arena). */
+mk_result mk_normal_groups_build(const mk_raw_mesh *mesh, mk_grouping grouping, mk_arena *arena, mk_normal_groups *out,
+                                 mk_error *err);
+
+/* Area-weighted face normal (cross product, length = 2 x area) of triangle t of the mesh at
+ * positions (3 doubles per vertex; NULL: the base positions). */
+void mk_face_normal(const mk_raw_mesh *mesh, const double *positions, uint32_t t, double out[3]);
+
+/* Unit normals of the mesh deformed to positions (3 doubles per vertex) into normals (3
+ * doubles per vertex), for the vertices with flags[v] != 0 (flags NULL: all). A group without
+ * area keeps its base normal (or 0 without base normals). Scratch from arena. */
+mk_result mk_normal_groups_smooth(const mk_normal_groups *groups, const mk_raw_mesh *mesh, const double *positions,
+                                  const unsigned char *flags, double *normals, mk_arena *arena, mk_error *err);
+
+#endif
