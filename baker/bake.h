@@ -1,4 +1,4 @@
-/* Bakers: offline deformers that add channels to a raw model (issue #5).
+/* Bakers: offline deformers that add channels to a raw model .
  *
  * Every baker turns a deformation of one mesh into an ordinary channel: one or more targets
  * (in-betweens with full weights in (0, 1], the last one at 1), so the runtime plays a baked

@@ -4,7 +4,7 @@
  * Conventions fixed here:
  * - Normal transform N' = normalize(cof(J) N), cof(J) = det(J) J^-T, never dividing by det J;
  *   cof(J) N stays consistent with the winding of the deformed triangles even where the map
- *   folds, since (Ja) x (Jb) = cof(J)(a x b) (Barr 1984; notes A1.1 "Policy when det J <= 0").
+ *   folds, since (Ja) x (Jb) = cof(J)(a x b) (Barr 1984; docs/baking.md, "Normals").
  * - A vertex whose scale-free conditioning det J / (|J|_F / sqrt 3)^3 is <= 1e-6 is
  *   "inverted": counted, and its normal comes from the deformed surface (area-weighted face
  *   normals, smoothed over render vertices with equal base position and base normal).

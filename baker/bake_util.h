@@ -67,7 +67,7 @@ static inline void mat3_rotation(double out[9], const double axis[3], double ang
 
 /* Scale-free conditioning of a Jacobian, r = det J / (|J|_F / sqrt 3)^3: 1 for a rotation,
  * <= 0 when the map folds. Vertices with r <= BAKE_DEGENERATE_R get their normal from the
- * deformed surface instead of cof(J) n (notes: "Policy when det J <= 0"). */
+ * deformed surface instead of cof(J) n (docs/baking.md, "Normals"). */
 #define BAKE_DEGENERATE_R 1e-6
 double bake_jacobian_quality(const double J[9]);
 

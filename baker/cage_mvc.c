@@ -5,7 +5,7 @@
  * - x on a cage vertex: lambda = e_j (within eps_d);
  * - x on a cage triangle (pi - h < eps): 2D barycentric coordinates on that triangle, with
  *   w_i = sin(theta_i) d_{i-1} d_{i+1} -- distances d, not chord lengths (the QMVC reference
- *   code uses chord lengths there, which is wrong; notes A3);
+ *   code uses chord lengths there, which is wrong);
  * - x coplanar with a triangle but outside it (|s_i| <= eps): that triangle is skipped.
  * Angles use theta = 2 asin(|u_a - u_b| / 2), which stays accurate for small and near-pi
  * angles where acos(dot) does not.

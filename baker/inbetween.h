@@ -2,7 +2,7 @@
  *
  * A deformer is a function of an amplitude a in [0, 1] (0 = rest, 1 = full deformation). The
  * channel's weight w plays amplitude w: the runtime interpolates piecewise linearly between
- * the targets (DESIGN.md "Evaluation semantics", with the implicit zero key at w = 0), so a
+ * the targets (docs/semantics.md, with the implicit zero key at w = 0), so a
  * deformation that is not linear in a (a twist, a bend, ARAP) needs in-between targets to
  * follow its curved path. mk_bake_channel places them, fixed or adaptively.
  */

@@ -1,6 +1,6 @@
-/* Target normals computed from target positions (DESIGN.md: "A target without normal data
- * gets normals computed at import from its positions with the base mesh's triangles and
- * smoothing (hard edges kept)").
+/* Target normals computed from target positions: a target without normal data gets normals
+ * computed at import from its positions with the base mesh's triangles and smoothing (hard
+ * edges kept); docs/semantics.md, "Normals and tangents".
  *
  * Smoothing groups: render vertices with the same control point and the same base normal
  * share one computed normal, so vertices split only for UVs are smoothed together while

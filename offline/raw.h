@@ -1,5 +1,5 @@
 /* The raw model: an editable, offline description of meshes, channels, in-between targets
- * and weight clips (DESIGN.md "Data model"). Importers fill it, bakers add to it, the writer
+ * and weight clips (docs/architecture.md). Importers fill it, bakers add to it, the writer
  * turns it into a .morph blob, the reader turns a blob back into it.
  *
  * All memory of a raw asset comes from its arena: mk_raw_free releases everything. Fields are

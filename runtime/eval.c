@@ -1,4 +1,4 @@
-/* Morph evaluation (DESIGN.md "Evaluation semantics", docs/semantics.md).
+/* Morph evaluation (docs/semantics.md).
  *
  * Per frame, once per job: every target of the mesh gets one scalar coefficient from the
  * channel weights (mk_channel_span: piecewise-linear through the implicit (0,0) key and the

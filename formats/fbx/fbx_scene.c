@@ -1,7 +1,7 @@
 /* FBX scene interpretation: objects, connections, meshes, blend shapes and weight animation
  * into the raw model.
  *
- * Object graph (notes/fbx-blend-shapes.md §2.3; ufbx ufbxi_read_objects/connections):
+ * Object graph (docs/importing-fbx.md):
  *   7.x:  Model <-OO- Geometry(Mesh) <-OO- Deformer(BlendShape) <-OO- Deformer(BlendShapeChannel)
  *         <-OO- Geometry(Shape) x N (in-between order = connection order, matching FullWeights);
  *         AnimationStack <-OO- AnimationLayer <-OO- AnimationCurveNode -OP "DeformPercent"->

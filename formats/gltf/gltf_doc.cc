@@ -2,7 +2,7 @@
 // importer as the plain structs of gltf_doc.h.
 //
 // Why tinygltf is compiled here and not linked from Debian's libtinygltf.so: the packaged
-// library has no Draco support (notes/gltf-morph-targets.md §3.2), and its inline TinyGLTF
+// library has no Draco support, and its inline TinyGLTF
 // constructor references the stb image writer unless every TU agrees on the same
 // TINYGLTF_NO_STB_* macros. This is the only TU that defines TINYGLTF_IMPLEMENTATION; it does
 // not link -ltinygltf.

@@ -1,5 +1,4 @@
-/* glTF 2.0 → raw model (DESIGN.md "What the glTF importer must get right",
- * notes/gltf-morph-targets.md).
+/* glTF 2.0 → raw model (docs/importing-gltf.md).
  *
  * Every (node, primitive) whose mesh has morph targets becomes one raw mesh: render vertex i is
  * glTF vertex i (identity control-point map), positions are mesh-local, `world` is the node's

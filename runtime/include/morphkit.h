@@ -60,7 +60,7 @@ typedef struct mk_error {
 
 const char *mk_result_name(mk_result code);
 
-/* Channel stacking on a mesh (DESIGN.md, "Evaluation semantics"). */
+/* Channel stacking on a mesh (docs/semantics.md). */
 typedef enum mk_stacking {
     MK_STACKING_ASSET = 0,      /* in a job: use the mesh's setting stored in the blob */
     MK_STACKING_ADDITIVE = 1,   /* P = B + sum_c D_c(w_c) */
@@ -264,7 +264,7 @@ mk_result mk_sample_run(const mk_sample_job *job, mk_error *err);
 /* Evaluates one curve at time t (clamped to the first/last key). Exposed for tools and tests. */
 float mk_curve_eval(const mk_key *keys, uint32_t key_count, double time, uint32_t *cursor);
 
-/* The channel displacement coefficients of DESIGN.md for one channel at weight w: the two
+/* The channel displacement coefficients (docs/semantics.md) for one channel at weight w: the two
  * targets (indices into the channel's sorted targets, -1 for the implicit zero key) and their
  * factors, so D(w) = ca * delta[ia] + cb * delta[ib]. Exposed for tools and tests. */
 void mk_channel_span(const float *full_weights, uint32_t count, float w,

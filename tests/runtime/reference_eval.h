@@ -1,6 +1,6 @@
 /* A second evaluator, for tests only: docs/semantics.md ("Channel displacement", "Stacking",
  * "Normals and tangents") written out in double precision, one vertex and one channel at a
- * time, straight from the raw model (importer/raw.h). It shares nothing with the runtime or
+ * time, straight from the raw model (offline/raw.h). It shares nothing with the runtime or
  * the writer: no blocks, no blob layout, no per-job coefficient tables or suffix products, no
  * mk_channel_span. Sequential stacking is the recurrence d_c = (1 - beta_c) d_{c-1} + D_c(w_c)
  * as written, not its unrolled form.

@@ -1,4 +1,4 @@
-/* Evaluation semantics (DESIGN.md) against hand-computed values: in-betweens, negative full
+/* Evaluation semantics (docs/semantics.md) against hand-computed values: in-betweens, negative full
  * weights, extrapolation, sequential stacking, nlerp/slerp normals, vertex ranges, strides. */
 #include <stdlib.h>
 #include "check.h"
