@@ -1,6 +1,7 @@
 /* Every invalid evaluation and sampling job is rejected with the right code (JobValidity
  * style): start from a valid job, break one field at a time. */
 #include <stdlib.h>
+#include <string.h>
 #include "check.h"
 #include "fixtures.h"
 
@@ -31,12 +32,15 @@ static mk_eval_job valid_eval(void)
     return j;
 }
 
+/* mk_eval_validate and mk_eval_run agree on every job: validate says what run would. */
 static void expect(mk_eval_job j, mk_result code, const char *what)
 {
-    mk_error err = { 0 };
+    mk_error err = { 0 }, verr = { 0 };
+    mk_result v = mk_eval_validate(&j, &verr);
+    CHECK_MSG(v == code, "%s: validate gave %s (%s), expected %s", what, mk_result_name(v), verr.message, mk_result_name(code));
     mk_result r = mk_eval_run(&j, &err);
     CHECK_MSG(r == code, "%s: got %s (%s), expected %s", what, mk_result_name(r), err.message, mk_result_name(code));
-    if (code != MK_OK) CHECK_MSG(err.message[0] != 0, "%s: no message", what);
+    if (code != MK_OK) CHECK_MSG(err.message[0] != 0 && !strcmp(err.message, verr.message), "%s: no message, or run and validate differ", what);
 }
 
 static void test_valid_job_runs(void) { expect(valid_eval(), MK_OK, "valid"); }
@@ -107,9 +111,12 @@ static mk_sample_job valid_sample(void)
 
 static void expect_sample(mk_sample_job j, mk_result code, const char *what)
 {
-    mk_error err = { 0 };
+    mk_error err = { 0 }, verr = { 0 };
+    mk_result v = mk_sample_validate(&j, &verr);
+    CHECK_MSG(v == code, "%s: validate gave %s, expected %s", what, mk_result_name(v), mk_result_name(code));
     mk_result r = mk_sample_run(&j, &err);
     CHECK_MSG(r == code, "%s: got %s, expected %s", what, mk_result_name(r), mk_result_name(code));
+    if (code != MK_OK) CHECK_MSG(err.message[0] != 0 && !strcmp(err.message, verr.message), "%s: no message, or run and validate differ", what);
 }
 
 static void test_invalid_sample_jobs(void)
