@@ -4,7 +4,6 @@
 #include "copy_probe.h"
 #include "timing.h"
 
-
 int copy_probe_init(copy_probe *p)
 {
     p->size = (size_t)256 << 20;

@@ -15,12 +15,19 @@ double bench_naive_frames(const pb_asset *l, const float *weight_sets, uint32_t 
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err;
-    if (mk_read_blob(a, &raw, &err)) { fprintf(stderr, "bench: %s\n", err.message); exit(1); }
+    if (mk_read_blob(a, &raw, &err)) {
+        fprintf(stderr, "bench: %s\n", err.message);
+        exit(1);
+    }
     /* Which targets are ever active: only those get dense arrays (memory). Targets are
      * numbered across the asset, channel by channel, as in the blob. */
     uint32_t *first_target = calloc(raw.channel_count + 1u, sizeof *first_target);
-    if (!first_target) { fprintf(stderr, "bench: out of memory\n"); exit(1); }
-    for (uint32_t c = 0; c < raw.channel_count; c++) first_target[c + 1] = first_target[c] + raw.channels[c].target_count;
+    if (!first_target) {
+        fprintf(stderr, "bench: out of memory\n");
+        exit(1);
+    }
+    for (uint32_t c = 0; c < raw.channel_count; c++)
+        first_target[c + 1] = first_target[c] + raw.channels[c].target_count;
     double total = 0;
     *diff = 0;
     for (uint32_t mi = 0; mi < raw.mesh_count; mi++) {
@@ -43,7 +50,8 @@ double bench_naive_frames(const pb_asset *l, const float *weight_sets, uint32_t 
                 for (uint32_t j = 0; j < t->count; j++)
                     for (int d = 0; d < 3; d++) {
                         dp[3 * (size_t)t->indices[j] + (size_t)d] = t->positions[3 * (size_t)j + (size_t)d];
-                        if (t->normals) dn[3 * (size_t)t->indices[j] + (size_t)d] = t->normals[3 * (size_t)j + (size_t)d];
+                        if (t->normals)
+                            dn[3 * (size_t)t->indices[j] + (size_t)d] = t->normals[3 * (size_t)j + (size_t)d];
                     }
                 dense_p[first_target[c] + k] = dp;
                 dense_n[first_target[c] + k] = dn;
@@ -65,16 +73,22 @@ double bench_naive_frames(const pb_asset *l, const float *weight_sets, uint32_t 
                         int32_t k = side ? ib : ia;
                         float coef = side ? cb : ca;
                         if (k < 0 || !dense_p[first_target[c] + (uint32_t)k]) continue;
-                        const float *dp = dense_p[first_target[c] + (uint32_t)k], *dn = dense_n[first_target[c] + (uint32_t)k];
+                        const float *dp = dense_p[first_target[c] + (uint32_t)k],
+                                    *dn = dense_n[first_target[c] + (uint32_t)k];
                         for (size_t i = 0; i < 3 * n; i++) out_p[i] += coef * dp[i];
-                        if (m->normals) for (size_t i = 0; i < 3 * n; i++) out_n[i] += coef * dn[i];
+                        if (m->normals)
+                            for (size_t i = 0; i < 3 * n; i++) out_n[i] += coef * dn[i];
                     }
                 }
                 if (m->normals)
                     for (size_t v = 0; v < n; v++) {
                         float *q = &out_n[3 * v];
                         float len = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-                        if (len > 1e-8f) { q[0] /= len; q[1] /= len; q[2] /= len; }
+                        if (len > 1e-8f) {
+                            q[0] /= len;
+                            q[1] /= len;
+                            q[2] /= len;
+                        }
                     }
             }
             double t = (bench_now_ns() - t0) / frames;
@@ -84,14 +98,17 @@ double bench_naive_frames(const pb_asset *l, const float *weight_sets, uint32_t 
         /* Check: the last frame against the runtime. */
         float *rp = malloc(12 * n), *rn = malloc(12 * n);
         if (pb_eval_mesh(a, mi, weight_sets + (size_t)(frames - 1) * a->channel_count, MK_STACKING_ADDITIVE,
-                            MK_NORMALS_NLERP, rp, m->normals ? rn : NULL, &err) == MK_OK)
+                         MK_NORMALS_NLERP, rp, m->normals ? rn : NULL, &err) == MK_OK)
             for (size_t i = 0; i < 3 * n; i++) {
                 double d = fabs((double)rp[i] - out_p[i]);
                 if (d > *diff) *diff = d;
             }
         free(rp);
         free(rn);
-        for (uint32_t k = 0; k < a->target_count; k++) { free(dense_p[k]); free(dense_n[k]); }
+        for (uint32_t k = 0; k < a->target_count; k++) {
+            free(dense_p[k]);
+            free(dense_n[k]);
+        }
         free(dense_p);
         free(dense_n);
         free(out_p);

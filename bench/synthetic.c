@@ -19,7 +19,8 @@ mk_result bench_build_synthetic(const bench_synthetic *o, mk_raw_asset *raw, mk_
     m->normals = mk_arena_array(&raw->arena, 3 * (size_t)n, sizeof(float));
     uint32_t quads = (w - 1) * (h - 1);
     m->triangles = mk_arena_array(&raw->arena, 6 * (size_t)quads, sizeof(uint32_t));
-    if (!m->name || !m->positions || !m->normals || !m->triangles) return mk_error_oom(err, "building the synthetic mesh");
+    if (!m->name || !m->positions || !m->normals || !m->triangles)
+        return mk_error_oom(err, "building the synthetic mesh");
     for (uint32_t v = 0; v < n; v++) {
         float x = (float)(v % w) / (float)w, y = (float)(v / w) / (float)h;
         m->positions[3 * v] = x;
@@ -33,7 +34,12 @@ mk_result bench_build_synthetic(const bench_synthetic *o, mk_raw_asset *raw, mk_
             uint32_t a = y * w + x, b = a + 1, c = a + w, d = c + 1;
             if (d >= n) continue;
             uint32_t *tri = &m->triangles[6 * (size_t)t++];
-            tri[0] = a; tri[1] = b; tri[2] = d; tri[3] = a; tri[4] = d; tri[5] = c;
+            tri[0] = a;
+            tri[1] = b;
+            tri[2] = d;
+            tri[3] = a;
+            tri[4] = d;
+            tri[5] = c;
         }
     m->triangle_count = 2 * t;
     uint32_t progressive = o->channels / 5;
@@ -41,7 +47,7 @@ mk_result bench_build_synthetic(const bench_synthetic *o, mk_raw_asset *raw, mk_
     if (!channels) return mk_error_oom(err, "building channels");
     uint32_t *scratch = mk_arena_array(&raw->arena, n, sizeof(uint32_t));
     if (!scratch) return mk_error_oom(err, "building channels");
-    double radius = sqrt(o->density * (double)n / (3.0 * 3.14159265)) ;
+    double radius = sqrt(o->density * (double)n / (3.0 * 3.14159265));
     uint64_t seed = 12345;
     for (uint32_t c = 0; c < o->channels; c++) {
         mk_raw_channel *ch = &channels[c];
@@ -62,7 +68,10 @@ mk_result bench_build_synthetic(const bench_synthetic *o, mk_raw_asset *raw, mk_
         for (uint32_t v = 0; v < n; v++) {
             double x = v % w, y = v / w;
             for (int k = 0; k < 3; k++)
-                if ((x - cx[k]) * (x - cx[k]) + (y - cy[k]) * (y - cy[k]) < radius * radius) { scratch[count++] = v; break; }
+                if ((x - cx[k]) * (x - cx[k]) + (y - cy[k]) * (y - cy[k]) < radius * radius) {
+                    scratch[count++] = v;
+                    break;
+                }
         }
         for (uint32_t k = 0; k < targets; k++) {
             mk_raw_target *tg = &ch->targets[k];
@@ -85,7 +94,6 @@ mk_result bench_build_synthetic(const bench_synthetic *o, mk_raw_asset *raw, mk_
     }
     return MK_OK;
 }
-
 
 double bench_machine_memory(void)
 {

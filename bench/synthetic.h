@@ -5,10 +5,10 @@
 #include "raw.h"
 
 typedef struct bench_synthetic {
-    uint32_t vertices;         /* a near-square grid of this many vertices (>= 64) */
-    uint32_t channels;         /* one in five progressive (an in-between at 0.5) */
-    uint32_t active;           /* channels nonzero per frame (for the memory estimate) */
-    double density;            /* fraction of the vertices each target moves */
+    uint32_t vertices; /* a near-square grid of this many vertices (>= 64) */
+    uint32_t channels; /* one in five progressive (an in-between at 0.5) */
+    uint32_t active;   /* channels nonzero per frame (for the memory estimate) */
+    double density;    /* fraction of the vertices each target moves */
 } bench_synthetic;
 
 /* One mesh with normals; each channel's targets move the vertices inside 3 disks (an LCG

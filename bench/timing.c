@@ -15,9 +15,6 @@ double bench_now_ns(void)
     return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
 }
 
-
-
-
 /* Threads split a mesh the way a job system would: into ranges of BENCH_CHUNK_BLOCKS
  * 64-vertex blocks (so no two jobs share a block), each one mk_eval_run job, taken from a
  * shared counter until none is left. Dynamic assignment keeps both threads busy when the
@@ -27,15 +24,25 @@ double bench_now_ns(void)
 static void run_range(bench_ctx *c, uint32_t index, const mk_mesh_info *m, uint32_t first, uint32_t last)
 {
     mk_eval_job job = {
-        .asset = c->asset, .mesh = c->mesh, .first_vertex = first, .vertex_count = last - first,
-        .weights = c->weights + m->first_channel, .weight_count = m->channel_count, .stacking = c->stacking,
-        .scratch = c->scratch[index], .scratch_size = mk_eval_scratch_size(c->asset, c->mesh),
-        .positions = c->positions + 3 * (size_t)first, .positions_size = 12 * (size_t)(last - first),
+        .asset = c->asset,
+        .mesh = c->mesh,
+        .first_vertex = first,
+        .vertex_count = last - first,
+        .weights = c->weights + m->first_channel,
+        .weight_count = m->channel_count,
+        .stacking = c->stacking,
+        .scratch = c->scratch[index],
+        .scratch_size = mk_eval_scratch_size(c->asset, c->mesh),
+        .positions = c->positions + 3 * (size_t)first,
+        .positions_size = 12 * (size_t)(last - first),
         .normals = c->normals && m->has_normals ? c->out_normals + 3 * (size_t)first : NULL,
         .normals_size = 12 * (size_t)(last - first),
     };
     mk_error err;
-    if (mk_eval_run(&job, &err) != MK_OK) { fprintf(stderr, "bench: eval failed: %s\n", err.message); exit(1); }
+    if (mk_eval_run(&job, &err) != MK_OK) {
+        fprintf(stderr, "bench: eval failed: %s\n", err.message);
+        exit(1);
+    }
 }
 
 static void run_slice(bench_ctx *c, uint32_t index)
@@ -90,8 +97,6 @@ static double time_pass(bench_ctx *c, const float *weight_sets, uint32_t frames,
     return (bench_now_ns() - t0) / frames;
 }
 
-
-
 /* Times the configurations round-robin, BENCH_PASSES rounds, one pass of each per round, and
  * keeps each one's best pass; a memory-copy sample follows each round. Interleaving means a
  * burst of interference on the shared host (seconds long) costs each configuration one pass
@@ -135,14 +140,22 @@ double bench_frame_bytes(const mk_asset *a, const float *weights, int normals, v
         mk_mesh_get(a, mi, &m);
         static float sink[3];
         mk_eval_job job = {
-            .asset = a, .mesh = mi, .vertex_count = MK_VERTICES_TO_END, .weights = weights + m.first_channel,
-            .weight_count = m.channel_count, .scratch = scratch, .scratch_size = mk_eval_scratch_size(a, mi),
+            .asset = a,
+            .mesh = mi,
+            .vertex_count = MK_VERTICES_TO_END,
+            .weights = weights + m.first_channel,
+            .weight_count = m.channel_count,
+            .scratch = scratch,
+            .scratch_size = mk_eval_scratch_size(a, mi),
             /* Output spans are only validated, never written. */
-            .positions = sink, .positions_stride = 12, .positions_size = SIZE_MAX,
-            .normals = normals && m.has_normals ? sink : NULL, .normals_stride = 12, .normals_size = SIZE_MAX,
+            .positions = sink,
+            .positions_stride = 12,
+            .positions_size = SIZE_MAX,
+            .normals = normals && m.has_normals ? sink : NULL,
+            .normals_stride = 12,
+            .normals_size = SIZE_MAX,
         };
         bytes += (double)mk_eval_traffic(&job);
     }
     return bytes;
 }
-

@@ -10,23 +10,26 @@
 typedef struct bench_ctx {
     const mk_asset *asset;
     uint32_t mesh;
-    const float *weights;      /* asset-wide weights of the current frame */
+    const float *weights; /* asset-wide weights of the current frame */
     mk_stacking stacking;
     int normals;
     float *positions, *out_normals;
-    void **scratch;            /* one per thread */
-    uint32_t threads;          /* threads in the pool */
-    uint32_t running;          /* threads evaluating this pass: 1 or `threads` */
+    void **scratch;   /* one per thread */
+    uint32_t threads; /* threads in the pool */
+    uint32_t running; /* threads evaluating this pass: 1 or `threads` */
     pthread_barrier_t start, done;
-    atomic_uint next_chunk;    /* next range of the current mesh to evaluate */
+    atomic_uint next_chunk; /* next range of the current mesh to evaluate */
     int quit;
-    copy_probe *probe;         /* sampled after each round of timed passes, or NULL */
-    void (*progress)(void *user, const char *stage, double fraction);  /* may be NULL */
+    copy_probe *probe; /* sampled after each round of timed passes, or NULL */
+    void (*progress)(void *user, const char *stage, double fraction); /* may be NULL */
     void *user;
-    uint64_t chunks[64][8];    /* chunks each thread evaluated (one cache line per thread) */
+    uint64_t chunks[64][8]; /* chunks each thread evaluated (one cache line per thread) */
 } bench_ctx;
 
-typedef struct worker { bench_ctx *ctx; uint32_t index; } worker;
+typedef struct worker {
+    bench_ctx *ctx;
+    uint32_t index;
+} worker;
 
 /* One measured configuration: threads running, stacking, normals; best ns per frame. */
 typedef struct timed_config {

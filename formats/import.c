@@ -29,7 +29,8 @@ static int looks_like_gltf(const unsigned char *p, size_t size)
 mk_result mk_import_memory(const void *data, size_t size, const mk_import_options *options, mk_raw_asset *out,
                            mk_error *err)
 {
-    if (!out || (!data && size)) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "import: invalid argument");
+    if (!out || (!data && size))
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "import: invalid argument");
     if (mk_is_blob(data, size)) return import_blob(data, size, options, out, err);
     if (looks_like_gltf(data, size)) return mk_import_gltf(data, size, options, out, err);
     /* FBX: binary files have a magic; ASCII files are text, and the parser refuses text
@@ -37,8 +38,10 @@ mk_result mk_import_memory(const void *data, size_t size, const mk_import_option
     const unsigned char *p = data;
     size_t head = size < 1024 ? size : 1024;
     int text = size > 0 && memchr(p, 0, head) == NULL;
-    if ((size >= 18 && memcmp(p, "Kaydara FBX Binary", 18) == 0) || text) return mk_import_fbx(data, size, options, out, err);
-    return mk_error_set(err, MK_ERROR_UNSUPPORTED, 0, "unknown file type: not a .morph blob, glTF (.gltf, .glb) or FBX");
+    if ((size >= 18 && memcmp(p, "Kaydara FBX Binary", 18) == 0) || text)
+        return mk_import_fbx(data, size, options, out, err);
+    return mk_error_set(err, MK_ERROR_UNSUPPORTED, 0,
+                        "unknown file type: not a .morph blob, glTF (.gltf, .glb) or FBX");
 }
 
 mk_result mk_import_file(const char *path, const mk_import_options *options, mk_raw_asset *out, mk_error *err)
@@ -51,13 +54,20 @@ mk_result mk_import_file(const char *path, const mk_import_options *options, mk_
     mk_arena_init(&tmp, &out->arena.allocator);
     void *data;
     size_t size;
-    mk_result r = mk_read_file(&tmp, path, o.max_input_size ? o.max_input_size : MK_IMPORT_DEFAULT_MAX_INPUT, &data, &size, err);
-    if (r != MK_OK) { mk_arena_free_all(&tmp); return r; }  /* the message names the file */
+    mk_result r =
+        mk_read_file(&tmp, path, o.max_input_size ? o.max_input_size : MK_IMPORT_DEFAULT_MAX_INPUT, &data, &size, err);
+    if (r != MK_OK) {
+        mk_arena_free_all(&tmp);
+        return r;
+    } /* the message names the file */
     char *dir = NULL;
     if (!o.base_dir) {
         const char *slash = strrchr(path, '/');
         dir = slash ? mk_arena_strndup(&tmp, path, (size_t)(slash - path + 1)) : mk_arena_strdup(&tmp, "./");
-        if (!dir) { mk_arena_free_all(&tmp); return mk_error_oom(err, "import path"); }
+        if (!dir) {
+            mk_arena_free_all(&tmp);
+            return mk_error_oom(err, "import path");
+        }
         o.base_dir = dir;
     }
     r = mk_import_memory(data, size, &o, out, err);

@@ -29,7 +29,8 @@ static mk_result read_stream(mk_arena *arena, int fd, const char *path, size_t m
     for (;;) {
         if (n == cap) {
             if (max_size && cap >= max_size)
-                return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "%.200s: more than the limit of %zu bytes", path, max_size);
+                return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "%.200s: more than the limit of %zu bytes", path,
+                                    max_size);
             uint8_t *q = mk_arena_realloc(arena, p, cap + 1, 2 * cap + 1);
             if (!q) return mk_error_oom(err, "reading a file");
             p = q;
@@ -42,7 +43,8 @@ static mk_result read_stream(mk_arena *arena, int fd, const char *path, size_t m
         n += (size_t)got;
     }
     if (max_size && n > max_size)
-        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "%.200s: %zu bytes exceeds the limit of %zu bytes", path, n, max_size);
+        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "%.200s: %zu bytes exceeds the limit of %zu bytes", path,
+                            n, max_size);
     p[n] = 0;
     *data = p;
     *size = n;
@@ -76,9 +78,13 @@ mk_result mk_read_file(mk_arena *arena, const char *path, size_t max_size, void 
         while (r == MK_OK && got < n) {
             ssize_t k = read(fd, p + got, n - got);
             if (k < 0 && errno == EINTR) continue;
-            if (k < 0) r = io_error(err, path, "read failed", errno);
-            else if (k == 0) r = mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: read %zu of %zu bytes (file shrank?)", path, got, n);
-            else got += (size_t)k;
+            if (k < 0)
+                r = io_error(err, path, "read failed", errno);
+            else if (k == 0)
+                r = mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: read %zu of %zu bytes (file shrank?)", path,
+                                 got, n);
+            else
+                got += (size_t)k;
         }
         if (p) p[n] = 0;
     }
@@ -99,7 +105,10 @@ mk_result mk_read_file(mk_arena *arena, const char *path, size_t max_size, void 
 static void dir_of(const char *path, char *out, size_t size)
 {
     const char *slash = strrchr(path, '/');
-    if (!slash) { snprintf(out, size, "."); return; }
+    if (!slash) {
+        snprintf(out, size, ".");
+        return;
+    }
     size_t n = slash == path ? 1 : (size_t)(slash - path);
     snprintf(out, size, "%.*s", (int)n, path);
 }
@@ -160,11 +169,14 @@ mk_result mk_output_check(mk_output *out, const char *const *inputs, uint32_t in
     dir_of(out->target, dir, sizeof dir);
     struct stat ds;
     if (stat(dir, &ds) != 0)
-        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: cannot create it: folder %.200s: %s", path, dir, strerror(errno));
+        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: cannot create it: folder %.200s: %s", path, dir,
+                            strerror(errno));
     if (!S_ISDIR(ds.st_mode))
-        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: cannot create it: %.200s is not a folder", path, dir);
+        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: cannot create it: %.200s is not a folder", path,
+                            dir);
     if (access(dir, W_OK) != 0)
-        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: cannot write in folder %.200s: %s", path, dir, strerror(errno));
+        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: cannot write in folder %.200s: %s", path, dir,
+                            strerror(errno));
     out->kind = exists ? MK_OUTPUT_REPLACE_FILE : MK_OUTPUT_NEW_FILE;
     out->mode = exists ? (uint32_t)(st.st_mode & 07777) : 0;
     return MK_OK;
@@ -218,12 +230,22 @@ mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
         mk_output *o = &outs[written];
         if (o->kind == MK_OUTPUT_STREAM) continue;
         int fd = create_beside(o->target, ".tmp", o->temp, sizeof o->temp);
-        if (fd < 0) { r = io_error(err, o->path, "cannot create a temporary file beside it", errno); o->temp[0] = 0; break; }
+        if (fd < 0) {
+            r = io_error(err, o->path, "cannot create a temporary file beside it", errno);
+            o->temp[0] = 0;
+            break;
+        }
         int failed = write_all(fd, o->data, o->size) != 0;
         int e = errno;
         if (!failed && o->kind == MK_OUTPUT_REPLACE_FILE) (void)fchmod(fd, (mode_t)o->mode);
-        if (!failed && fsync(fd) != 0) { failed = 1; e = errno; }
-        if (close(fd) != 0 && !failed) { failed = 1; e = errno; }
+        if (!failed && fsync(fd) != 0) {
+            failed = 1;
+            e = errno;
+        }
+        if (close(fd) != 0 && !failed) {
+            failed = 1;
+            e = errno;
+        }
         if (failed) r = io_error(err, o->path, "write failed", e);
     }
     /* 2. Streams (devices, FIFOs) are written directly; they cannot be taken back, so they
@@ -232,10 +254,16 @@ mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
         mk_output *o = &outs[i];
         if (o->kind != MK_OUTPUT_STREAM) continue;
         int fd = open(o->target, O_WRONLY | O_NOCTTY);
-        if (fd < 0) { r = io_error(err, o->path, "cannot open", errno); break; }
+        if (fd < 0) {
+            r = io_error(err, o->path, "cannot open", errno);
+            break;
+        }
         int failed = write_all(fd, o->data, o->size) != 0;
         int e = errno;
-        if (close(fd) != 0 && !failed) { failed = 1; e = errno; }
+        if (close(fd) != 0 && !failed) {
+            failed = 1;
+            e = errno;
+        }
         if (failed) r = io_error(err, o->path, "write failed", e);
     }
     /* 3. Renames into place; a replaced file keeps a hard-linked backup until all succeeded,
@@ -252,15 +280,20 @@ mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
                 o->backup[0] = 0;
             }
         }
-        if (rename(o->temp, o->target) != 0) { r = io_error(err, o->path, "cannot rename into place", errno); break; }
+        if (rename(o->temp, o->target) != 0) {
+            r = io_error(err, o->path, "cannot rename into place", errno);
+            break;
+        }
         o->temp[0] = 0;
     }
     if (r != MK_OK) {
         for (uint32_t i = 0; i < renamed; i++) {
             mk_output *o = &outs[i];
             if (o->kind == MK_OUTPUT_STREAM) continue;
-            if (o->backup[0]) rename(o->backup, o->target);
-            else if (o->kind == MK_OUTPUT_NEW_FILE) unlink(o->target);
+            if (o->backup[0])
+                rename(o->backup, o->target);
+            else if (o->kind == MK_OUTPUT_NEW_FILE)
+                unlink(o->target);
             o->backup[0] = 0;
         }
     }

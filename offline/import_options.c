@@ -4,14 +4,15 @@ mk_result mk_import_options_check(const mk_import_options *o, size_t input_size,
 {
     if (!o) return MK_OK;
     if ((unsigned)o->stacking > MK_STACKING_SEQUENTIAL)
-        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "%s import: unknown stacking %d", format, (int)o->stacking);
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "%s import: unknown stacking %d", format,
+                            (int)o->stacking);
     if (o->channels_sidecar && o->channels_sidecar_text)
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
                             "%s import: give the channel sidecar as a path or as text, not both", format);
     size_t limit = o->max_input_size ? o->max_input_size : MK_IMPORT_DEFAULT_MAX_INPUT;
     if (input_size > limit)
-        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "%s input of %zu bytes exceeds the limit of %zu bytes", format,
-                            input_size, limit);
+        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "%s input of %zu bytes exceeds the limit of %zu bytes",
+                            format, input_size, limit);
     return MK_OK;
 }
 

@@ -42,7 +42,7 @@ uint32_t *mk_mesh_weld(const mk_raw_mesh *mesh, mk_arena *arena, uint32_t *welde
     for (uint32_t k = 0; k < n;) {
         uint32_t e = k + 1;
         while (e < n && memcmp(keys[e].bits, keys[k].bits, sizeof keys[k].bits) == 0) e++;
-        for (uint32_t q = k; q < e; q++) first[keys[q].vertex] = keys[k].vertex;   /* the smallest v */
+        for (uint32_t q = k; q < e; q++) first[keys[q].vertex] = keys[k].vertex; /* the smallest v */
         k = e;
     }
     uint32_t count = 0;
@@ -100,7 +100,10 @@ mk_result mk_normal_groups_build(const mk_raw_mesh *m, mk_grouping grouping, mk_
             uint32_t v = key_verts[i], found = UINT32_MAX;
             if (m->normals) {
                 for (uint32_t j = key_first[k]; j < i; j++)
-                    if (same_normal(&m->normals[3u * key_verts[j]], &m->normals[3u * v])) { found = g->group_of[key_verts[j]]; break; }
+                    if (same_normal(&m->normals[3u * key_verts[j]], &m->normals[3u * v])) {
+                        found = g->group_of[key_verts[j]];
+                        break;
+                    }
             } else if (i > key_first[k]) {
                 found = start;
             }
@@ -120,9 +123,16 @@ mk_result mk_normal_groups_build(const mk_raw_mesh *m, mk_grouping grouping, mk_
     for (uint32_t t = 0; t < m->triangle_count; t++) {
         uint32_t g0 = g->group_of[m->triangles[3u * t]], g1 = g->group_of[m->triangles[3u * t + 1]],
                  g2 = g->group_of[m->triangles[3u * t + 2]];
-        tri_group[pairs] = g0; tri_index[pairs++] = t;
-        if (g1 != g0) { tri_group[pairs] = g1; tri_index[pairs++] = t; }
-        if (g2 != g0 && g2 != g1) { tri_group[pairs] = g2; tri_index[pairs++] = t; }
+        tri_group[pairs] = g0;
+        tri_index[pairs++] = t;
+        if (g1 != g0) {
+            tri_group[pairs] = g1;
+            tri_index[pairs++] = t;
+        }
+        if (g2 != g0 && g2 != g1) {
+            tri_group[pairs] = g2;
+            tri_index[pairs++] = t;
+        }
     }
     uint32_t *slots;
     if (!build_csr(arena, tri_group, pairs, g->group_count, &g->group_tri_first, &slots))
@@ -163,7 +173,9 @@ mk_result mk_normal_groups_smooth(const mk_normal_groups *g, const mk_raw_mesh *
             uint32_t v = g->group_verts[i];
             if (flags && !flags[v]) continue;
             for (int d = 0; d < 3; d++)
-                normals[3u * v + (uint32_t)d] = len > 0 ? sum[d] / len : m->normals ? m->normals[3u * v + (uint32_t)d] : 0.0;
+                normals[3u * v + (uint32_t)d] = len > 0      ? sum[d] / len
+                                                : m->normals ? m->normals[3u * v + (uint32_t)d]
+                                                             : 0.0;
         }
     }
     mk_arena_release(arena, face);

@@ -55,13 +55,16 @@ mk_result mk_obj_read(const char *path, mk_arena *arena, mk_obj *out, mk_error *
             if ((eol - q >= 2 && q[0] == 'v' && (q[1] == ' ' || q[1] == '\t')) || is_normal) {
                 double xyz[3];
                 if (!read_triple(q + (is_normal ? 3 : 2), eol, xyz))
-                    return mk_error_set(err, MK_ERROR_PARSE, (uint64_t)(q - text), "%s:%zu: %s needs 3 finite coordinates",
-                                        path, line_no, is_normal ? "a normal" : "a vertex");
+                    return mk_error_set(err, MK_ERROR_PARSE, (uint64_t)(q - text),
+                                        "%s:%zu: %s needs 3 finite coordinates", path, line_no,
+                                        is_normal ? "a normal" : "a vertex");
                 if (is_normal) {
-                    if (pass == 1 && n) for (int c = 0; c < 3; c++) n[3 * in + (size_t)c] = xyz[c];
+                    if (pass == 1 && n)
+                        for (int c = 0; c < 3; c++) n[3 * in + (size_t)c] = xyz[c];
                     in++;
                 } else {
-                    if (pass == 1) for (int c = 0; c < 3; c++) v[3 * iv + (size_t)c] = xyz[c];
+                    if (pass == 1)
+                        for (int c = 0; c < 3; c++) v[3 * iv + (size_t)c] = xyz[c];
                     iv++;
                 }
             } else if (eol - q >= 2 && q[0] == 'f' && (q[1] == ' ' || q[1] == '\t')) {
@@ -73,35 +76,42 @@ mk_result mk_obj_read(const char *path, mk_arena *arena, mk_obj *out, mk_error *
                     if (q >= eol) break;
                     char buf[32];
                     size_t len = 0;
-                    while (q + len < eol && len < sizeof buf - 1 && q[len] != ' ' && q[len] != '\t' &&
-                           q[len] != '\r' && q[len] != '/') len++;
+                    while (q + len < eol && len < sizeof buf - 1 && q[len] != ' ' && q[len] != '\t' && q[len] != '\r' &&
+                           q[len] != '/')
+                        len++;
                     memcpy(buf, q, len);
                     buf[len] = 0;
                     char *stop;
                     errno = 0;
                     long idx = strtol(buf, &stop, 10);
-                    if (len == 0 || *stop || errno) 
-                        return mk_error_set(err, MK_ERROR_PARSE, (uint64_t)(q - text),
-                                            "%s:%zu: bad face index", path, line_no);
+                    if (len == 0 || *stop || errno)
+                        return mk_error_set(err, MK_ERROR_PARSE, (uint64_t)(q - text), "%s:%zu: bad face index", path,
+                                            line_no);
                     /* skip "/t/n" */
                     while (q < eol && *q != ' ' && *q != '\t' && *q != '\r') q++;
                     long resolved = idx > 0 ? idx - 1 : (long)iv + idx;
                     if (idx == 0 || resolved < 0 || (pass == 1 && (size_t)resolved >= nv) ||
                         (pass == 0 && (size_t)resolved >= iv))
-                        return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX,
-                                            "%s:%zu: face index %ld is out of range", path, line_no, idx);
+                        return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%s:%zu: face index %ld is out of range",
+                                            path, line_no, idx);
                     uint32_t cur = (uint32_t)resolved;
-                    if (corners == 0) first = cur;
+                    if (corners == 0)
+                        first = cur;
                     else if (corners >= 2) {
                         /* fan triangulation */
-                        if (pass == 1) { t[3 * it] = first; t[3 * it + 1] = prev; t[3 * it + 2] = cur; }
+                        if (pass == 1) {
+                            t[3 * it] = first;
+                            t[3 * it + 1] = prev;
+                            t[3 * it + 2] = cur;
+                        }
                         it++;
                     }
                     prev = cur;
                     corners++;
                 }
                 if (corners < 3)
-                    return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%s:%zu: face with fewer than 3 corners", path, line_no);
+                    return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%s:%zu: face with fewer than 3 corners", path,
+                                        line_no);
             }
             p = eol < end ? eol + 1 : end;
         }

@@ -34,4 +34,7 @@ mk_result pb_asset_load(const char *path, const mk_import_options *import, const
     return r != MK_OK ? r : pb_asset_open_raw(out, write, err);
 }
 
-void pb_asset_free(pb_asset *a) { mk_raw_free(&a->raw); }
+void pb_asset_free(pb_asset *a)
+{
+    mk_raw_free(&a->raw);
+}

@@ -11,7 +11,7 @@
 static double float32_half_ulp(double x)
 {
     int exponent;
-    frexp(fabs(x), &exponent);  /* 2^(exponent-1) <= |x| < 2^exponent */
+    frexp(fabs(x), &exponent); /* 2^(exponent-1) <= |x| < 2^exponent */
     return x != 0 ? ldexp(1.0, exponent - 25) : 0.0;
 }
 
@@ -19,7 +19,8 @@ static double max_column_norm(const float *w)
 {
     double m = 0;
     for (int c = 0; c < 3; c++) {
-        double s = sqrt((double)w[4 * c] * w[4 * c] + (double)w[4 * c + 1] * w[4 * c + 1] + (double)w[4 * c + 2] * w[4 * c + 2]);
+        double s = sqrt((double)w[4 * c] * w[4 * c] + (double)w[4 * c + 1] * w[4 * c + 1] +
+                        (double)w[4 * c + 2] * w[4 * c + 2]);
         if (s > m) m = s;
     }
     return m;
@@ -48,8 +49,8 @@ mk_result pb_conform_weights(const pb_case *c, const pb_frame_spec *f, const mk_
     int32_t clip = -1;
     if (f->has_time && !f->forced) clip = f->clip >= 0 ? f->clip : !c->gltf && a->clip_count ? 0 : -1;
     if (clip >= (int32_t)a->clip_count)
-        return mk_error_set(err, MK_ERROR_OUT_OF_RANGE, UINT64_MAX, "the frame needs clip %d, the import has %u clips", clip,
-                            a->clip_count);
+        return mk_error_set(err, MK_ERROR_OUT_OF_RANGE, UINT64_MAX, "the frame needs clip %d, the import has %u clips",
+                            clip, a->clip_count);
     return pb_frame_weights(a, clip, f->has_time ? f->time : 0.0, weights, err);
 }
 
@@ -75,8 +76,8 @@ typedef struct frame_state {
     const pb_frame_spec *f;
     const mk_asset *a;
     float *weights;
-    double quantization, largest;       /* the largest allowance terms over the compared meshes */
-    double lo[3], hi[3];                /* reference bounds over the compared points */
+    double quantization, largest; /* the largest allowance terms over the compared meshes */
+    double lo[3], hi[3];          /* reference bounds over the compared points */
     pb_frame_result *res;
 } frame_state;
 
@@ -92,13 +93,13 @@ static void compare_mesh(frame_state *s, uint32_t mi, const pb_ref_mesh *rm)
         s->weights[m.first_channel + k] = (float)s->f->forced[k];
     if (rm->weights && rm->weight_count) {
         if (rm->weight_count != m.channel_count) {
-            snprintf(res->failure, sizeof res->failure, "mesh '%.100s': the reference has %u channels, the import %u", m.name,
-                     rm->weight_count, m.channel_count);
+            snprintf(res->failure, sizeof res->failure, "mesh '%.100s': the reference has %u channels, the import %u",
+                     m.name, rm->weight_count, m.channel_count);
             return;
         }
         for (uint32_t k = 0; k < m.channel_count; k++) {
             double e = fabs((double)s->weights[m.first_channel + k] - rm->weights[k]);
-            if (!(e <= res->weight_error)) res->weight_error = e;   /* NaN fails closed */
+            if (!(e <= res->weight_error)) res->weight_error = e; /* NaN fails closed */
         }
         res->weights_compared = 1;
     }
@@ -108,7 +109,8 @@ static void compare_mesh(frame_state *s, uint32_t mi, const pb_ref_mesh *rm)
                  rm->point_count, s->c->by_control_point ? "control points" : "vertices", expected);
         return;
     }
-    float *pos = malloc(12u * (size_t)m.vertex_count + 12), *nrm = m.has_normals ? malloc(12u * (size_t)m.vertex_count + 12) : NULL;
+    float *pos = malloc(12u * (size_t)m.vertex_count + 12),
+          *nrm = m.has_normals ? malloc(12u * (size_t)m.vertex_count + 12) : NULL;
     mk_error err;
     if (!pos || (m.has_normals && !nrm)) {
         snprintf(res->failure, sizeof res->failure, "out of memory");
@@ -122,7 +124,7 @@ static void compare_mesh(frame_state *s, uint32_t mi, const pb_ref_mesh *rm)
             uint32_t r = s->c->by_control_point ? m.control_points[v] : v;
             for (int d = 0; d < 3; d++) {
                 double ref = rm->positions[3 * r + (uint32_t)d], e = fabs((double)pos[3 * v + (uint32_t)d] - ref);
-                if (!(e <= res->position_error)) res->position_error = e;   /* NaN propagates as failure */
+                if (!(e <= res->position_error)) res->position_error = e; /* NaN propagates as failure */
                 if (fabs(ref) > s->largest) s->largest = fabs(ref);
                 if (ref < s->lo[d]) s->lo[d] = ref;
                 if (ref > s->hi[d]) s->hi[d] = ref;
@@ -132,11 +134,11 @@ static void compare_mesh(frame_state *s, uint32_t mi, const pb_ref_mesh *rm)
             const float *n = &nrm[3 * v];
             double rl = sqrt(rn[0] * rn[0] + rn[1] * rn[1] + rn[2] * rn[2]);
             double nl = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-            if (rl <= 1e-12) continue;   /* the reference has no direction here */
+            if (rl <= 1e-12) continue; /* the reference has no direction here */
             double dot = (n[0] * rn[0] + n[1] * rn[1] + n[2] * rn[2]) / (rl * nl);
             dot = dot > 1 ? 1 : dot < -1 ? -1 : dot;
             double angle = acos(dot) * (180.0 / 3.14159265358979323846);
-            if (!(angle <= res->normal_error_deg)) res->normal_error_deg = angle;   /* NaN fails closed */
+            if (!(angle <= res->normal_error_deg)) res->normal_error_deg = angle; /* NaN fails closed */
             res->normals_compared = 1;
         }
         res->meshes_compared++;
@@ -154,9 +156,14 @@ void pb_conform_frame(const pb_manifest *manifest, const pb_case *c, const pb_fr
     double normal_tolerance = o->normal_tolerance_deg > 0 ? o->normal_tolerance_deg : 1.0;
     double weight_tolerance = o->weight_tolerance > 0 ? o->weight_tolerance : 1e-5;
     const mk_asset *a = &loaded->asset;
-    frame_state s = { c, o, f, a, NULL, 0, 0, { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY }, res };
+    frame_state s = {
+        c, o, f, a, NULL, 0, 0, { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY }, res
+    };
     s.weights = calloc(a->channel_count + 1u, sizeof(float));
-    if (!s.weights) { snprintf(res->failure, sizeof res->failure, "out of memory"); return; }
+    if (!s.weights) {
+        snprintf(res->failure, sizeof res->failure, "out of memory");
+        return;
+    }
     mk_error err;
     char path[4200];
     pb_manifest_path(manifest, f->file, path, sizeof path);
@@ -174,11 +181,14 @@ void pb_conform_frame(const pb_manifest *manifest, const pb_case *c, const pb_fr
         for (uint32_t i = 0; i < a->mesh_count; i++) {
             mk_mesh_info m;
             mk_mesh_get(a, i, &m);
-            if (m.channel_count) { only = (int32_t)i; with_channels++; }
+            if (m.channel_count) {
+                only = (int32_t)i;
+                with_channels++;
+            }
         }
         if (with_channels != 1)
-            snprintf(res->failure, sizeof res->failure, "an OBJ reference needs exactly one mesh with channels; the import has %d",
-                     with_channels);
+            snprintf(res->failure, sizeof res->failure,
+                     "an OBJ reference needs exactly one mesh with channels; the import has %d", with_channels);
         else
             compare_mesh(&s, (uint32_t)only, &ref.meshes[0]);
     } else {
@@ -188,8 +198,11 @@ void pb_conform_frame(const pb_manifest *manifest, const pb_case *c, const pb_fr
              * scenes (node animation, skinning), and such a mesh is not imported by default. */
             if (!rm->has_channels) continue;
             int mi = find_mesh(a, rm);
-            if (mi < 0) snprintf(res->failure, sizeof res->failure, "reference mesh '%.200s' with channels is not in the import", rm->label);
-            else compare_mesh(&s, (uint32_t)mi, rm);
+            if (mi < 0)
+                snprintf(res->failure, sizeof res->failure,
+                         "reference mesh '%.200s' with channels is not in the import", rm->label);
+            else
+                compare_mesh(&s, (uint32_t)mi, rm);
         }
         if (!res->failure[0] && res->meshes_compared == 0)
             snprintf(res->failure, sizeof res->failure, "no reference mesh with channels matched the import");
@@ -199,16 +212,19 @@ void pb_conform_frame(const pb_manifest *manifest, const pb_case *c, const pb_fr
     double rounding = float32_half_ulp(s.largest);
     res->allowed = c->tolerance + s.quantization + rounding;
     if (c->relative_tolerance > 0 && res->meshes_compared) {
-        double diagonal = sqrt((s.hi[0] - s.lo[0]) * (s.hi[0] - s.lo[0]) + (s.hi[1] - s.lo[1]) * (s.hi[1] - s.lo[1])
-                               + (s.hi[2] - s.lo[2]) * (s.hi[2] - s.lo[2]));
+        double diagonal = sqrt((s.hi[0] - s.lo[0]) * (s.hi[0] - s.lo[0]) + (s.hi[1] - s.lo[1]) * (s.hi[1] - s.lo[1]) +
+                               (s.hi[2] - s.lo[2]) * (s.hi[2] - s.lo[2]));
         res->reference_size = c->relative_to_largest ? s.largest : diagonal;
         res->relative_allowed = c->relative_tolerance * res->reference_size + s.quantization + rounding;
     }
     if (res->failure[0]) return;
     int other_ok = res->normal_error_deg <= normal_tolerance && res->weight_error <= weight_tolerance;
     if (!other_ok) return;
-    if (c->tolerance > 0 && res->position_error <= res->allowed) res->passed_by = "tolerance";
-    else if (c->relative_tolerance > 0 && res->position_error <= res->relative_allowed) res->passed_by = "relative_tolerance";
-    else if (c->tolerance == 0 && c->relative_tolerance == 0 && res->position_error <= res->allowed) res->passed_by = "tolerance";
+    if (c->tolerance > 0 && res->position_error <= res->allowed)
+        res->passed_by = "tolerance";
+    else if (c->relative_tolerance > 0 && res->position_error <= res->relative_allowed)
+        res->passed_by = "relative_tolerance";
+    else if (c->tolerance == 0 && c->relative_tolerance == 0 && res->position_error <= res->allowed)
+        res->passed_by = "tolerance";
     res->passed = res->passed_by != NULL;
 }

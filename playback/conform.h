@@ -8,23 +8,23 @@
 #include "manifest.h"
 
 typedef struct pb_conform_options {
-    mk_stacking stacking;          /* 0: each mesh's stored stacking */
-    mk_normal_mode normal_mode;    /* default nlerp */
-    double normal_tolerance_deg;   /* largest normal angle; 0 means 1 degree */
-    double weight_tolerance;       /* largest |weight - reference weight|; 0 means 1e-5 */
+    mk_stacking stacking;        /* 0: each mesh's stored stacking */
+    mk_normal_mode normal_mode;  /* default nlerp */
+    double normal_tolerance_deg; /* largest normal angle; 0 means 1 degree */
+    double weight_tolerance;     /* largest |weight - reference weight|; 0 means 1e-5 */
 } pb_conform_options;
 
 typedef struct pb_frame_result {
-    double position_error;         /* largest |coordinate - reference| over the compared meshes */
-    double allowed;                /* the absolute allowance: case tolerance + quantization + float32 rounding */
-    double relative_allowed;       /* relative_tolerance x size + quantization + rounding (0: none) */
-    double reference_size;         /* the size the relative tolerance refers to */
-    double normal_error_deg;       /* largest angle to the reference's normals */
-    double weight_error;           /* largest |sampled weight - reference weight| */
+    double position_error;   /* largest |coordinate - reference| over the compared meshes */
+    double allowed;          /* the absolute allowance: case tolerance + quantization + float32 rounding */
+    double relative_allowed; /* relative_tolerance x size + quantization + rounding (0: none) */
+    double reference_size;   /* the size the relative tolerance refers to */
+    double normal_error_deg; /* largest angle to the reference's normals */
+    double weight_error;     /* largest |sampled weight - reference weight| */
     int normals_compared, weights_compared, meshes_compared;
     int passed;
-    const char *passed_by;         /* "tolerance", "relative_tolerance" or NULL */
-    char failure[512];             /* why the frame could not be compared (empty when it was) */
+    const char *passed_by; /* "tolerance", "relative_tolerance" or NULL */
+    char failure[512];     /* why the frame could not be compared (empty when it was) */
 } pb_frame_result;
 
 /* Checks frame f of case c (of manifest m) against asset a (the case's source, loaded with
@@ -34,6 +34,7 @@ void pb_conform_frame(const pb_manifest *m, const pb_case *c, const pb_frame_spe
 
 /* The weights a frame plays with: the static state (channel defaults) for "time": null or
  * forced weights, else the frame's clip (the first for FBX) at its time. */
-mk_result pb_conform_weights(const pb_case *c, const pb_frame_spec *f, const mk_asset *a, float *weights, mk_error *err);
+mk_result pb_conform_weights(const pb_case *c, const pb_frame_spec *f, const mk_asset *a, float *weights,
+                             mk_error *err);
 
 #endif

@@ -11,34 +11,43 @@ mk_result pb_frame_weights(const mk_asset *asset, int32_t clip, double time, flo
         weights[c] = info.default_weight;
     }
     if (clip < 0) return MK_OK;
-    mk_sample_job job = { .asset = asset, .clip = (uint32_t)clip, .time = time, .weights = weights,
-                          .weight_count = asset->channel_count };
+    mk_sample_job job = {
+        .asset = asset, .clip = (uint32_t)clip, .time = time, .weights = weights, .weight_count = asset->channel_count
+    };
     return mk_sample_run(&job, err);
 }
 
 mk_result pb_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
-                          mk_normal_mode normals_mode, float *positions, float *normals, mk_error *err)
+                       mk_normal_mode normals_mode, float *positions, float *normals, mk_error *err)
 {
     mk_mesh_info m;
     if (!mk_mesh_get(asset, mesh, &m))
-        return mk_error_set(err, MK_ERROR_OUT_OF_RANGE, UINT64_MAX, "mesh %u does not exist (%u meshes)", mesh, asset->mesh_count);
+        return mk_error_set(err, MK_ERROR_OUT_OF_RANGE, UINT64_MAX, "mesh %u does not exist (%u meshes)", mesh,
+                            asset->mesh_count);
     size_t scratch_size = mk_eval_scratch_size(asset, mesh);
-    void *scratch = aligned_alloc(16, (scratch_size + 31) & ~(size_t)15);   /* never 0 bytes */
+    void *scratch = aligned_alloc(16, (scratch_size + 31) & ~(size_t)15); /* never 0 bytes */
     if (!scratch) return mk_error_oom(err, "evaluation scratch");
     mk_eval_job job = {
-        .asset = asset, .mesh = mesh, .vertex_count = MK_VERTICES_TO_END,
-        .weights = weights + m.first_channel, .weight_count = m.channel_count,
-        .stacking = stacking, .normal_mode = normals_mode, .scratch = scratch, .scratch_size = scratch_size,
-        .positions = positions, .positions_size = (size_t)m.vertex_count * 12,
-        .normals = m.has_normals ? normals : NULL, .normals_size = (size_t)m.vertex_count * 12,
+        .asset = asset,
+        .mesh = mesh,
+        .vertex_count = MK_VERTICES_TO_END,
+        .weights = weights + m.first_channel,
+        .weight_count = m.channel_count,
+        .stacking = stacking,
+        .normal_mode = normals_mode,
+        .scratch = scratch,
+        .scratch_size = scratch_size,
+        .positions = positions,
+        .positions_size = (size_t)m.vertex_count * 12,
+        .normals = m.has_normals ? normals : NULL,
+        .normals_size = (size_t)m.vertex_count * 12,
     };
     mk_result r = mk_eval_run(&job, err);
     free(scratch);
     return r;
 }
 
-void pb_channel_span(const mk_asset *asset, uint32_t channel, float w, int32_t *ia, float *ca, int32_t *ib,
-                        float *cb)
+void pb_channel_span(const mk_asset *asset, uint32_t channel, float w, int32_t *ia, float *ca, int32_t *ib, float *cb)
 {
     mk_channel_info ch;
     mk_channel_get(asset, channel, &ch);
@@ -59,9 +68,8 @@ void pb_to_world(const float w[16], float *positions, float *normals, uint32_t c
     double a = w[0], b = w[4], c = w[8], d = w[1], e = w[5], f = w[9], g = w[2], h = w[6], i = w[10];
     double det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
     /* Cofactor matrix = det * (M^-1)^T: normals only need its direction. */
-    double cof[9] = { e * i - f * h, -(d * i - f * g), d * h - e * g,
-                      -(b * i - c * h), a * i - c * g, -(a * h - b * g),
-                      b * f - c * e, -(a * f - c * d), a * e - b * d };
+    double cof[9] = { e * i - f * h,    -(d * i - f * g), d * h - e * g,    -(b * i - c * h), a * i - c * g,
+                      -(a * h - b * g), b * f - c * e,    -(a * f - c * d), a * e - b * d };
     double sign = det < 0 ? -1.0 : 1.0;
     for (uint32_t v = 0; v < count; v++) {
         float *p = &positions[3u * v];
@@ -76,6 +84,10 @@ void pb_to_world(const float w[16], float *positions, float *normals, uint32_t c
         double oy = sign * (cof[3] * nx + cof[4] * ny + cof[5] * nz);
         double oz = sign * (cof[6] * nx + cof[7] * ny + cof[8] * nz);
         double len = sqrt(ox * ox + oy * oy + oz * oz);
-        if (len > 0) { n[0] = (float)(ox / len); n[1] = (float)(oy / len); n[2] = (float)(oz / len); }
+        if (len > 0) {
+            n[0] = (float)(ox / len);
+            n[1] = (float)(oy / len);
+            n[2] = (float)(oz / len);
+        }
     }
 }

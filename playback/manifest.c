@@ -30,8 +30,10 @@ static mk_result read_frame(pb_manifest *m, const char *path, const char *where,
                             mk_error *err)
 {
     if (!cJSON_IsObject(j)) return field_error(err, path, where, "a frame must be an object");
-    const cJSON *time = cJSON_GetObjectItemCaseSensitive(j, "time"), *clip = cJSON_GetObjectItemCaseSensitive(j, "clip"),
-                *weights = cJSON_GetObjectItemCaseSensitive(j, "weights"), *file = cJSON_GetObjectItemCaseSensitive(j, "file");
+    const cJSON *time = cJSON_GetObjectItemCaseSensitive(j, "time"),
+                *clip = cJSON_GetObjectItemCaseSensitive(j, "clip"),
+                *weights = cJSON_GetObjectItemCaseSensitive(j, "weights"),
+                *file = cJSON_GetObjectItemCaseSensitive(j, "file");
     char w[320];
     if (!cJSON_IsString(file) || !file->valuestring[0])
         return field_error(err, path, where, "\"file\" must name the reference frame");
@@ -46,8 +48,8 @@ static mk_result read_frame(pb_manifest *m, const char *path, const char *where,
         f->time = time->valuedouble;
     }
     if (clip) {
-        if (!cJSON_IsNumber(clip) || clip->valuedouble < 0 || clip->valuedouble != floor(clip->valuedouble)
-            || clip->valuedouble > 1e6) {
+        if (!cJSON_IsNumber(clip) || clip->valuedouble < 0 || clip->valuedouble != floor(clip->valuedouble) ||
+            clip->valuedouble > 1e6) {
             snprintf(w, sizeof w, "%.280s.clip", where);
             return field_error(err, path, w, "must be an animation index (0, 1, ...)");
         }
@@ -60,8 +62,10 @@ static mk_result read_frame(pb_manifest *m, const char *path, const char *where,
         f->forced = mk_arena_array(&m->arena, (size_t)n + 1, sizeof(double));
         if (!f->forced) return mk_error_oom(err, "manifest");
         const cJSON *e;
-        cJSON_ArrayForEach(e, weights) {
-            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) return field_error(err, path, w, "must hold finite numbers");
+        cJSON_ArrayForEach(e, weights)
+        {
+            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble))
+                return field_error(err, path, w, "must hold finite numbers");
             f->forced[f->forced_count++] = e->valuedouble;
         }
     }
@@ -77,7 +81,8 @@ static mk_result read_case(pb_manifest *m, const char *path, uint32_t index, con
     if (!cJSON_IsObject(j)) return field_error(err, path, where, "a case must be an object");
     if (!cJSON_IsString(name) || !name->valuestring[0]) return field_error(err, path, where, "needs a \"name\"");
     const cJSON *source = cJSON_GetObjectItemCaseSensitive(j, "source");
-    if (!cJSON_IsString(source) || !source->valuestring[0]) return field_error(err, path, where, "needs a \"source\" file");
+    if (!cJSON_IsString(source) || !source->valuestring[0])
+        return field_error(err, path, where, "needs a \"source\" file");
     static const char *const formats[] = { "fbx", "gltf" };
     int format = choice(cJSON_GetObjectItemCaseSensitive(j, "format"), formats, 2);
     if (format < 0) return field_error(err, path, where, "\"format\" must be fbx or gltf");
@@ -107,7 +112,10 @@ static mk_result read_case(pb_manifest *m, const char *path, uint32_t index, con
     c->name = dup_string(m, name);
     c->source = dup_string(m, source);
     c->gltf = format == 1;
-    c->kind = kind == 0 ? PB_REF_UFBX_JSON : kind == 1 ? PB_REF_THREE_JSON : kind == 2 ? PB_REF_MORPHKIT_JSON : PB_REF_OBJ;
+    c->kind = kind == 0   ? PB_REF_UFBX_JSON
+              : kind == 1 ? PB_REF_THREE_JSON
+              : kind == 2 ? PB_REF_MORPHKIT_JSON
+                          : PB_REF_OBJ;
     c->world = space == 1;
     c->by_control_point = match == 1;
     c->tolerance = tol ? tol->valuedouble : 0;
@@ -116,11 +124,13 @@ static mk_result read_case(pb_manifest *m, const char *path, uint32_t index, con
     if (!c->name || !c->source) return mk_error_oom(err, "manifest");
     const cJSON *frames = cJSON_GetObjectItemCaseSensitive(j, "frames");
     snprintf(w, sizeof w, "%.250s.frames", where);
-    if (!cJSON_IsArray(frames) || cJSON_GetArraySize(frames) == 0) return field_error(err, path, w, "must be a non-empty array");
+    if (!cJSON_IsArray(frames) || cJSON_GetArraySize(frames) == 0)
+        return field_error(err, path, w, "must be a non-empty array");
     c->frames = mk_arena_array(&m->arena, (size_t)cJSON_GetArraySize(frames), sizeof(pb_frame_spec));
     if (!c->frames) return mk_error_oom(err, "manifest");
     const cJSON *f;
-    cJSON_ArrayForEach(f, frames) {
+    cJSON_ArrayForEach(f, frames)
+    {
         snprintf(w, sizeof w, "%.250s.frames[%u]", where, c->frame_count);
         mk_result r = read_frame(m, path, w, f, &c->frames[c->frame_count], err);
         if (r != MK_OK) return r;
@@ -135,7 +145,10 @@ mk_result pb_manifest_read(const char *path, pb_manifest *out, mk_error *err)
     mk_arena_init(&out->arena, NULL);
     snprintf(out->base_dir, sizeof out->base_dir, "%s", path);
     char *slash = strrchr(out->base_dir, '/');
-    if (slash) *slash = 0; else strcpy(out->base_dir, ".");
+    if (slash)
+        *slash = 0;
+    else
+        strcpy(out->base_dir, ".");
     void *text;
     size_t size;
     mk_result r = mk_read_file(&out->arena, path, MANIFEST_MAX_BYTES, &text, &size, err);
@@ -144,7 +157,8 @@ mk_result pb_manifest_read(const char *path, pb_manifest *out, mk_error *err)
     cJSON *root = cJSON_ParseWithLengthOpts(text, size, &end, 0);
     if (!root)
         return mk_error_set(err, MK_ERROR_PARSE, end ? (uint64_t)(end - (const char *)text) : 0,
-                            "%.200s: not JSON (parse error at byte %zu)", path, end ? (size_t)(end - (const char *)text) : (size_t)0);
+                            "%.200s: not JSON (parse error at byte %zu)", path,
+                            end ? (size_t)(end - (const char *)text) : (size_t)0);
     const cJSON *cases = cJSON_GetObjectItemCaseSensitive(root, "cases");
     if (!cJSON_IsObject(root) || !cJSON_IsArray(cases)) {
         cJSON_Delete(root);
@@ -154,7 +168,8 @@ mk_result pb_manifest_read(const char *path, pb_manifest *out, mk_error *err)
     out->cases = mk_arena_array(&out->arena, (size_t)cJSON_GetArraySize(cases) + 1, sizeof(pb_case));
     if (!out->cases) r = mk_error_oom(err, "manifest");
     const cJSON *c;
-    cJSON_ArrayForEach(c, cases) {
+    cJSON_ArrayForEach(c, cases)
+    {
         if (r != MK_OK) break;
         r = read_case(out, path, out->case_count, c, &out->cases[out->case_count], err);
         if (r == MK_OK) out->case_count++;
@@ -164,12 +179,17 @@ mk_result pb_manifest_read(const char *path, pb_manifest *out, mk_error *err)
     return r;
 }
 
-void pb_manifest_free(pb_manifest *m) { mk_arena_free_all(&m->arena); }
+void pb_manifest_free(pb_manifest *m)
+{
+    mk_arena_free_all(&m->arena);
+}
 
 void pb_manifest_path(const pb_manifest *m, const char *path, char *out, size_t size)
 {
-    if (path[0] == '/') snprintf(out, size, "%s", path);
-    else snprintf(out, size, "%s/%s", m->base_dir, path);
+    if (path[0] == '/')
+        snprintf(out, size, "%s", path);
+    else
+        snprintf(out, size, "%s/%s", m->base_dir, path);
 }
 
 const char *pb_frame_label(const pb_frame_spec *f)

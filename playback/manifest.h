@@ -23,12 +23,12 @@ typedef struct pb_frame_spec {
 
 typedef struct pb_case {
     const char *name;
-    const char *source;    /* relative to the manifest's folder unless absolute */
-    int gltf;              /* "format": "gltf" (else "fbx") */
+    const char *source; /* relative to the manifest's folder unless absolute */
+    int gltf;           /* "format": "gltf" (else "fbx") */
     pb_reference_kind kind;
-    int world;             /* "space": "world" (else "mesh-local") */
-    int by_control_point;  /* "match": "control_points" (else "vertices") */
-    double tolerance;      /* absolute, in the reference's units (0 when only relative) */
+    int world;                 /* "space": "world" (else "mesh-local") */
+    int by_control_point;      /* "match": "control_points" (else "vertices") */
+    double tolerance;          /* absolute, in the reference's units (0 when only relative) */
     double relative_tolerance; /* times the reference's size (0: none); a frame passes within
                                 * either tolerance */
     int relative_to_largest;   /* the size is the largest |coordinate| (else the bounding-box diagonal) */
@@ -37,8 +37,8 @@ typedef struct pb_case {
 } pb_case;
 
 typedef struct pb_manifest {
-    mk_arena arena;        /* owns everything below */
-    char base_dir[4096];   /* folder the manifest's paths are relative to */
+    mk_arena arena;      /* owns everything below */
+    char base_dir[4096]; /* folder the manifest's paths are relative to */
     uint32_t case_count;
     pb_case *cases;
 } pb_manifest;

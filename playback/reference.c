@@ -17,14 +17,17 @@ static mk_result number_array(pb_reference *r, const cJSON *array, const char *p
     *count = 0;
     if (!array || cJSON_IsNull(array)) return MK_OK;
     int n = cJSON_GetArraySize(array);
-    if (!cJSON_IsArray(array)) return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%.200s: %s must be an array", path, what);
+    if (!cJSON_IsArray(array))
+        return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%.200s: %s must be an array", path, what);
     double *p = mk_arena_array(&r->arena, (size_t)n + 1, sizeof(double));
     if (!p) return mk_error_oom(err, "reference frame");
     uint32_t i = 0;
     const cJSON *e;
-    cJSON_ArrayForEach(e, array) {
+    cJSON_ArrayForEach(e, array)
+    {
         if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble))
-            return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%.200s: %s[%u] is not a finite number", path, what, i);
+            return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%.200s: %s[%u] is not a finite number", path, what,
+                                i);
         p[i++] = e->valuedouble;
     }
     *out = p;
@@ -73,7 +76,8 @@ static mk_result read_json_mesh(pb_reference *r, const char *path, pb_reference_
         m->weights = mk_arena_array(&r->arena, (size_t)n + 1, sizeof(double));
         if (!m->weights) return mk_error_oom(err, "reference frame");
         const cJSON *c;
-        cJSON_ArrayForEach(c, channels) {
+        cJSON_ArrayForEach(c, channels)
+        {
             const cJSON *w = cJSON_GetObjectItemCaseSensitive(c, "weight");
             m->weights[m->weight_count++] = cJSON_IsNumber(w) ? w->valuedouble : NAN;
         }
@@ -82,16 +86,19 @@ static mk_result read_json_mesh(pb_reference *r, const char *path, pb_reference_
     if (res != MK_OK) return res;
     uint32_t count, ncount;
     snprintf(what, sizeof what, "meshes[%u].positions", index);
-    if ((res = number_array(r, cJSON_GetObjectItemCaseSensitive(j, "positions"), path, what, &m->positions, &count, err)) != MK_OK)
+    if ((res = number_array(r, cJSON_GetObjectItemCaseSensitive(j, "positions"), path, what, &m->positions, &count,
+                            err)) != MK_OK)
         return res;
     if (!m->positions || count % 3)
         return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%.200s: %s must hold 3 numbers per point", path, what);
     m->point_count = count / 3;
     snprintf(what, sizeof what, "meshes[%u].normals", index);
-    if ((res = number_array(r, cJSON_GetObjectItemCaseSensitive(j, "normals"), path, what, &m->normals, &ncount, err)) != MK_OK)
+    if ((res = number_array(r, cJSON_GetObjectItemCaseSensitive(j, "normals"), path, what, &m->normals, &ncount,
+                            err)) != MK_OK)
         return res;
     if (m->normals && ncount != count)
-        return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%.200s: %s has %u numbers, positions %u", path, what, ncount, count);
+        return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%.200s: %s has %u numbers, positions %u", path, what,
+                            ncount, count);
     return MK_OK;
 }
 
@@ -106,7 +113,7 @@ static mk_result read_obj(pb_reference *r, const char *path, mk_error *err)
     r->mesh_count = 1;
     m->label = "obj";
     m->gltf_node = m->gltf_mesh = m->gltf_primitive = -1;
-    m->has_channels = 1;  /* an OBJ frame is of the mesh with channels */
+    m->has_channels = 1; /* an OBJ frame is of the mesh with channels */
     m->positions = obj.positions;
     m->normals = obj.normals;
     m->point_count = obj.vertex_count;
@@ -130,12 +137,14 @@ mk_result pb_reference_read(const char *path, pb_reference_kind kind, pb_referen
     const cJSON *meshes = cJSON_GetObjectItemCaseSensitive(root, "meshes");
     if (!cJSON_IsArray(meshes)) {
         cJSON_Delete(root);
-        return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%.200s: not a reference frame (no \"meshes\" array)", path);
+        return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%.200s: not a reference frame (no \"meshes\" array)",
+                            path);
     }
     out->meshes = mk_arena_array(&out->arena, (size_t)cJSON_GetArraySize(meshes) + 1, sizeof(pb_ref_mesh));
     if (!out->meshes) r = mk_error_oom(err, "reference frame");
     const cJSON *m;
-    cJSON_ArrayForEach(m, meshes) {
+    cJSON_ArrayForEach(m, meshes)
+    {
         if (r != MK_OK) break;
         r = read_json_mesh(out, path, kind, out->mesh_count, m, &out->meshes[out->mesh_count], err);
         out->mesh_count++;
@@ -144,4 +153,7 @@ mk_result pb_reference_read(const char *path, pb_reference_kind kind, pb_referen
     return r;
 }
 
-void pb_reference_free(pb_reference *r) { mk_arena_free_all(&r->arena); }
+void pb_reference_free(pb_reference *r)
+{
+    mk_arena_free_all(&r->arena);
+}

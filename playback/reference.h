@@ -7,15 +7,15 @@
 #include "manifest.h"
 
 typedef struct pb_ref_mesh {
-    const char *label;          /* for reports */
-    const char *node;           /* FBX model / node name, or NULL */
+    const char *label;                            /* for reports */
+    const char *node;                             /* FBX model / node name, or NULL */
     int32_t gltf_node, gltf_mesh, gltf_primitive; /* -1 when not given */
-    int has_channels;           /* the reference lists channels (or weights) for this mesh */
-    uint32_t weight_count;      /* the channel weights the reference evaluated with */
+    int has_channels;                             /* the reference lists channels (or weights) for this mesh */
+    uint32_t weight_count;                        /* the channel weights the reference evaluated with */
     double *weights;
-    uint32_t point_count;       /* positions: 3 doubles per point */
+    uint32_t point_count; /* positions: 3 doubles per point */
     double *positions;
-    double *normals;            /* 3 per point, or NULL; directions (need not be unit) */
+    double *normals; /* 3 per point, or NULL; directions (need not be unit) */
 } pb_ref_mesh;
 
 typedef struct pb_reference {

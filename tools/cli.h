@@ -8,8 +8,8 @@
 #include "cli_args.h"
 #include "import.h"
 
-extern const cli_verb cli_verb_import, cli_verb_info, cli_verb_play, cli_verb_bake, cli_verb_export,
-    cli_verb_conform, cli_verb_bench;
+extern const cli_verb cli_verb_import, cli_verb_info, cli_verb_play, cli_verb_bake, cli_verb_export, cli_verb_conform,
+    cli_verb_bench;
 
 /* Prints the warnings of a raw model to stderr ("warning: ..."); nothing when there are none. */
 void cli_print_warnings(const mk_raw_asset *raw);
@@ -30,8 +30,8 @@ typedef struct cli_output {
  * whose content is described by `what` ("a .morph blob"); the output must not be one of
  * the inputs. Returns -1 when fine, else the exit status after printing the error. */
 int cli_output_check(const cli_verb *verb, cli_output *out, const char *option, const char *path,
-                     const char *const *extensions, const char *what, int allow_stdout,
-                     const char *const *inputs, uint32_t input_count);
+                     const char *const *extensions, const char *what, int allow_stdout, const char *const *inputs,
+                     uint32_t input_count);
 /* Writes the outputs all or none (standard output last). Returns 0 or the exit status. */
 int cli_write_outputs(const cli_verb *verb, cli_output *outs, uint32_t count);
 

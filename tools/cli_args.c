@@ -53,11 +53,14 @@ static int store_value(const cli_verb *verb, const cli_option *o, const char *v,
         const char *p = v;
         while (*p >= '0' && *p <= '9') p++;
         if (*p || p == v)
-            return cli_usage_error(verb, "%s: \"%s\" is not a whole number (accepted: %.0f to %.0f)", o->name, v, o->min, o->max), -1;
+            return cli_usage_error(verb, "%s: \"%s\" is not a whole number (accepted: %.0f to %.0f)", o->name, v,
+                                   o->min, o->max),
+                   -1;
         errno = 0;
         unsigned long long x = strtoull(v, NULL, 10);
         if (errno == ERANGE || (double)x < o->min || (double)x > o->max)
-            return cli_usage_error(verb, "%s: %s is out of range (accepted: %.0f to %.0f)", o->name, v, o->min, o->max), -1;
+            return cli_usage_error(verb, "%s: %s is out of range (accepted: %.0f to %.0f)", o->name, v, o->min, o->max),
+                   -1;
         *(uint64_t *)(void *)at = x;
         return 0;
     }
@@ -66,7 +69,9 @@ static int store_value(const cli_verb *verb, const cli_option *o, const char *v,
         errno = 0;
         double x = strtod(v, &end);
         if (*end || end == v || !isfinite(x) || errno == ERANGE)
-            return cli_usage_error(verb, "%s: \"%s\" is not a finite number (accepted: %g to %g)", o->name, v, o->min, o->max), -1;
+            return cli_usage_error(verb, "%s: \"%s\" is not a finite number (accepted: %g to %g)", o->name, v, o->min,
+                                   o->max),
+                   -1;
         if (x < o->min || x > o->max)
             return cli_usage_error(verb, "%s: %s is out of range (accepted: %g to %g)", o->name, v, o->min, o->max), -1;
         *(double *)(void *)at = x;
@@ -162,7 +167,7 @@ static void print_wrapped(FILE *f, const char *text, int indent, int column, int
     fputc('\n', f);
 }
 
-#define HELP_WIDTH 96
+#define HELP_WIDTH  96
 #define HELP_COLUMN 26
 
 static void print_entry(FILE *f, const char *left, const char *text)
@@ -193,9 +198,10 @@ void cli_print_help(const cli_verb *verb, FILE *f)
         if (o->kind == CLI_CHOICE && n < (int)sizeof text)
             n += snprintf(text + n, sizeof text - (size_t)n, " One of %s.", o->choices);
         if ((o->kind == CLI_UINT || o->kind == CLI_NUMBER) && n < (int)sizeof text)
-            n += snprintf(text + n, sizeof text - (size_t)n, o->kind == CLI_UINT ? " Accepted: %.0f to %.0f." : " Accepted: %g to %g.",
-                          o->min, o->max);
-        if (o->fallback && n < (int)sizeof text) n += snprintf(text + n, sizeof text - (size_t)n, " Default: %s.", o->fallback);
+            n += snprintf(text + n, sizeof text - (size_t)n,
+                          o->kind == CLI_UINT ? " Accepted: %.0f to %.0f." : " Accepted: %g to %g.", o->min, o->max);
+        if (o->fallback && n < (int)sizeof text)
+            n += snprintf(text + n, sizeof text - (size_t)n, " Default: %s.", o->fallback);
         if (o->required && n < (int)sizeof text) snprintf(text + n, sizeof text - (size_t)n, " Required.");
         print_entry(f, left, text);
     }

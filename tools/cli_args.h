@@ -15,24 +15,24 @@
 enum { CLI_EXIT_OK = 0, CLI_EXIT_FAILURE = 1, CLI_EXIT_USAGE = 2 };
 
 typedef enum cli_kind {
-    CLI_FLAG,        /* no value; stores int 1 */
-    CLI_STRING,      /* stores const char * (non-empty) */
-    CLI_CHOICE,      /* one of `choices` ("a|b|c"); stores int index */
-    CLI_UINT,        /* whole number in [min, max]; stores uint64_t */
-    CLI_NUMBER       /* finite number in [min, max]; stores double */
+    CLI_FLAG,   /* no value; stores int 1 */
+    CLI_STRING, /* stores const char * (non-empty) */
+    CLI_CHOICE, /* one of `choices` ("a|b|c"); stores int index */
+    CLI_UINT,   /* whole number in [min, max]; stores uint64_t */
+    CLI_NUMBER  /* finite number in [min, max]; stores double */
 } cli_kind;
 
 typedef struct cli_option {
-    const char *name;        /* "--vertices", "-o" */
-    const char *value;       /* placeholder shown in help ("N"); NULL for flags */
+    const char *name;  /* "--vertices", "-o" */
+    const char *value; /* placeholder shown in help ("N"); NULL for flags */
     cli_kind kind;
-    size_t offset;           /* where the value goes in the verb's argument struct */
-    const char *help;        /* meaning, with its unit */
-    const char *fallback;    /* default, parsed like a given value before argv; NULL: none */
-    const char *choices;     /* CLI_CHOICE: "additive|sequential" */
-    double min, max;         /* CLI_UINT / CLI_NUMBER: accepted range, inclusive */
+    size_t offset;        /* where the value goes in the verb's argument struct */
+    const char *help;     /* meaning, with its unit */
+    const char *fallback; /* default, parsed like a given value before argv; NULL: none */
+    const char *choices;  /* CLI_CHOICE: "additive|sequential" */
+    double min, max;      /* CLI_UINT / CLI_NUMBER: accepted range, inclusive */
     int required;
-    size_t given_offset;     /* when nonzero: an int set to 1 where the option was given */
+    size_t given_offset; /* when nonzero: an int set to 1 where the option was given */
 } cli_option;
 
 typedef struct cli_verb {
@@ -46,7 +46,7 @@ typedef struct cli_verb {
     int positional_required;
     const cli_option *options;
     size_t option_count;
-    size_t args_size;        /* sizeof the verb's argument struct */
+    size_t args_size; /* sizeof the verb's argument struct */
     int (*run)(void *args);
 } cli_verb;
 

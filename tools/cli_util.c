@@ -18,13 +18,14 @@ int cli_fail(const char *verb, const mk_error *err)
 }
 
 int cli_output_check(const cli_verb *verb, cli_output *out, const char *option, const char *path,
-                     const char *const *extensions, const char *what, int allow_stdout,
-                     const char *const *inputs, uint32_t input_count)
+                     const char *const *extensions, const char *what, int allow_stdout, const char *const *inputs,
+                     uint32_t input_count)
 {
     memset(out, 0, sizeof *out);
     out->file.path = path;
     if (!strcmp(path, "-")) {
-        if (!allow_stdout) return cli_usage_error(verb, "%s -: %s cannot go to standard output; name a file", option, what);
+        if (!allow_stdout)
+            return cli_usage_error(verb, "%s -: %s cannot go to standard output; name a file", option, what);
         out->to_stdout = 1;
         return -1;
     }
@@ -36,7 +37,8 @@ int cli_output_check(const cli_verb *verb, cli_output *out, const char *option, 
     char list[128] = "";
     for (const char *const *e = extensions; *e; e++)
         snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", e == extensions ? "" : " or ", *e);
-    return cli_usage_error(verb, "%s %s: %s writes %s, so the name must end in %s", option, path, verb->name, what, list);
+    return cli_usage_error(verb, "%s %s: %s writes %s, so the name must end in %s", option, path, verb->name, what,
+                           list);
 }
 
 int cli_write_outputs(const cli_verb *verb, cli_output *outs, uint32_t count)
@@ -74,7 +76,7 @@ void cli_progress_init(cli_progress *p, int quiet)
 void cli_progress_update(cli_progress *p, const char *stage, double fraction)
 {
     if (!p->enabled) return;
-    if (fraction < 0) {  /* announce a stage that reports no fractions */
+    if (fraction < 0) { /* announce a stage that reports no fractions */
         fprintf(stderr, "  %s ...\n", stage);
         return;
     }

@@ -17,22 +17,32 @@ static const cli_option options[] = {
     { "--recipe", "RECIPE.json", CLI_STRING, offsetof(bake_args, recipe),
       "The bake recipe: which deformers make which channels (docs/baking.md). Paths in it are relative to its folder.",
       NULL, NULL, 0, 0, 1, 0 },
-    { "-o", "OUT.morph", CLI_STRING, offsetof(bake_args, output), "The blob to write (a path ending in .morph, or a device/FIFO).",
-      NULL, NULL, 0, 0, 1, 0 },
-    { "--precision", "P", CLI_CHOICE, offsetof(bake_args, precision), "How deltas are stored (as for 'morphkit import').", "q16",
-      "q16|float", 0, 0, 0, 0 },
+    { "-o", "OUT.morph", CLI_STRING, offsetof(bake_args, output),
+      "The blob to write (a path ending in .morph, or a device/FIFO).", NULL, NULL, 0, 0, 1, 0 },
+    { "--precision", "P", CLI_CHOICE, offsetof(bake_args, precision),
+      "How deltas are stored (as for 'morphkit import').", "q16", "q16|float", 0, 0, 0, 0 },
     { "--all-meshes", NULL, CLI_FLAG, offsetof(bake_args, all_meshes),
       "Also write meshes that end up without channels (by default they are left out).", NULL, NULL, 0, 0, 0, 0 },
-    { "--quiet", NULL, CLI_FLAG, offsetof(bake_args, quiet), "No progress lines and no solver details (results are still printed).",
-      NULL, NULL, 0, 0, 0, 0 },
+    { "--quiet", NULL, CLI_FLAG, offsetof(bake_args, quiet),
+      "No progress lines and no solver details (results are still printed).", NULL, NULL, 0, 0, 0, 0 },
 };
 
 const cli_verb cli_verb_bake = {
-    "bake", "IN --recipe RECIPE.json -o OUT.morph [options]", "bake deformers (FFD, bend, cage, Laplacian, ...) into channels",
-    "Reads IN (meshes with or without morph targets), applies the recipe's deformers and writes the asset with the baked "
-    "channels added, each with adaptive in-betweens placed so playback stays within the recipe's tolerance.",
-    "IN", "A .morph blob, or any file 'morphkit import' reads.", offsetof(bake_args, input), 1,
-    options, sizeof options / sizeof options[0], sizeof(bake_args), run_bake,
+    .name = "bake",
+    .usage = "IN --recipe RECIPE.json -o OUT.morph [options]",
+    .summary = "bake deformers (FFD, bend, cage, Laplacian, ...) into channels",
+    .description =
+        "Reads IN (meshes with or without morph targets), applies the recipe's deformers and writes the asset with the "
+        "baked "
+        "channels added, each with adaptive in-betweens placed so playback stays within the recipe's tolerance.",
+    .positional = "IN",
+    .positional_help = "A .morph blob, or any file 'morphkit import' reads.",
+    .positional_offset = offsetof(bake_args, input),
+    .positional_required = 1,
+    .options = options,
+    .option_count = sizeof options / sizeof options[0],
+    .args_size = sizeof(bake_args),
+    .run = run_bake,
 };
 
 typedef struct bake_ui {
@@ -51,24 +61,25 @@ static void on_channel(void *user, const mk_bake_channel_report *c)
     bake_ui *ui = user;
     printf("channel \"%s\" (%s, mesh %u): %u target%s, %u evaluations, playback error %.3g x diagonal%s, "
            "%u vertices moved, %.3f s\n",
-           c->name, c->op, c->mesh, c->targets, c->targets == 1 ? "" : "s", c->evaluations,
-           c->max_error, c->error_measured_on_grid ? "" : " (span midpoints)", c->moved_vertices,
-           c->seconds);
+           c->name, c->op, c->mesh, c->targets, c->targets == 1 ? "" : "s", c->evaluations, c->max_error,
+           c->error_measured_on_grid ? "" : " (span midpoints)", c->moved_vertices, c->seconds);
     if (c->factorizations && !ui->quiet)
-        printf("  solver: %u factorization (%.3f s), %u solves (%.4f s each)\n", c->factorizations,
-               c->factor_seconds, c->solves, c->solves ? c->solve_seconds / c->solves : 0.0);
+        printf("  solver: %u factorization (%.3f s), %u solves (%.4f s each)\n", c->factorizations, c->factor_seconds,
+               c->solves, c->solves ? c->solve_seconds / c->solves : 0.0);
     if (c->inverted_vertices)
-        printf("  %u vertices fold (det J <= 0): normals taken from the deformed surface\n",
-               c->inverted_vertices);
+        printf("  %u vertices fold (det J <= 0): normals taken from the deformed surface\n", c->inverted_vertices);
 }
 
 /* Directory part of a path ("" for a bare file name). */
 static void dir_of(const char *path, char *out, size_t size)
 {
     const char *slash = strrchr(path, '/');
-    if (!slash) { out[0] = 0; return; }
+    if (!slash) {
+        out[0] = 0;
+        return;
+    }
     size_t n = (size_t)(slash - path);
-    if (n == 0) n = 1;  /* "/file" -> "/" */
+    if (n == 0) n = 1; /* "/file" -> "/" */
     if (n >= size) n = size - 1;
     memcpy(out, path, n);
     out[n] = 0;
@@ -89,20 +100,30 @@ static int run_bake(void *p)
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err;
-    mk_import_options io = { .keep_plain_meshes = 1 };  /* a plain mesh is a baker's natural input */
+    mk_import_options io = { .keep_plain_meshes = 1 }; /* a plain mesh is a baker's natural input */
     mk_result r = mk_import_file(a->input, &io, &raw, &err);
-    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail(verb->name, &err); }
+    if (r != MK_OK) {
+        mk_raw_free(&raw);
+        return cli_fail(verb->name, &err);
+    }
     void *recipe = NULL;
     size_t recipe_size = 0;
     r = mk_read_file(&raw.arena, a->recipe, (size_t)64 << 20, &recipe, &recipe_size, &err);
-    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail(verb->name, &err); }
+    if (r != MK_OK) {
+        mk_raw_free(&raw);
+        return cli_fail(verb->name, &err);
+    }
 
     char dir[4096];
     dir_of(a->recipe, dir, sizeof dir);
     mk_bake_options bo = { .base_dir = dir, .progress = on_progress, .channel_done = on_channel, .user = &ui };
     mk_bake_report report;
     r = mk_bake_recipe(&raw, recipe, recipe_size, &bo, &report, &err);
-    if (r != MK_OK) { cli_print_warnings(&raw); mk_raw_free(&raw); return cli_fail(verb->name, &err); }
+    if (r != MK_OK) {
+        cli_print_warnings(&raw);
+        mk_raw_free(&raw);
+        return cli_fail(verb->name, &err);
+    }
     if (!a->all_meshes) mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");
     cli_print_warnings(&raw);
 
@@ -111,13 +132,16 @@ static int run_bake(void *p)
     mk_write_report wr;
     mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16 };
     r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &wr, &err);
-    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail(verb->name, &err); }
+    if (r != MK_OK) {
+        mk_raw_free(&raw);
+        return cli_fail(verb->name, &err);
+    }
     out.file.data = blob;
     out.file.size = size;
     status = cli_write_outputs(verb, &out, 1);
     if (status == 0) {
-        printf("%s -> %s: %u channels baked, %u targets, max playback error %.3g x diagonal, %zu bytes\n",
-               a->input, a->output, report.channels_added, report.targets_added, report.max_error, size);
+        printf("%s -> %s: %u channels baked, %u targets, max playback error %.3g x diagonal, %zu bytes\n", a->input,
+               a->output, report.channels_added, report.targets_added, report.max_error, size);
         printf("precision: %u int16 targets, %u float targets; max position quantization error %.3g\n",
                wr.quantized_targets, wr.float_targets, wr.max_position_error);
     }

@@ -43,32 +43,44 @@ typedef struct bench_args {
 static int run_bench(void *p);
 
 static const cli_option options[] = {
-    { "--vertices", "N", CLI_UINT, offsetof(bench_args, vertices), "Synthetic mesh size, in vertices.", "1000000", NULL, 64,
-      100000000, 0, 0 },
+    { "--vertices", "N", CLI_UINT, offsetof(bench_args, vertices), "Synthetic mesh size, in vertices.", "1000000", NULL,
+      64, 100000000, 0, 0 },
     { "--channels", "C", CLI_UINT, offsetof(bench_args, channels),
       "Synthetic channels (one in five progressive, with an in-between at 0.5).", "100", NULL, 1, 100000, 0, 0 },
-    { "--active", "A", CLI_UINT, offsetof(bench_args, active), "Synthetic channels with a nonzero weight in each frame (<= C).",
-      "30", NULL, 0, 100000, 0, 0 },
+    { "--active", "A", CLI_UINT, offsetof(bench_args, active),
+      "Synthetic channels with a nonzero weight in each frame (<= C).", "30", NULL, 0, 100000, 0, 0 },
     { "--density", "D", CLI_NUMBER, offsetof(bench_args, density),
-      "Fraction of the vertices each synthetic target moves (in a few coherent regions).", "0.1", NULL, 1e-6, 0.3, 0, 0 },
+      "Fraction of the vertices each synthetic target moves (in a few coherent regions).", "0.1", NULL, 1e-6, 0.3, 0,
+      0 },
     { "--threads", "T", CLI_UINT, offsetof(bench_args, threads),
       "Evaluation threads (ranges of 256 blocks taken from a shared counter).", "1", NULL, 1, 64, 0, 0 },
     { "--frames", "F", CLI_UINT, offsetof(bench_args, frames),
       "Weight sets per pass (with FILE: its first clip at F evenly spaced times).", "100", NULL, 1, 100000, 0, 0 },
-    { "--json", NULL, CLI_FLAG, offsetof(bench_args, json), "Print one JSON object with the measured keys only.", NULL, NULL,
-      0, 0, 0, 0 },
+    { "--json", NULL, CLI_FLAG, offsetof(bench_args, json), "Print one JSON object with the measured keys only.", NULL,
+      NULL, 0, 0, 0, 0 },
     { "--profile", "N", CLI_UINT, offsetof(bench_args, profile),
-      "Profiling mode: only N rounds of evaluation (for perf or callgrind), no baselines.", NULL, NULL, 1, 1000000, 0, 0 },
+      "Profiling mode: only N rounds of evaluation (for perf or callgrind), no baselines.", NULL, NULL, 1, 1000000, 0,
+      0 },
     { "--quiet", NULL, CLI_FLAG, offsetof(bench_args, quiet), "No progress lines.", NULL, NULL, 0, 0, 0, 0 },
 };
 
 const cli_verb cli_verb_bench = {
-    "bench", "[FILE] [options]", "measure evaluation speed against baselines run in the same process",
-    "Times the runtime's evaluation (positions + normals, positions only, sequential stacking) and prints it with ratios "
-    "against baselines measured in the same run: the memory-copy bound for the bytes a frame touches, and a naive dense "
-    "loop. Without FILE a synthetic asset is built (--vertices, --channels, --active, --density).",
-    "FILE", "An asset to play instead of the synthetic one (its first clip).", offsetof(bench_args, file), 0,
-    options, sizeof options / sizeof options[0], sizeof(bench_args), run_bench,
+    .name = "bench",
+    .usage = "[FILE] [options]",
+    .summary = "measure evaluation speed against baselines run in the same process",
+    .description = "Times the runtime's evaluation (positions + normals, positions only, sequential stacking) and "
+                   "prints it with ratios "
+                   "against baselines measured in the same run: the memory-copy bound for the bytes a frame touches, "
+                   "and a naive dense "
+                   "loop. Without FILE a synthetic asset is built (--vertices, --channels, --active, --density).",
+    .positional = "FILE",
+    .positional_help = "An asset to play instead of the synthetic one (its first clip).",
+    .positional_offset = offsetof(bench_args, file),
+    .positional_required = 0,
+    .options = options,
+    .option_count = sizeof options / sizeof options[0],
+    .args_size = sizeof(bench_args),
+    .run = run_bench,
 };
 
 static int run_bench(void *p)
@@ -76,14 +88,18 @@ static int run_bench(void *p)
     bench_args *args = p;
     const cli_verb *verb = &cli_verb_bench;
     bench_synthetic o = { (uint32_t)args->vertices, (uint32_t)args->channels, (uint32_t)args->active, args->density };
-    const uint32_t thread_count = (uint32_t)args->threads, frames = (uint32_t)args->frames, profile = (uint32_t)args->profile;
+    const uint32_t thread_count = (uint32_t)args->threads, frames = (uint32_t)args->frames,
+                   profile = (uint32_t)args->profile;
     const char *file = args->file;
-    if (o.active > o.channels) return cli_usage_error(verb, "--active %u is more than --channels %u", o.active, o.channels);
+    if (o.active > o.channels)
+        return cli_usage_error(verb, "--active %u is more than --channels %u", o.active, o.channels);
     if (!file) {
         double need = bench_synthetic_bytes(&o), have = bench_machine_memory();
         if (have > 0 && need > 0.8 * have)
-            return cli_usage_error(verb, "the synthetic asset needs about %.1f GB, more than this machine's %.1f GB allows; "
-                                   "lower --vertices, --channels, --active or --density", need / 1e9, have / 1e9);
+            return cli_usage_error(verb,
+                                   "the synthetic asset needs about %.1f GB, more than this machine's %.1f GB allows; "
+                                   "lower --vertices, --channels, --active or --density",
+                                   need / 1e9, have / 1e9);
     }
     cli_progress progress;
     cli_progress_init(&progress, args->quiet || args->json);
@@ -101,7 +117,10 @@ static int run_bench(void *p)
         if (!r) r = mk_write_blob(&l.raw, NULL, &l.raw.arena, &l.blob, &l.blob_size, &l.report, &err);
         if (!r) r = mk_asset_open(l.blob, l.blob_size, &l.asset, &err);
     }
-    if (r) { pb_asset_free(&l); return cli_fail(verb->name, &err); }
+    if (r) {
+        pb_asset_free(&l);
+        return cli_fail(verb->name, &err);
+    }
     t_build = bench_now_ns() - t_build;
     const mk_asset *a = &l.asset;
 
@@ -114,7 +133,8 @@ static int run_bench(void *p)
         if (file) {
             mk_clip_info clip;
             double t = 0;
-            if (mk_clip_get(a, 0, &clip)) t = clip.start + clip.duration * (float)f / (float)(frames > 1 ? frames - 1 : 1);
+            if (mk_clip_get(a, 0, &clip))
+                t = clip.start + clip.duration * (float)f / (float)(frames > 1 ? frames - 1 : 1);
             pb_frame_weights(a, a->clip_count ? 0 : -1, t, w, &err);
         } else {
             for (uint32_t k = 0; k < o.active; k++) {
@@ -181,7 +201,8 @@ static int run_bench(void *p)
         for (uint32_t t = 1; t < thread_count; t++) pthread_join(threads[t], NULL);
     }
     double bytes = 0;
-    for (uint32_t f = 0; f < frames; f++) bytes += bench_frame_bytes(a, weights + (size_t)f * a->channel_count, 1, ctx.scratch[0]);
+    for (uint32_t f = 0; f < frames; f++)
+        bytes += bench_frame_bytes(a, weights + (size_t)f * a->channel_count, 1, ctx.scratch[0]);
     bytes /= frames;
     for (int i = 0; i < 5; i++) copy_probe_sample(ctx.probe);
     double bandwidth = copy_probe_bandwidth(&probe);
@@ -199,7 +220,11 @@ static int run_bench(void *p)
                ns, ns_positions, bytes, bound_ns, bound_ns / ns, naive_ns, naive_ns / ns, ns_sequential / ns);
     } else {
         uint32_t vertices = 0;
-        for (uint32_t mi = 0; mi < a->mesh_count; mi++) { mk_mesh_info m; mk_mesh_get(a, mi, &m); vertices += m.vertex_count; }
+        for (uint32_t mi = 0; mi < a->mesh_count; mi++) {
+            mk_mesh_info m;
+            mk_mesh_get(a, mi, &m);
+            vertices += m.vertex_count;
+        }
         printf("asset: %s, %u meshes, %u vertices, %u channels, %u targets, blob %.1f MB (built in %.1f s)\n",
                file ? file : "synthetic", a->mesh_count, vertices, a->channel_count, a->target_count,
                (double)l.blob_size / 1e6, t_build / 1e9);

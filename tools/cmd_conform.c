@@ -18,18 +18,21 @@ static int run_conform(void *p);
 
 static const cli_option options[] = {
     { "--case", "SUBSTRING", CLI_STRING, offsetof(conform_args, filter),
-      "Only the cases whose name or source path contains SUBSTRING (an error when none does).", NULL, NULL, 0, 0, 0, 0 },
+      "Only the cases whose name or source path contains SUBSTRING (an error when none does).", NULL, NULL, 0, 0, 0,
+      0 },
     { "--precision", "P", CLI_CHOICE, offsetof(conform_args, precision),
       "How sources are written before playback: q16 (the allowed error grows by each target's quantization step) "
-      "or float.", "q16", "q16|float", 0, 0, 0, 0 },
+      "or float.",
+      "q16", "q16|float", 0, 0, 0, 0 },
     { "--stacking", "MODE", CLI_CHOICE, offsetof(conform_args, stacking),
-      "Channel stacking to play with. Default: each mesh's stored stacking (references from other software are additive).",
+      "Channel stacking to play with. Default: each mesh's stored stacking (references from other software are "
+      "additive).",
       NULL, "additive|sequential", 0, 0, 0, offsetof(conform_args, stacking_given) },
     { "--normals", "MODE", CLI_CHOICE, offsetof(conform_args, normals), "How normal changes combine.", "nlerp",
       "nlerp|slerp", 0, 0, 0, 0 },
     { "--normal-tolerance", "DEG", CLI_NUMBER, offsetof(conform_args, normal_tolerance),
-      "Largest angle, in degrees, between a normal and the reference's (where the reference has normals).", "1", NULL, 1e-9,
-      180, 0, 0 },
+      "Largest angle, in degrees, between a normal and the reference's (where the reference has normals).", "1", NULL,
+      1e-9, 180, 0, 0 },
     { "--weight-tolerance", "W", CLI_NUMBER, offsetof(conform_args, weight_tolerance),
       "Largest difference between a sampled channel weight and the reference's (where the reference lists weights).",
       "1e-5", NULL, 1e-12, 1e6, 0, 0 },
@@ -38,13 +41,25 @@ static const cli_option options[] = {
 };
 
 const cli_verb cli_verb_conform = {
-    "conform", "CASES.json [options]", "check playback against reference frames made by other software",
-    "For each case of the manifest CASES.json (docs/conformance.md): imports its source, writes it with the chosen "
-    "precision, opens it with the runtime and, for every reference frame, plays the frame (a clip at a time, the static "
-    "state, or forced weights), evaluates every mesh with channels and compares positions, normals and channel weights "
-    "where the reference has them. One line per frame, then 'N passed, N failed'. Exit status 1 when a frame fails.",
-    "CASES.json", "The manifest; paths in it are relative to its folder.", offsetof(conform_args, manifest), 1,
-    options, sizeof options / sizeof options[0], sizeof(conform_args), run_conform,
+    .name = "conform",
+    .usage = "CASES.json [options]",
+    .summary = "check playback against reference frames made by other software",
+    .description =
+        "For each case of the manifest CASES.json (docs/conformance.md): imports its source, writes it with the chosen "
+        "precision, opens it with the runtime and, for every reference frame, plays the frame (a clip at a time, the "
+        "static "
+        "state, or forced weights), evaluates every mesh with channels and compares positions, normals and channel "
+        "weights "
+        "where the reference has them. One line per frame, then 'N passed, N failed'. Exit status 1 when a frame "
+        "fails.",
+    .positional = "CASES.json",
+    .positional_help = "The manifest; paths in it are relative to its folder.",
+    .positional_offset = offsetof(conform_args, manifest),
+    .positional_required = 1,
+    .options = options,
+    .option_count = sizeof options / sizeof options[0],
+    .args_size = sizeof(conform_args),
+    .run = run_conform,
 };
 
 static int case_matches(const pb_case *c, const char *filter)
@@ -52,19 +67,24 @@ static int case_matches(const pb_case *c, const char *filter)
     return !filter || strstr(c->name, filter) || strstr(c->source, filter);
 }
 
-static void print_text(const pb_case *c, const pb_frame_spec *f, const pb_frame_result *r, int name_width, int frame_width)
+static void print_text(const pb_case *c, const pb_frame_spec *f, const pb_frame_result *r, int name_width,
+                       int frame_width)
 {
     char allowed[64], normal[32];
     if (r->relative_allowed > 0 && (r->passed_by == NULL || !strcmp(r->passed_by, "relative_tolerance")))
         snprintf(allowed, sizeof allowed, "%.3g rel", r->relative_allowed);
     else
         snprintf(allowed, sizeof allowed, "%.3g", r->allowed);
-    if (r->normals_compared) snprintf(normal, sizeof normal, "%.3g deg", r->normal_error_deg);
-    else snprintf(normal, sizeof normal, "-");
+    if (r->normals_compared)
+        snprintf(normal, sizeof normal, "%.3g deg", r->normal_error_deg);
+    else
+        snprintf(normal, sizeof normal, "-");
     printf("%-*s %-*s pos %-9.3g <= %-12s normal %-10s %s", name_width, c->name, frame_width, pb_frame_label(f),
            r->position_error, allowed, normal, r->passed ? "ok" : "FAIL");
-    if (r->failure[0]) printf(" %s", r->failure);
-    else if (!r->passed && r->weights_compared) printf(" (weight error %.3g)", r->weight_error);
+    if (r->failure[0])
+        printf(" %s", r->failure);
+    else if (!r->passed && r->weights_compared)
+        printf(" (weight error %.3g)", r->weight_error);
     printf("\n");
 }
 
@@ -81,10 +101,14 @@ static void json_frame(json_writer *w, const pb_case *c, const pb_frame_spec *f,
         json_number(w, "relative_allowed", r->relative_allowed);
         json_number(w, "reference_size", r->reference_size);
     }
-    if (r->normals_compared) json_number(w, "normal_error_deg", r->normal_error_deg);
-    else json_null(w, "normal_error_deg");
-    if (r->weights_compared) json_number(w, "weight_error", r->weight_error);
-    else json_null(w, "weight_error");
+    if (r->normals_compared)
+        json_number(w, "normal_error_deg", r->normal_error_deg);
+    else
+        json_null(w, "normal_error_deg");
+    if (r->weights_compared)
+        json_number(w, "weight_error", r->weight_error);
+    else
+        json_null(w, "weight_error");
     json_int(w, "meshes_compared", r->meshes_compared);
     if (r->failure[0]) json_string(w, "failure", r->failure);
     json_end_object(w);
@@ -107,7 +131,8 @@ static int run_conform(void *p)
         matched++;
         if ((int)strlen(c->name) > name_width) name_width = (int)strlen(c->name);
         for (uint32_t k = 0; k < c->frame_count; k++)
-            if ((int)strlen(pb_frame_label(&c->frames[k])) > frame_width) frame_width = (int)strlen(pb_frame_label(&c->frames[k]));
+            if ((int)strlen(pb_frame_label(&c->frames[k])) > frame_width)
+                frame_width = (int)strlen(pb_frame_label(&c->frames[k]));
     }
     if (!matched) {
         if (args->filter)
@@ -119,9 +144,12 @@ static int run_conform(void *p)
         return CLI_EXIT_FAILURE;
     }
     pb_conform_options opt = {
-        .stacking = !args->stacking_given ? MK_STACKING_ASSET : args->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE,
+        .stacking = !args->stacking_given ? MK_STACKING_ASSET
+                    : args->stacking      ? MK_STACKING_SEQUENTIAL
+                                          : MK_STACKING_ADDITIVE,
         .normal_mode = args->normals ? MK_NORMALS_SLERP : MK_NORMALS_NLERP,
-        .normal_tolerance_deg = args->normal_tolerance, .weight_tolerance = args->weight_tolerance,
+        .normal_tolerance_deg = args->normal_tolerance,
+        .weight_tolerance = args->weight_tolerance,
     };
     mk_write_options wo = { .precision = args->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16 };
     json_writer w;
@@ -148,9 +176,14 @@ static int run_conform(void *p)
             } else {
                 pb_conform_frame(&manifest, c, &c->frames[k], &asset, &opt, &res);
             }
-            if (args->json) json_frame(&w, c, &c->frames[k], &res);
-            else print_text(c, &c->frames[k], &res, name_width, frame_width);
-            if (res.passed) passed++; else failed++;
+            if (args->json)
+                json_frame(&w, c, &c->frames[k], &res);
+            else
+                print_text(c, &c->frames[k], &res, name_width, frame_width);
+            if (res.passed)
+                passed++;
+            else
+                failed++;
         }
         pb_asset_free(&asset);
     }

@@ -19,7 +19,8 @@ static const cli_option options[] = {
     { "-o", "OUT.glb|OUT.gltf", CLI_STRING, offsetof(export_args, output),
       "The glTF to write: .glb (binary) or .gltf (JSON with the buffer embedded).", NULL, NULL, 0, 0, 1, 0 },
     { "--sidecar", "PATH", CLI_STRING, offsetof(export_args, sidecar),
-      "Where to write the channel sidecar (JSON). Default: OUT without its extension + .channels.json.", NULL, NULL, 0, 0, 0, 0 },
+      "Where to write the channel sidecar (JSON). Default: OUT without its extension + .channels.json.", NULL, NULL, 0,
+      0, 0, 0 },
     { "--no-sidecar", NULL, CLI_FLAG, offsetof(export_args, no_sidecar),
       "Write no sidecar (a re-import then sees one channel per glTF target).", NULL, NULL, 0, 0, 0, 0 },
     { "--channels", "SIDECAR.json", CLI_STRING, offsetof(export_args, channels),
@@ -27,12 +28,22 @@ static const cli_option options[] = {
 };
 
 const cli_verb cli_verb_export = {
-    "export", "FILE -o OUT.glb|OUT.gltf [options]", "write an asset as glTF 2.0 (plus a channel sidecar)",
-    "Writes FILE's meshes, morph targets and weight clips as glTF 2.0. A progressive channel becomes one glTF target "
-    "per in-between with weight tracks that reproduce morphkit's playback; the channel sidecar records the grouping so "
-    "a re-import restores the channels. The glTF and the sidecar are written both or neither.",
-    "FILE", "A .morph blob, or any file 'morphkit import' reads.", offsetof(export_args, input), 1,
-    options, sizeof options / sizeof options[0], sizeof(export_args), run_export,
+    .name = "export",
+    .usage = "FILE -o OUT.glb|OUT.gltf [options]",
+    .summary = "write an asset as glTF 2.0 (plus a channel sidecar)",
+    .description = "Writes FILE's meshes, morph targets and weight clips as glTF 2.0. A progressive channel becomes "
+                   "one glTF target "
+                   "per in-between with weight tracks that reproduce morphkit's playback; the channel sidecar records "
+                   "the grouping so "
+                   "a re-import restores the channels. The glTF and the sidecar are written both or neither.",
+    .positional = "FILE",
+    .positional_help = "A .morph blob, or any file 'morphkit import' reads.",
+    .positional_offset = offsetof(export_args, input),
+    .positional_required = 1,
+    .options = options,
+    .option_count = sizeof options / sizeof options[0],
+    .args_size = sizeof(export_args),
+    .run = run_export,
 };
 
 static int run_export(void *p)
@@ -42,7 +53,8 @@ static int run_export(void *p)
     if (a->no_sidecar && a->sidecar) return cli_usage_error(verb, "--sidecar and --no-sidecar contradict each other");
     int gltf_input = mk_path_has_extension(a->input, ".gltf") || mk_path_has_extension(a->input, ".glb");
     if (a->channels && !gltf_input)
-        return cli_usage_error(verb, "--channels: channel sidecars apply to glTF input only (%s is not .gltf or .glb)", a->input);
+        return cli_usage_error(verb, "--channels: channel sidecars apply to glTF input only (%s is not .gltf or .glb)",
+                               a->input);
     /* Default sidecar: OUT.glb -> OUT.channels.json, next to the glTF. */
     char default_sidecar[4200];
     if (!a->sidecar && !a->no_sidecar) {
@@ -58,7 +70,8 @@ static int run_export(void *p)
     if (status >= 0) return status;
     uint32_t count = 1;
     if (a->sidecar) {
-        status = cli_output_check(verb, &outs[1], "--sidecar", a->sidecar, json_ext, "a JSON channel sidecar", 0, inputs, 3);
+        status =
+            cli_output_check(verb, &outs[1], "--sidecar", a->sidecar, json_ext, "a JSON channel sidecar", 0, inputs, 3);
         if (status >= 0) return status;
         count = 2;
         if (!strcmp(outs[0].file.target, outs[1].file.target))
@@ -79,13 +92,19 @@ static int run_export(void *p)
     if (r == MK_OK)
         r = mk_export_gltf_memory(&raw, container, &raw.arena, &gltf, &gltf_size, count == 2 ? &sidecar : NULL,
                                   &sidecar_size, &rep, &err);
-    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail(verb->name, &err); }
+    if (r != MK_OK) {
+        mk_raw_free(&raw);
+        return cli_fail(verb->name, &err);
+    }
     outs[0].file.data = gltf;
     outs[0].file.size = gltf_size;
     outs[1].file.data = sidecar;
     outs[1].file.size = sidecar_size;
     status = cli_write_outputs(verb, outs, count);
-    if (status) { mk_raw_free(&raw); return status; }
+    if (status) {
+        mk_raw_free(&raw);
+        return status;
+    }
     printf("%s -> %s: %u meshes, %u glTF targets, %u clips\n", a->input, a->output, rep.meshes, rep.targets, rep.clips);
     if (rep.progressive_channels)
         printf("note: %u progressive (in-between) channel%s exported as one glTF target per in-between, with weight\n"
@@ -102,8 +121,8 @@ static int run_export(void *p)
         printf("note: %u zero-length base normal%s/tangents replaced by face normals (glTF requires unit vectors)\n",
                rep.fixed_normals, rep.fixed_normals == 1 ? "" : "s");
     if (count == 2)
-        printf("channel sidecar: %s (re-import with: morphkit import %s --channels %s -o OUT.morph)\n", a->sidecar, a->output,
-               a->sidecar);
+        printf("channel sidecar: %s (re-import with: morphkit import %s --channels %s -o OUT.morph)\n", a->sidecar,
+               a->output, a->sidecar);
     mk_raw_free(&raw);
     return 0;
 }

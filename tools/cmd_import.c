@@ -14,32 +14,45 @@ typedef struct import_args {
 static int run_import(void *p);
 
 static const cli_option options[] = {
-    { "-o", "OUT.morph", CLI_STRING, offsetof(import_args, output), "The blob to write (a path ending in .morph, or a device/FIFO).",
-      NULL, NULL, 0, 0, 1, 0 },
+    { "-o", "OUT.morph", CLI_STRING, offsetof(import_args, output),
+      "The blob to write (a path ending in .morph, or a device/FIFO).", NULL, NULL, 0, 0, 1, 0 },
     { "--stacking", "MODE", CLI_CHOICE, offsetof(import_args, stacking),
-      "Channel stacking stored for every mesh (docs/semantics.md). Default: additive; for a .morph input, the stored one (which this option replaces).",
+      "Channel stacking stored for every mesh (docs/semantics.md). Default: additive; for a .morph input, the stored "
+      "one (which this option replaces).",
       NULL, "additive|sequential", 0, 0, 0, offsetof(import_args, stacking_given) },
     { "--precision", "P", CLI_CHOICE, offsetof(import_args, precision),
-      "How deltas are stored: q16 (int16 with a per-target scale; a target that would exceed --tolerance falls back to float) or float (lossless float32).",
+      "How deltas are stored: q16 (int16 with a per-target scale; a target that would exceed --tolerance falls back to "
+      "float) or float (lossless float32).",
       "q16", "q16|float", 0, 0, 0, 0 },
     { "--tolerance", "D", CLI_NUMBER, offsetof(import_args, tolerance),
       "Largest quantization error of a position, in mesh units. Default: 1e-4 x each mesh's bounding-box diagonal.",
       NULL, NULL, 1e-30, 1e30, 0, 0 },
     { "--channels", "SIDECAR.json", CLI_STRING, offsetof(import_args, channels),
-      "glTF input only: a channel sidecar (written by 'morphkit export') that groups targets into progressive channels.",
+      "glTF input only: a channel sidecar (written by 'morphkit export') that groups targets into progressive "
+      "channels.",
       NULL, NULL, 0, 0, 0, 0 },
     { "--all-meshes", NULL, CLI_FLAG, offsetof(import_args, all_meshes),
-      "Also keep meshes without morph targets (by default only meshes with targets are imported).", NULL, NULL, 0, 0, 0, 0 },
-    { "--quiet", NULL, CLI_FLAG, offsetof(import_args, quiet), "No progress lines (results are still printed).",
-      NULL, NULL, 0, 0, 0, 0 },
+      "Also keep meshes without morph targets (by default only meshes with targets are imported).", NULL, NULL, 0, 0, 0,
+      0 },
+    { "--quiet", NULL, CLI_FLAG, offsetof(import_args, quiet), "No progress lines (results are still printed).", NULL,
+      NULL, 0, 0, 0, 0 },
 };
 
 const cli_verb cli_verb_import = {
-    "import", "FILE -o OUT.morph [options]", "convert an FBX or glTF file into a .morph blob",
-    "Imports FILE (.fbx binary or ASCII, .gltf, .glb, or a .morph blob to re-encode) with every mesh's blend shape "
-    "channels, in-between targets, target normals and weight clips, and writes it as a validated .morph blob.",
-    "FILE", "The source: .fbx, .gltf, .glb or .morph.", offsetof(import_args, input), 1,
-    options, sizeof options / sizeof options[0], sizeof(import_args), run_import,
+    .name = "import",
+    .usage = "FILE -o OUT.morph [options]",
+    .summary = "convert an FBX or glTF file into a .morph blob",
+    .description =
+        "Imports FILE (.fbx binary or ASCII, .gltf, .glb, or a .morph blob to re-encode) with every mesh's blend shape "
+        "channels, in-between targets, target normals and weight clips, and writes it as a validated .morph blob.",
+    .positional = "FILE",
+    .positional_help = "The source: .fbx, .gltf, .glb or .morph.",
+    .positional_offset = offsetof(import_args, input),
+    .positional_required = 1,
+    .options = options,
+    .option_count = sizeof options / sizeof options[0],
+    .args_size = sizeof(import_args),
+    .run = run_import,
 };
 
 static int run_import(void *p)
@@ -48,7 +61,8 @@ static int run_import(void *p)
     const cli_verb *verb = &cli_verb_import;
     int is_gltf = mk_path_has_extension(a->input, ".gltf") || mk_path_has_extension(a->input, ".glb");
     if (a->channels && !is_gltf)
-        return cli_usage_error(verb, "--channels: channel sidecars apply to glTF input only (%s is not .gltf or .glb)", a->input);
+        return cli_usage_error(verb, "--channels: channel sidecars apply to glTF input only (%s is not .gltf or .glb)",
+                               a->input);
     const char *inputs[] = { a->input, a->channels };
     static const char *const extensions[] = { ".morph", NULL };
     cli_output out;
@@ -57,7 +71,8 @@ static int run_import(void *p)
 
     mk_import_options io = { .channels_sidecar = a->channels, .keep_plain_meshes = a->all_meshes };
     if (a->stacking_given) io.stacking = a->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
-    mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16, .tolerance = (float)a->tolerance };
+    mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16,
+                            .tolerance = (float)a->tolerance };
     /* Progress only for inputs big enough to take a while. */
     struct stat st;
     cli_progress progress;
@@ -73,7 +88,10 @@ static int run_import(void *p)
     mk_write_report report;
     cli_progress_update(&progress, "writing the blob", -1);
     if (r == MK_OK) r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &report, &err);
-    if (r != MK_OK) { mk_raw_free(&raw); return cli_fail(verb->name, &err); }
+    if (r != MK_OK) {
+        mk_raw_free(&raw);
+        return cli_fail(verb->name, &err);
+    }
     out.file.data = blob;
     out.file.size = size;
     status = cli_write_outputs(verb, &out, 1);
@@ -86,7 +104,8 @@ static int run_import(void *p)
         printf("precision: %u int16 targets, %u float targets; max position quantization error %.3g (tolerance %.3g)\n",
                report.quantized_targets, report.float_targets, report.max_position_error, report.tolerance_used);
         if (report.max_normal_error > 0 || report.max_tangent_error > 0)
-            printf("max normal quantization error %.3g, tangent %.3g\n", report.max_normal_error, report.max_tangent_error);
+            printf("max normal quantization error %.3g, tangent %.3g\n", report.max_normal_error,
+                   report.max_tangent_error);
     }
     mk_raw_free(&raw);
     return status;

@@ -38,33 +38,34 @@ static void print_text(FILE *f, const pb_asset *l, const char *path)
     fprintf(f, "%s: %zu bytes, format v%u\n", path, l->blob_size, MK_FORMAT_VERSION);
     if (l->imported) {
         fprintf(f, "source: %s%s%s\n", l->raw.source_format[0] ? l->raw.source_format : "?",
-               l->raw.source_creator[0] ? ", creator " : "", l->raw.source_creator);
+                l->raw.source_creator[0] ? ", creator " : "", l->raw.source_creator);
         if (l->raw.unit_scale > 0) fprintf(f, "unit scale: %g cm per unit\n", (double)l->raw.unit_scale);
         if (l->raw.up_axis >= 0) fprintf(f, "up axis: %c\n", "XYZ"[l->raw.up_axis % 3]);
         fprintf(f, "import warnings: %u\n", l->raw.warning_count);
     }
-    fprintf(f, "precision: %u quantized (int16) targets, %u float targets; max quantization error <= %.3g\n", nq, nf, bound);
+    fprintf(f, "precision: %u quantized (int16) targets, %u float targets; max quantization error <= %.3g\n", nq, nf,
+            bound);
     for (uint32_t i = 0; i < a->mesh_count; i++) {
         mk_mesh_info m;
         mk_mesh_get(a, i, &m);
-        fprintf(f, "mesh %u '%s': %u vertices (%u control points), %u triangles, %s%s%s stacking",
-               i, m.name, m.vertex_count, m.control_point_count, m.triangle_count,
-               m.has_normals ? "normals, " : "", m.has_tangents ? "tangents, " : "",
-               m.stacking == MK_STACKING_SEQUENTIAL ? "sequential" : "additive");
-        if (m.gltf_node >= 0) fprintf(f, ", glTF node %d mesh %d primitive %d", m.gltf_node, m.gltf_mesh, m.gltf_primitive);
-        fprintf(f, "\n  target data: %llu bytes in %llu block entries\n",
-               (unsigned long long)m.target_bytes, (unsigned long long)m.entry_count);
+        fprintf(f, "mesh %u '%s': %u vertices (%u control points), %u triangles, %s%s%s stacking", i, m.name,
+                m.vertex_count, m.control_point_count, m.triangle_count, m.has_normals ? "normals, " : "",
+                m.has_tangents ? "tangents, " : "", m.stacking == MK_STACKING_SEQUENTIAL ? "sequential" : "additive");
+        if (m.gltf_node >= 0)
+            fprintf(f, ", glTF node %d mesh %d primitive %d", m.gltf_node, m.gltf_mesh, m.gltf_primitive);
+        fprintf(f, "\n  target data: %llu bytes in %llu block entries\n", (unsigned long long)m.target_bytes,
+                (unsigned long long)m.entry_count);
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
             mk_channel_info ch;
             mk_channel_get(a, c, &ch);
             fprintf(f, "  channel %u '%s': default %g, %u target%s%s\n", c, ch.name, (double)ch.default_weight,
-                   ch.target_count, ch.target_count == 1 ? "" : "s", ch.target_count > 1 ? " (progressive)" : "");
+                    ch.target_count, ch.target_count == 1 ? "" : "s", ch.target_count > 1 ? " (progressive)" : "");
             for (uint32_t k = 0; k < ch.target_count; k++) {
                 mk_target_info t;
                 mk_target_get(a, c, k, &t);
                 fprintf(f, "    target '%s': full weight %g, %u vertices, %s%s%s\n", t.name, (double)t.full_weight,
-                       t.moved_vertices, t.quantized ? "int16" : "float", t.has_normals ? ", normals" : "",
-                       t.has_tangents ? ", tangents" : "");
+                        t.moved_vertices, t.quantized ? "int16" : "float", t.has_normals ? ", normals" : "",
+                        t.has_tangents ? ", tangents" : "");
             }
             if (ch.origin[0]) fprintf(f, "    baked from recipe: %s\n", ch.origin);
         }
@@ -72,8 +73,8 @@ static void print_text(FILE *f, const pb_asset *l, const char *path)
     for (uint32_t i = 0; i < a->clip_count; i++) {
         mk_clip_info c;
         mk_clip_get(a, i, &c);
-        fprintf(f, "clip %u '%s': start %g s, duration %g s, %u tracks\n", i, c.name, (double)c.start, (double)c.duration,
-               c.track_count);
+        fprintf(f, "clip %u '%s': start %g s, duration %g s, %u tracks\n", i, c.name, (double)c.start,
+                (double)c.duration, c.track_count);
     }
 }
 
@@ -168,19 +169,30 @@ typedef struct info_args {
 static int run_info(void *p);
 
 static const cli_option options[] = {
-    { "--json", NULL, CLI_FLAG, offsetof(info_args, json), "Print JSON (one object: file facts, meshes, channels, targets, clips) instead of text.",
-      NULL, NULL, 0, 0, 0, 0 },
-    { "-o", "OUT", CLI_STRING, offsetof(info_args, output), "Where to write the description: a file, or - for standard output.",
-      "-", NULL, 0, 0, 0, 0 },
+    { "--json", NULL, CLI_FLAG, offsetof(info_args, json),
+      "Print JSON (one object: file facts, meshes, channels, targets, clips) instead of text.", NULL, NULL, 0, 0, 0,
+      0 },
+    { "-o", "OUT", CLI_STRING, offsetof(info_args, output),
+      "Where to write the description: a file, or - for standard output.", "-", NULL, 0, 0, 0, 0 },
 };
 
 const cli_verb cli_verb_info = {
-    "info", "FILE [--json] [-o OUT]", "describe an asset: meshes, channels, in-betweens, clips, sizes",
-    "Describes FILE: its meshes (vertices, control points, triangles, normals, tangents, stacking), channels with their "
-    "in-between targets and full weights, clips, byte sizes, precision and the quantization error bound. A file that is "
-    "not a .morph blob is imported and written in memory with the default options first.",
-    "FILE", "A .morph blob, or any file 'morphkit import' reads.", offsetof(info_args, input), 1,
-    options, sizeof options / sizeof options[0], sizeof(info_args), run_info,
+    .name = "info",
+    .usage = "FILE [--json] [-o OUT]",
+    .summary = "describe an asset: meshes, channels, in-betweens, clips, sizes",
+    .description = "Describes FILE: its meshes (vertices, control points, triangles, normals, tangents, stacking), "
+                   "channels with their "
+                   "in-between targets and full weights, clips, byte sizes, precision and the quantization error "
+                   "bound. A file that is "
+                   "not a .morph blob is imported and written in memory with the default options first.",
+    .positional = "FILE",
+    .positional_help = "A .morph blob, or any file 'morphkit import' reads.",
+    .positional_offset = offsetof(info_args, input),
+    .positional_required = 1,
+    .options = options,
+    .option_count = sizeof options / sizeof options[0],
+    .args_size = sizeof(info_args),
+    .run = run_info,
 };
 
 static int run_info(void *p)
@@ -193,12 +205,22 @@ static int run_info(void *p)
     if (status >= 0) return status;
     pb_asset l;
     mk_error err;
-    if (pb_asset_load(a->input, NULL, NULL, &l, &err)) { pb_asset_free(&l); return cli_fail(verb->name, &err); }
+    if (pb_asset_load(a->input, NULL, NULL, &l, &err)) {
+        pb_asset_free(&l);
+        return cli_fail(verb->name, &err);
+    }
     char *text = NULL;
     size_t size = 0;
     FILE *f = open_memstream(&text, &size);
-    if (!f) { pb_asset_free(&l); fprintf(stderr, "morphkit info: out of memory\n"); return CLI_EXIT_FAILURE; }
-    if (a->json) print_json(f, &l, a->input); else print_text(f, &l, a->input);
+    if (!f) {
+        pb_asset_free(&l);
+        fprintf(stderr, "morphkit info: out of memory\n");
+        return CLI_EXIT_FAILURE;
+    }
+    if (a->json)
+        print_json(f, &l, a->input);
+    else
+        print_text(f, &l, a->input);
     fclose(f);
     out.file.data = text;
     out.file.size = size;

@@ -9,8 +9,8 @@
 #include "json_write.h"
 #include "weights_arg.h"
 
-static void write_json(FILE *f, const mk_asset *a, float **pos, float **nrm, const char *space, double time, int32_t clip,
-                       const float *weights)
+static void write_json(FILE *f, const mk_asset *a, float **pos, float **nrm, const char *space, double time,
+                       int32_t clip, const float *weights)
 {
     json_writer w;
     json_begin(&w, f, 0);
@@ -61,14 +61,19 @@ static void write_obj(FILE *f, const mk_asset *a, float **pos, float **nrm)
         mk_mesh_get(a, i, &m);
         fprintf(f, "o %s\n", m.name);
         for (uint32_t v = 0; v < m.vertex_count; v++)
-            fprintf(f, "v %.9g %.9g %.9g\n", (double)pos[i][3 * v], (double)pos[i][3 * v + 1], (double)pos[i][3 * v + 2]);
+            fprintf(f, "v %.9g %.9g %.9g\n", (double)pos[i][3 * v], (double)pos[i][3 * v + 1],
+                    (double)pos[i][3 * v + 2]);
         if (nrm[i])
             for (uint32_t v = 0; v < m.vertex_count; v++)
-                fprintf(f, "vn %.9g %.9g %.9g\n", (double)nrm[i][3 * v], (double)nrm[i][3 * v + 1], (double)nrm[i][3 * v + 2]);
+                fprintf(f, "vn %.9g %.9g %.9g\n", (double)nrm[i][3 * v], (double)nrm[i][3 * v + 1],
+                        (double)nrm[i][3 * v + 2]);
         for (uint32_t t = 0; t < m.triangle_count; t++) {
-            uint32_t x = m.triangles[3 * t] + base, y = m.triangles[3 * t + 1] + base, z = m.triangles[3 * t + 2] + base;
-            if (nrm[i]) fprintf(f, "f %u//%u %u//%u %u//%u\n", x, x, y, y, z, z);
-            else fprintf(f, "f %u %u %u\n", x, y, z);
+            uint32_t x = m.triangles[3 * t] + base, y = m.triangles[3 * t + 1] + base,
+                     z = m.triangles[3 * t + 2] + base;
+            if (nrm[i])
+                fprintf(f, "f %u//%u %u//%u %u//%u\n", x, x, y, y, z, z);
+            else
+                fprintf(f, "f %u %u %u\n", x, y, z);
         }
         base += m.vertex_count;
     }
@@ -84,33 +89,47 @@ static int run_play(void *p);
 
 static const cli_option options[] = {
     { "-o", "OUT", CLI_STRING, offsetof(play_args, output),
-      "Where to write the frame: a .json or .obj file, a device/FIFO, or - for standard output.", NULL, NULL, 0, 0, 1, 0 },
+      "Where to write the frame: a .json or .obj file, a device/FIFO, or - for standard output.", NULL, NULL, 0, 0, 1,
+      0 },
     { "--format", "F", CLI_CHOICE, offsetof(play_args, format),
       "Output format. Default: obj when -o ends in .obj, else json.", NULL, "json|obj", 0, 0, 0,
       offsetof(play_args, format_given) },
     { "--clip", "NAME|INDEX", CLI_STRING, offsetof(play_args, clip),
-      "The clip to sample. Default: the first clip when --time is given, else none (the default weights).", NULL, NULL, 0, 0, 0, 0 },
-    { "--time", "T", CLI_NUMBER, offsetof(play_args, time), "Sampling time in seconds on the clip's time line.", NULL, NULL,
-      -1e9, 1e9, 0, offsetof(play_args, time_given) },
+      "The clip to sample. Default: the first clip when --time is given, else none (the default weights).", NULL, NULL,
+      0, 0, 0, 0 },
+    { "--time", "T", CLI_NUMBER, offsetof(play_args, time), "Sampling time in seconds on the clip's time line.", NULL,
+      NULL, -1e9, 1e9, 0, offsetof(play_args, time_given) },
     { "--weights", "NAME=V,...", CLI_STRING, offsetof(play_args, weights),
-      "Channel weights (1 = 100 %) set after the clip is sampled, by channel name, NODE/CHANNEL or index. A name sets that "
-      "channel on every primitive of its node.", NULL, NULL, 0, 0, 0, 0 },
+      "Channel weights (1 = 100 %) set after the clip is sampled, by channel name, NODE/CHANNEL or index. A name sets "
+      "that "
+      "channel on every primitive of its node.",
+      NULL, NULL, 0, 0, 0, 0 },
     { "--stacking", "MODE", CLI_CHOICE, offsetof(play_args, stacking),
       "Channel stacking. Default: each mesh's stored stacking.", NULL, "additive|sequential", 0, 0, 0,
       offsetof(play_args, stacking_given) },
-    { "--normals", "MODE", CLI_CHOICE, offsetof(play_args, normals), "How normal changes combine (docs/semantics.md).", "nlerp",
-      "nlerp|slerp", 0, 0, 0, 0 },
+    { "--normals", "MODE", CLI_CHOICE, offsetof(play_args, normals), "How normal changes combine (docs/semantics.md).",
+      "nlerp", "nlerp|slerp", 0, 0, 0, 0 },
     { "--space", "S", CLI_CHOICE, offsetof(play_args, space),
       "Coordinates of the output: world (each mesh's node transform at rest applied) or local (mesh space).", "world",
       "world|local", 0, 0, 0, 0 },
 };
 
 const cli_verb cli_verb_play = {
-    "play", "FILE -o OUT [options]", "evaluate one frame and write it as JSON or OBJ",
-    "Evaluates one frame of FILE through the runtime (a clip at a time, or the default weights, then any --weights) and "
-    "writes every mesh's positions and normals: JSON shaped like the conformance reference frames, or OBJ.",
-    "FILE", "A .morph blob, or any file 'morphkit import' reads.", offsetof(play_args, input), 1,
-    options, sizeof options / sizeof options[0], sizeof(play_args), run_play,
+    .name = "play",
+    .usage = "FILE -o OUT [options]",
+    .summary = "evaluate one frame and write it as JSON or OBJ",
+    .description =
+        "Evaluates one frame of FILE through the runtime (a clip at a time, or the default weights, then any "
+        "--weights) and "
+        "writes every mesh's positions and normals: JSON shaped like the conformance reference frames, or OBJ.",
+    .positional = "FILE",
+    .positional_help = "A .morph blob, or any file 'morphkit import' reads.",
+    .positional_offset = offsetof(play_args, input),
+    .positional_required = 1,
+    .options = options,
+    .option_count = sizeof options / sizeof options[0],
+    .args_size = sizeof(play_args),
+    .run = run_play,
 };
 
 /* The clip named or numbered by arg, or -1 after printing the error. */
@@ -126,9 +145,11 @@ static int32_t find_clip(const cli_verb *verb, const mk_asset *a, const char *ar
         mk_clip_info ci;
         mk_clip_get(a, c, &ci);
         size_t n = strlen(names);
-        if (n + strlen(ci.name) + 8 < sizeof names) snprintf(names + n, sizeof names - n, "%s'%s'", n ? ", " : "", ci.name);
+        if (n + strlen(ci.name) + 8 < sizeof names)
+            snprintf(names + n, sizeof names - n, "%s'%s'", n ? ", " : "", ci.name);
     }
-    cli_usage_error(verb, "--clip: no clip '%s'; the clips are %s", arg, a->clip_count ? names : "(none: no animation)");
+    cli_usage_error(verb, "--clip: no clip '%s'; the clips are %s", arg,
+                    a->clip_count ? names : "(none: no animation)");
     return -1;
 }
 
@@ -142,22 +163,30 @@ static int run_play(void *p)
     int status = cli_output_check(verb, &out, "-o", args->output, extensions, "a frame as JSON or OBJ", 1, inputs, 1);
     if (status >= 0) return status;
     int obj = args->format_given ? args->format == 1 : mk_path_has_extension(args->output, ".obj");
-    if (args->format_given && !out.to_stdout && out.file.kind != MK_OUTPUT_STREAM
-        && !mk_path_has_extension(args->output, obj ? ".obj" : ".json"))
+    if (args->format_given && !out.to_stdout && out.file.kind != MK_OUTPUT_STREAM &&
+        !mk_path_has_extension(args->output, obj ? ".obj" : ".json"))
         return cli_usage_error(verb, "-o %s: --format %s needs a name ending in %s", args->output, obj ? "obj" : "json",
                                obj ? ".obj" : ".json");
     const char *space = args->space ? "local" : "world";
-    mk_stacking stacking = !args->stacking_given ? MK_STACKING_ASSET : args->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
+    mk_stacking stacking = !args->stacking_given ? MK_STACKING_ASSET
+                           : args->stacking      ? MK_STACKING_SEQUENTIAL
+                                                 : MK_STACKING_ADDITIVE;
     mk_normal_mode nmode = args->normals ? MK_NORMALS_SLERP : MK_NORMALS_NLERP;
 
     pb_asset l;
     mk_error err;
-    if (pb_asset_load(args->input, NULL, NULL, &l, &err)) { pb_asset_free(&l); return cli_fail(verb->name, &err); }
+    if (pb_asset_load(args->input, NULL, NULL, &l, &err)) {
+        pb_asset_free(&l);
+        return cli_fail(verb->name, &err);
+    }
     const mk_asset *a = &l.asset;
     int32_t clip = -1;
     if (args->clip) {
         clip = find_clip(verb, a, args->clip);
-        if (clip < 0) { pb_asset_free(&l); return CLI_EXIT_USAGE; }
+        if (clip < 0) {
+            pb_asset_free(&l);
+            return CLI_EXIT_USAGE;
+        }
     } else if (args->time_given) {
         if (!a->clip_count) {
             pb_asset_free(&l);
@@ -169,8 +198,15 @@ static int run_play(void *p)
     float **pos = calloc(a->mesh_count + 1u, sizeof(float *)), **nrm = calloc(a->mesh_count + 1u, sizeof(float *));
     char *text = NULL, why[1024];
     size_t text_size = 0;
-    if (!weights || !pos || !nrm) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
-    if (pb_frame_weights(a, clip, args->time, weights, &err)) { status = cli_fail(verb->name, &err); goto done; }
+    if (!weights || !pos || !nrm) {
+        fprintf(stderr, "morphkit play: out of memory\n");
+        status = 1;
+        goto done;
+    }
+    if (pb_frame_weights(a, clip, args->time, weights, &err)) {
+        status = cli_fail(verb->name, &err);
+        goto done;
+    }
     if (args->weights && weights_arg_apply(a, args->weights, weights, why, sizeof why) != 0) {
         status = cli_usage_error(verb, "--weights: %s", why);
         goto done;
@@ -180,14 +216,27 @@ static int run_play(void *p)
         mk_mesh_get(a, i, &m);
         pos[i] = malloc(12u * (size_t)m.vertex_count);
         nrm[i] = m.has_normals ? malloc(12u * (size_t)m.vertex_count) : NULL;
-        if (!pos[i] || (m.has_normals && !nrm[i])) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
-        if (pb_eval_mesh(a, i, weights, stacking, nmode, pos[i], nrm[i], &err)) { status = cli_fail(verb->name, &err); goto done; }
+        if (!pos[i] || (m.has_normals && !nrm[i])) {
+            fprintf(stderr, "morphkit play: out of memory\n");
+            status = 1;
+            goto done;
+        }
+        if (pb_eval_mesh(a, i, weights, stacking, nmode, pos[i], nrm[i], &err)) {
+            status = cli_fail(verb->name, &err);
+            goto done;
+        }
         if (!args->space) pb_to_world(m.world, pos[i], nrm[i], m.vertex_count);
     }
     FILE *f = open_memstream(&text, &text_size);
-    if (!f) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
-    if (obj) write_obj(f, a, pos, nrm);
-    else write_json(f, a, pos, nrm, space, args->time, clip, weights);
+    if (!f) {
+        fprintf(stderr, "morphkit play: out of memory\n");
+        status = 1;
+        goto done;
+    }
+    if (obj)
+        write_obj(f, a, pos, nrm);
+    else
+        write_json(f, a, pos, nrm, space, args->time, clip, weights);
     fclose(f);
     out.file.data = text;
     out.file.size = text_size;
@@ -198,9 +247,11 @@ static int run_play(void *p)
     if (clip >= 0) {
         mk_clip_info ci;
         mk_clip_get(a, (uint32_t)clip, &ci);
-        fprintf(report, "%s: clip '%s' at %g s%s", args->input, ci.name, args->time, args->weights ? ", then --weights" : "");
+        fprintf(report, "%s: clip '%s' at %g s%s", args->input, ci.name, args->time,
+                args->weights ? ", then --weights" : "");
     } else {
-        fprintf(report, "%s: %s", args->input, args->weights ? "default weights, then --weights" : "default weights (no clip)");
+        fprintf(report, "%s: %s", args->input,
+                args->weights ? "default weights, then --weights" : "default weights (no clip)");
     }
     fprintf(report, "; %u mesh%s (%s space, %s) written to %s\n", a->mesh_count, a->mesh_count == 1 ? "" : "es", space,
             obj ? "OBJ" : "JSON", out.to_stdout ? "standard output" : args->output);

@@ -21,9 +21,13 @@ static void put_escaped(FILE *f, const char *s)
     fputc('"', f);
     for (; s && *s; s++) {
         unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\') { fputc('\\', f); fputc(c, f); }
-        else if (c < 0x20) fprintf(f, "\\u%04x", c);
-        else fputc(c, f);
+        if (c == '"' || c == '\\') {
+            fputc('\\', f);
+            fputc(c, f);
+        } else if (c < 0x20)
+            fprintf(f, "\\u%04x", c);
+        else
+            fputc(c, f);
     }
     fputc('"', f);
 }
@@ -35,7 +39,10 @@ static void element(json_writer *w, const char *key)
         indent(w);
     }
     w->first[w->depth] = 0;
-    if (key) { put_escaped(w->f, key); fputs(w->pretty ? ": " : ":", w->f); }
+    if (key) {
+        put_escaped(w->f, key);
+        fputs(w->pretty ? ": " : ":", w->f);
+    }
 }
 
 static void open_container(json_writer *w, const char *key, char c)
@@ -55,10 +62,22 @@ static void close_container(json_writer *w, char c)
     if (w->depth == 0) fputc('\n', w->f);
 }
 
-void json_object(json_writer *w, const char *key) { open_container(w, key, '{'); }
-void json_array(json_writer *w, const char *key) { open_container(w, key, '['); }
-void json_end_object(json_writer *w) { close_container(w, '}'); }
-void json_end_array(json_writer *w) { close_container(w, ']'); }
+void json_object(json_writer *w, const char *key)
+{
+    open_container(w, key, '{');
+}
+void json_array(json_writer *w, const char *key)
+{
+    open_container(w, key, '[');
+}
+void json_end_object(json_writer *w)
+{
+    close_container(w, '}');
+}
+void json_end_array(json_writer *w)
+{
+    close_container(w, ']');
+}
 
 void json_string(json_writer *w, const char *key, const char *value)
 {
@@ -68,7 +87,10 @@ void json_string(json_writer *w, const char *key, const char *value)
 
 static void put_number(FILE *f, double v)
 {
-    if (!isfinite(v)) { fputs("null", f); return; }
+    if (!isfinite(v)) {
+        fputs("null", f);
+        return;
+    }
     fprintf(f, "%.9g", v);
 }
 

@@ -7,12 +7,12 @@
 typedef struct json_writer {
     FILE *f;
     int depth;
-    int first[64];     /* per depth: no element written yet */
+    int first[64]; /* per depth: no element written yet */
     int pretty;
 } json_writer;
 
 void json_begin(json_writer *w, FILE *f, int pretty);
-void json_object(json_writer *w, const char *key);   /* key NULL inside arrays / at top */
+void json_object(json_writer *w, const char *key); /* key NULL inside arrays / at top */
 void json_array(json_writer *w, const char *key);
 void json_end_object(json_writer *w);
 void json_end_array(json_writer *w);

@@ -3,7 +3,8 @@
 #include "cli.h"
 
 static const cli_verb *const verbs[] = {
-    &cli_verb_import, &cli_verb_info, &cli_verb_play, &cli_verb_bake, &cli_verb_export, &cli_verb_conform, &cli_verb_bench,
+    &cli_verb_import, &cli_verb_info,    &cli_verb_play,  &cli_verb_bake,
+    &cli_verb_export, &cli_verb_conform, &cli_verb_bench,
 };
 #define VERB_COUNT (sizeof verbs / sizeof verbs[0])
 
@@ -24,7 +25,10 @@ static const cli_verb *find_verb(const char *name)
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) { usage(stderr); return CLI_EXIT_USAGE; }
+    if (argc < 2) {
+        usage(stderr);
+        return CLI_EXIT_USAGE;
+    }
     const char *first = argv[1];
     if (!strcmp(first, "--help") || !strcmp(first, "-h") || (!strcmp(first, "help") && argc == 2)) {
         usage(stdout);

@@ -105,16 +105,28 @@ int weights_arg_apply(const mk_asset *a, const char *spec, float *weights, char 
     char *copy = malloc(len + 1);
     uint32_t *found = malloc(((size_t)a->channel_count + 1) * sizeof *found);
     int status = -1;
-    if (!copy || !found) { snprintf(why, why_size, "out of memory"); goto done; }
+    if (!copy || !found) {
+        snprintf(why, why_size, "out of memory");
+        goto done;
+    }
     memcpy(copy, spec, len + 1);
     for (char *item = copy, *next; item; item = next) {
         next = strchr(item, ',');
         if (next) *next++ = 0;
         char *eq = strrchr(item, '=');
-        if (!item[0]) { snprintf(why, why_size, "an item of \"%.200s\" is empty (write NAME=V,NAME=V)", spec); goto done; }
-        if (!eq) { snprintf(why, why_size, "'%.200s' needs NAME=VALUE", item); goto done; }
+        if (!item[0]) {
+            snprintf(why, why_size, "an item of \"%.200s\" is empty (write NAME=V,NAME=V)", spec);
+            goto done;
+        }
+        if (!eq) {
+            snprintf(why, why_size, "'%.200s' needs NAME=VALUE", item);
+            goto done;
+        }
         *eq = 0;
-        if (!item[0]) { snprintf(why, why_size, "'=%.200s' has no channel name", eq + 1); goto done; }
+        if (!item[0]) {
+            snprintf(why, why_size, "'=%.200s' has no channel name", eq + 1);
+            goto done;
+        }
         char *end;
         double v = strtod(eq + 1, &end);
         if (!eq[1] || *end || !isfinite(v) || fabs(v) > 1e30) {
