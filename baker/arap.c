@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* As-rigid-as-possible surface deformation, local/global iterations on the factored Laplacian.
  *
  * Papers:

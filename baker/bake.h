@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Bakers: offline deformers that add channels to a raw model .
  *
  * Every baker turns a deformation of one mesh into an ordinary channel: one or more targets

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Shared baker helpers: bounds, welding, normals from a deformed surface, the point-map
  * evaluator used by FFD and Barr, timing.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Small shared pieces of the bakers: 3-vector / 3x3 helpers (double precision, row-major
  * 3x3 as m[3*row + col]), mesh bounding box, and normals recomputed from a deformed surface.
  * Internal to baker/ (not installed). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Barr's global deformations: taper, twist and bend, with exact Jacobians for the normals.
  *
  * Paper: A. H. Barr, "Global and Local Deformations of Solid Primitives", SIGGRAPH 1984.

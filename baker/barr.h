@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Barr's global deformations (taper, twist, bend) along an arbitrary axis. See barr.c. */
 #ifndef MK_BARR_H
 #define MK_BARR_H

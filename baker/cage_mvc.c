@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Cage deformation by mean value coordinates of a closed triangle cage.
  *
  * Paper: T. Ju, S. Schaefer, J. Warren, "Mean Value Coordinates for Closed Triangular Meshes",

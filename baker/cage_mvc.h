@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Cage deformation with mean value coordinates for closed triangle cages. See cage_mvc.c. */
 #ifndef MK_CAGE_MVC_H
 #define MK_CAGE_MVC_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Surface editing's entry for a bake: the constrained targets at an amplitude, then the
  * method's solve (Laplacian or ARAP), copied back to the render vertices. */
 #include "surface_edit_internal.h"

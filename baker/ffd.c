@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Free-form deformation: a lattice of control points deforms the space it encloses.
  *
  * Papers and sources:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Free-form deformation lattices (Sederberg-Parry Bernstein, uniform cubic B-spline). See ffd.c. */
 #ifndef MK_FFD_H
 #define MK_FFD_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Adaptive in-betweens: sample a deformation at amplitudes 0..1 and write the targets that make
  * the runtime's piecewise-linear playback follow it within a tolerance.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Turning a deformation into a channel: targets, in-betweens, playback error.
  *
  * A deformer is a function of an amplitude a in [0, 1] (0 = rest, 1 = full deformation). The

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Laplacian surface editing: keep the differential coordinates in the least-squares sense
  * while constrained vertices go where the handles put them.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* JSON bake recipes (docs/baking.md): parse, validate every field, then bake channel by channel.
  *
  * All or nothing: the whole recipe is parsed and checked before any baking starts, and if a

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The core of surface editing (Laplacian and ARAP): the position-welded mesh, its adjacency
  * and edge weights, the constraints (anchors and handles), the system matrix factored once with
  * CHOLMOD, and the solve. The methods are leaves on it (laplacian.c, arap.c); edit.c picks one.

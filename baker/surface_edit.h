@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Laplacian surface editing and as-rigid-as-possible deformation with handles and anchors,
  * solved with CHOLMOD (one factorization per bake). See laplacian.c and arap.c. */
 #ifndef MK_SURFACE_EDIT_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Surface editing internals: the core state and the functions its methods share (baker/ only). */
 #ifndef MK_SURFACE_EDIT_INTERNAL_H
 #define MK_SURFACE_EDIT_INTERNAL_H

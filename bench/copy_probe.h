@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The memory-bandwidth baseline of the benchmark. */
 #ifndef MK_BENCH_COPY_PROBE_H
 #define MK_BENCH_COPY_PROBE_H

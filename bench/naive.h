@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The naive baseline of the benchmark: dense float deltas, a loop over every vertex per active
  * target. */
 #ifndef MK_BENCH_NAIVE_H

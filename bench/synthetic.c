@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The synthetic benchmark asset: a wavy grid whose targets move spatially coherent regions. */
 #include <math.h>
 #include <stdio.h>

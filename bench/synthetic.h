@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The synthetic asset `morphkit bench` builds without a file. */
 #ifndef MK_BENCH_SYNTHETIC_H
 #define MK_BENCH_SYNTHETIC_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The benchmark's timing harness: a pool of threads that split a mesh as a job system would,
  * configurations timed round-robin, and the bytes a frame must move. */
 #define _GNU_SOURCE

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Timing evaluation the way an engine runs it: a pool of threads taking ranges of a mesh. */
 #ifndef MK_BENCH_TIMING_H
 #define MK_BENCH_TIMING_H

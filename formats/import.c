@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* mk_import_memory / mk_import_file: pick the reader from the content. */
 #include <stdio.h>
 #include <string.h>

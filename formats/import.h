@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Importing any source into the raw model: the one entry shape of every reader (FBX, glTF,
  * .morph). mk_import_memory picks the reader by content; mk_import_file reads the file first,
  * resolves glTF buffers against its folder and names the file in errors. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* mk_arena: every allocation is its own block from the user allocator, linked into a list so
  * mk_arena_free_all releases everything (no leak on any error path) and single blocks can
  * still be released or grown. A live-bytes limit and a fail-after-K hook make allocation

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Offline allocation for morphkit (importer, baker, tools). The runtime never allocates.
  *
  * mk_allocator is the user hook (zero-initialized means libc malloc/free, no limit).

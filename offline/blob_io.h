@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* raw model <-> .morph blob, and file helpers for offline tools. */
 #ifndef MK_BLOB_IO_H
 #define MK_BLOB_IO_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Whole-file reads into arena memory, and output writing that never loses data: a regular
  * file is replaced atomically (temporary file beside it, flushed, renamed), a symbolic link is
  * followed (the file it points at is replaced, the link stays a link), a device, FIFO or

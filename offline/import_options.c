@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "import_options.h"
 
 mk_result mk_import_options_check(const mk_import_options *o, size_t input_size, const char *format, mk_error *err)

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Options every importer takes (FBX, glTF, .morph), checked and applied in one place. Zero
  * means the default for every field. */
 #ifndef MK_IMPORT_OPTIONS_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Which render vertices belong together: welding by position, and smoothing groups for
  * normals. One definition shared by the importer's target normals and the bakers' normals from
  * deformed surfaces, so seams and hard edges behave the same everywhere.

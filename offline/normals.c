@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Target normals computed from target positions: a target without normal data gets normals
  * computed at import from its positions with the base mesh's triangles and smoothing (hard
  * edges kept); docs/semantics.md, "Normals and tangents".

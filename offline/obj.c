@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The one Wavefront OBJ reader of the offline tools: cages for the bakers, reference frames for
  * conformance. */
 #include <errno.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Reading Wavefront OBJ: vertices ("v"), normals ("vn", kept when there is one per vertex)
  * and faces ("f", polygons fan-triangulated, negative indices relative). */
 #ifndef MK_OBJ_H

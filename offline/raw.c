@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The raw model: growth helpers, warnings, ordering and validation. */
 #include <math.h>
 #include <stdarg.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The raw model: an editable, offline description of meshes, channels, in-between targets
  * and weight clips (docs/architecture.md). Importers fill it, bakers add to it, the writer
  * turns it into a .morph blob, the reader turns a blob back into it.

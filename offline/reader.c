@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* mk_read_blob: an opened .morph asset back into a raw model (deltas dequantized). Dense
  * blocks store zeros for vertices a target does not move; all-zero vertices of dense blocks
  * are dropped again (a vertex the author stored with a zero delta inside a dense block is

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* mk_write_blob: raw model -> .morph blob (runtime/format.h, docs/format.md).
  *
  * Layout: header | section table | STRINGS | MESHES | CHANNELS | TARGETS | CLIPS | TRACKS |

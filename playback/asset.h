@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Any input as an opened runtime asset: a .morph blob is opened as it is; any other file is
  * imported and written as a blob in memory first, so everything plays through the runtime. */
 #ifndef MK_PB_ASSET_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Conformance: one reference frame against the runtime's playback of the same asset. The
  * rules (which meshes are compared, how they are matched, how tolerances combine) are
  * docs/conformance.md; `morphkit conform` and the corpus tests both run them from here. */

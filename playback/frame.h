@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* One evaluated frame of an asset through the runtime's public jobs: weights from a clip or
  * the defaults, a mesh's positions and normals, the world transform. Shared by play, conform,
  * bench, render and the tests. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A conformance manifest (docs/conformance.md): cases, each a source file with reference
  * frames made by other software, read and checked field by field. */
 #ifndef MK_PB_MANIFEST_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A reference frame made by other software (or by 'morphkit frames'), read into one shape:
  * meshes with the names that match them to the import, their channel weights, positions and
  * (where present) normals. Kinds and their matching rules: docs/conformance.md. */

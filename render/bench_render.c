@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* render_bench [level] [rounds]: times mkr_draw_mesh on a subdivided sphere (level 7:
  * 163842 vertices, 327680 triangles) in a 512x512 cell, per view, then a 6-cell contact
  * sheet and its PNG encoding. Prints the best and median milliseconds. Not a test. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Orthographic cameras: look-at orientation, the four standard views, and framing of a
  * bounding box into a viewport.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A perceptually ordered color map and a legend bar to read it.
  *
  * The ramp is defined in the Oklab color space (B. Ottosson's perceptual Lab, 2020): the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Generated meshes for the render benchmark and demo (not part of the library). */
 #ifndef MKR_DEMO_MESH_H
 #define MKR_DEMO_MESH_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* render_demo DIR: writes sample pictures into DIR to look at (not a test):
  *   bulge_sheet.png   contact sheet, sphere with a bulge growing over 6 frames (iso view)
  *   bulge_diff.png    diff sheet of those frames against a slightly different bulge, one

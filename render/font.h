@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A built-in 5x9 bitmap font (ASCII 32..126) and text drawing at integer scale.
  *
  * A glyph is 5 columns by 9 rows: rows 0-6 stand on the baseline (capitals and digits are 7

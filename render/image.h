@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* An RGBA8 picture with a float depth buffer: the target every drawing function writes to. */
 #ifndef MKR_IMAGE_H
 #define MKR_IMAGE_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The one translation unit that compiles stb_image_write (Debian's libstb-dev). */
 #include <limits.h>
 #include <stdlib.h>

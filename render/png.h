@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* PNG encoding of an mkr_image, in memory: the caller decides where the bytes go. */
 #ifndef MKR_PNG_H
 #define MKR_PNG_H

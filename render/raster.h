@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Software rasterizer: indexed triangle meshes into an mkr_image through an orthographic
  * mkr_camera, with a depth buffer and one fixed directional light.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* morphkit_render: pictures of meshes for people to look at (docs/rendering.md).
  *
  *   mkr_sheet_desc desc = { .cells = cells, .cell_count = n, .cell_width = 512, .cell_height = 512,

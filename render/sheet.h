@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Contact sheets: one picture of many frames, each frame a cell of a grid, all drawn through
  * one fixed camera framed on the union of every frame's bounds, so motion shows as change
  * between cells.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* mk_checksum: a 64-bit hash over little-endian 8-byte words, four independent lanes so it
  * runs near memory speed (opening validates it in the same O(size) pass as everything else).
  * It detects corruption, it is not a cryptographic hash. docs/format.md gives the algorithm:

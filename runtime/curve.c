@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Weight curves and the clip sampling job.
  *
  * A curve is a list of mk_key with strictly increasing times. Segment k -> k+1 follows the

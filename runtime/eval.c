@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Morph evaluation (docs/semantics.md).
  *
  * Per frame, once per job: every target of the mesh gets one scalar coefficient from the

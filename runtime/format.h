@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The .morph blob layout, version 2 (docs/format.md is the prose description).
  *
  * Little-endian. Every record and array starts at a multiple of 16 bytes from the blob start.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* mk_asset_open: validates a .morph blob once, in one O(size) pass, so that no hot path ever
  * checks again. Every offset, count and index is checked against the blob size with
  * overflow-safe arithmetic; every float is checked finite; sorted data is checked sorted.
@@ -436,6 +437,8 @@ mk_result mk_asset_open(const void *data, size_t size, mk_asset *out, mk_error *
 /* ---- queries ---- */
 
 static const char *string_at(const mk_asset *a, uint32_t offset) { return a->strings + offset; }
+
+uint32_t mk_version(void) { return MK_VERSION; }
 
 int mk_is_blob(const void *data, size_t size)
 {

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The smallest complete engine integration (docs/embedding.md walks through it):
  * load a .morph file into aligned memory, open it in place, and per frame sample the first
  * clip and evaluate every mesh into a vertex buffer. Only the runtime is linked. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Builds the bundled example asset by code (no external files): a tube with a "bulge"
  * channel and a progressive "bend" channel (four in-betweens sampled from an exact bend, so
  * playback follows the curved path), normals computed from the targets, and a clip "wave"

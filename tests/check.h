@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A tiny test harness: plain C, one runner per test program, a closing summary line
  * "N passed, N failed" (the format CI reads). A test case is a function; CHECK records a
  * failure with file:line and keeps going, so one run shows every broken property. */

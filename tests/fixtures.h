@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Small raw assets built by code for tests, with hand-checkable deltas. */
 #ifndef MK_FIXTURES_H
 #define MK_FIXTURES_H

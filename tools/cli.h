@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The morphkit command-line program: one verb per file (cmd_*.c), thin over the libraries.
  * Each verb declares its command line as a cli_verb (cli_args.h). */
 #ifndef MK_CLI_H

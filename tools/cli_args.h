@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The command line of each verb, declared once as data: its usage line, description,
  * positional argument and options (value kind, accepted range or choices, default, unit,
  * meaning). One parser reads argv against that table, checks every value and prints exact

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Shared helpers of the verbs. */
 #include <string.h>
 #include <time.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* morphkit bake: applies a bake recipe (docs/baking.md) and writes the asset with the baked
  * channels added. Nothing is written when the recipe or any channel fails. */
 #include <stddef.h>

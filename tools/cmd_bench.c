@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* morphkit bench [FILE] [--vertices N] [--channels C] [--active A] [--density D] [--threads T]
  *                [--frames F] [--json] [--profile N]
  *

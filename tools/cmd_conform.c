@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* morphkit conform: playback checked against reference frames made by other software. The
  * checking itself is playback/conform.c, shared with the corpus tests. */
 #include <math.h>

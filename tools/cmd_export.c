@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* morphkit export: meshes, morph targets (baked ones included) and weight clips as glTF 2.0,
  * so any glTF viewer plays the result, plus the channel sidecar that lets
  * `morphkit import OUT.glb --channels OUT.channels.json` restore progressive channels.

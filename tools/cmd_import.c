@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* morphkit import: any source file into a .morph blob. */
 #include <stddef.h>
 #include <stdlib.h>

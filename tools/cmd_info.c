@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* morphkit info FILE [--json]: meshes, channels with in-betweens and full weights, clips,
  * sizes, precision and the quantization error bound. Any input works; non-.morph inputs are
  * imported and written in memory with the default options first. */

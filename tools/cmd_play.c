@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* morphkit play: one frame through the runtime, written as JSON shaped like the conformance
  * reference frames (meshes[] with name, positions, normals) or as OBJ. */
 #include <stddef.h>

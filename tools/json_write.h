@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A minimal streaming JSON writer for the CLI's outputs (commas and nesting tracked). */
 #ifndef MK_JSON_WRITE_H
 #define MK_JSON_WRITE_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* morphkit: one command-line program with verbs; all logic lives in the libraries. */
 #include <string.h>
 #include "cli.h"
@@ -35,7 +36,7 @@ int main(int argc, char **argv)
         return CLI_EXIT_OK;
     }
     if (!strcmp(first, "--version")) {
-        printf("morphkit 0.1.0 (blob format v%u)\n", MK_FORMAT_VERSION);
+        printf("morphkit %s (blob format v%u)\n", MK_VERSION_STRING, MK_FORMAT_VERSION);
         return CLI_EXIT_OK;
     }
     if (!strcmp(first, "help")) {

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* --weights NAME=V,... : channel weights given by name on the command line. */
 #ifndef MK_WEIGHTS_ARG_H
 #define MK_WEIGHTS_ARG_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* FBX weight curves into mk_key tracks.
  *
  * 7.x AnimationCurve (FbxAnimCurveDef; ufbx.c ufbxi_read_animation_curve): KeyTime (KTime),

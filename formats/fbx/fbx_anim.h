@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* FBX weight curves into mk_key tracks (fbx_anim.c). */
 #ifndef MK_FBX_ANIM_H
 #define MK_FBX_ANIM_H

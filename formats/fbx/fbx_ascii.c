@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* ASCII FBX reader (6.x and 7.x syntax) into the fbx_doc tree.
  *
  * Syntax (ufbx.c ASCII tokenizer; observed in Maya, Blender, ZBrush and 3ds Max files):

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Binary FBX reader: node records into the fbx_doc tree.
  *
  * Layout (Blender's "FBX binary file format specification", 2013; fbx-book; ufbx.c

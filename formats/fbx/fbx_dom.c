@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Accessors over the FBX document tree: child lookup, scalar values, properties and lazy array
  * decoding (zlib via libdeflate for binary arrays, text for ASCII arrays, scalar runs for
  * FBX 5.x/6.x binary).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* mk_import_fbx: binary or ASCII FBX from memory into the raw model.
  *
  * Steps: parse the file into a node tree (fbx_binary.c / fbx_ascii.c, with limits against

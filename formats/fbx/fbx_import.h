@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The FBX reader: binary (either byte order) or ASCII FBX, versions 5.x to 7.x, from memory
  * into the raw model. Behaviour and limits: docs/importing-fbx.md. */
 #ifndef MK_FBX_IMPORT_H

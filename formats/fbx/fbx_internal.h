@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* FBX importer internals: the document tree both parsers build, its accessors, and the
  * interpretation steps (scene, mesh, blend shapes, curves, transforms).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* FBX mesh geometry into a raw mesh: control points, polygons, normal and UV layer elements,
  * render vertices and triangles; and blend shape deltas expanded onto render vertices.
  *

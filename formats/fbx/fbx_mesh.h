@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* FBX mesh conversion and blend shape expansion (fbx_mesh.c). */
 #ifndef MK_FBX_MESH_H
 #define MK_FBX_MESH_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* FBX scene interpretation: objects, connections, meshes, blend shapes and weight animation
  * into the raw model.
  *

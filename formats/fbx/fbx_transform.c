@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* FBX node transforms at rest.
  *
  * The FBX SDK transform stack (FBX SDK "Computing transformation matrix", FbxNode docs; ufbx

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* FBX node transforms at rest (fbx_transform.c). Column-major doubles, m[col * 4 + row]. */
 #ifndef MK_FBX_TRANSFORM_H
 #define MK_FBX_TRANSFORM_H

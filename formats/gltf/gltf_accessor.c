@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* glTF accessor decoding (spec §3.6.2), KHR_mesh_quantization component types and
  * EXT_meshopt_compression bufferViews. tinygltf parses accessors but applies neither sparse
  * substitution nor meshopt, and accepts accessors without bufferView; all of that is done here,

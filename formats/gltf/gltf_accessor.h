@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Decoding glTF accessors into floats and indices: strides, normalized and integer
  * components (KHR_mesh_quantization), sparse substitution, accessors without bufferView (zeros)
  * and EXT_meshopt_compression bufferViews. Every offset, count and index is checked; errors

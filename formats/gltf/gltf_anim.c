@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* glTF weight animations → raw clips (spec §3.11 and Appendix C).
  *
  * One clip per glTF animation, in the same order, so a reference frame that names glTF

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // glTF parsing shim: tinygltf (JSON, GLB, buffers, data URIs) + libdraco, exposed to the C
 // importer as the plain structs of gltf_doc.h.
 //

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A plain C view of a parsed glTF 2.0 document (.gltf or .glb).
  *
  * gltf_doc.cc parses the JSON and loads buffers with tinygltf (C++), decodes

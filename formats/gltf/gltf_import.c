@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* glTF 2.0 → raw model (docs/importing-gltf.md).
  *
  * Every (node, primitive) whose mesh has morph targets becomes one raw mesh: render vertex i is

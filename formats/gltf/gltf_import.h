@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The glTF reader: .gltf or .glb from memory into the raw model. External buffers resolve
  * against options->base_dir only; a channel sidecar (options->channels_sidecar or its text)
  * regroups targets into progressive channels. Behaviour: docs/importing-gltf.md. */

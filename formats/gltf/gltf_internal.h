@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Shared between the glTF importer's C files (not a public header). */
 #ifndef MK_GLTF_INTERNAL_H
 #define MK_GLTF_INTERNAL_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The glTF channel sidecar (format: docs/importing-gltf.md). glTF has no in-between
  * concept, so `morphkit export` writes each progressive channel as several glTF targets and this
  * JSON file says which targets form which channel, with their full weights; re-import restores

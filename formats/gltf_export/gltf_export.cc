@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // raw model → glTF 2.0 (.gltf with an embedded buffer, or .glb), written with tinygltf's
 // serializer, plus the channel sidecar that lets a re-import restore progressive channels
 // (format and behaviour: docs/importing-gltf.md).

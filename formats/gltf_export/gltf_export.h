@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The glTF writer: a raw model as glTF 2.0 (.glb or .gltf), plus the channel sidecar that lets
  * a re-import restore progressive channels. Behaviour: docs/importing-gltf.md. */
 #ifndef MK_GLTF_EXPORT_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* morphkit runtime: open a .morph blob in place, sample weight clips, evaluate morphs.
  *
  * C11, libc only, never allocates, no global state. Every function is thread-safe for
@@ -24,6 +25,16 @@
 extern "C" {
 #endif
 
+/* The library's version (meson.build reads the same numbers from VERSION; a test fails when they
+ * differ). Minor versions add API; the blob format has its own number, MK_FORMAT_VERSION:
+ * blobs are readable by every runtime of the same format version (docs/embedding.md). */
+#define MK_VERSION_MAJOR 0
+#define MK_VERSION_MINOR 2
+#define MK_VERSION_PATCH 0
+#define MK_VERSION ((MK_VERSION_MAJOR * 10000) + (MK_VERSION_MINOR * 100) + MK_VERSION_PATCH)
+#define MK_VERSION_STRING "0.2.0"
+
+/* The version of the blob format this runtime reads and the tools write. */
 #define MK_FORMAT_VERSION 2u
 
 /* Consecutive key points of a channel (its full weights and the implicit 0) are at least this
@@ -59,6 +70,9 @@ typedef struct mk_error {
 } mk_error;
 
 const char *mk_result_name(mk_result code);
+
+/* MK_VERSION of the compiled library: compare with the header's to catch a mismatched build. */
+uint32_t mk_version(void);
 
 /* Channel stacking on a mesh (docs/semantics.md). */
 typedef enum mk_stacking {

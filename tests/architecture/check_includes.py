@@ -7,7 +7,8 @@ include from, then checks every C/C++ source of the repository:
   - the runtime includes nothing but C library headers;
   - no two files include each other through a circle, and the modules form no circle;
   - code, build files and docs cite nothing outside the repository (the team's background
-    files, issue numbers).
+    files, issue numbers);
+  - every C/C++ source starts with its SPDX licence line (engines copy sources).
 Prints one line per check and "N passed, N failed"."""
 import os, re, subprocess, sys
 
@@ -143,6 +144,10 @@ for src, targets in graph.items():
             mgraph.setdefault(a, set()).add(b)
 mcycle = find_cycle({k: sorted(v) for k, v in mgraph.items()})
 check("no circle between modules", [" -> ".join(mcycle)] if mcycle else [])
+
+# ---- licence ----
+missing = [f for f in sources if "SPDX-License-Identifier: MIT" not in open(os.path.join(root, f), errors="replace").readline()]
+check("every C/C++ source starts with its SPDX licence line", missing)
 
 # ---- self-contained ----
 outside = []

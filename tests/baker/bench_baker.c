@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Baker benchmark: Laplacian (cotangent) and ARAP (10 iterations) bakes of a ~100 000-vertex
  * sphere, one factorization each; prints factor time, per-solve time and total wall time.
  * usage: bench_baker [rings segments]   (default 250 x 400 = 99 602 vertices) */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* `morphkit bake` end to end: bake a sample recipe onto samples/make_example's tube, open the
  * result with the runtime, and check that a bad recipe fails without writing anything.
  * usage (from meson): test_bake_cli MORPHKIT MAKE_EXAMPLE RECIPES_DIR WORK_DIR */

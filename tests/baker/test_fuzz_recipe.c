@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The recipe fuzz target (tests/fuzz/fuzz_recipe.c) as a plain regression test: every sample
  * recipe, all its truncations and single-byte flips must give a result or a clean error. */
 #include <stdint.h>

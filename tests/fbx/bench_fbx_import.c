@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* FBX import benchmark (built, not run as a test).
  *
  * Writes a large binary FBX 7500 with the test writer into a temporary directory: a grid mesh

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Prints the node tree of an FBX file (development aid; not a test). */
 #include <stdio.h>
 #include <stdlib.h>

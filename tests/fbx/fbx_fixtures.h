@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Writer-made FBX fixtures shared by the FBX tests, the fuzz seeds and the benchmark. */
 #ifndef MK_TESTS_FBX_FIXTURES_H
 #define MK_TESTS_FBX_FIXTURES_H

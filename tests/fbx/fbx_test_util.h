@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Helpers shared by the FBX tests: evaluate an imported raw model through the public runtime
  * and read positions back per control point in world space. */
 #ifndef MK_TESTS_FBX_UTIL_H

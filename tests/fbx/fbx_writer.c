@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Test-only FBX writer (see fbx_writer.h). Binary records follow the layout fbx_binary.c
  * reads (13-byte headers below 7500, 25-byte from 7500, a null record closing every child
  * list); ASCII follows the 7.x syntax with `*N { a: ... }` arrays and, from 7200, integer bit

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Test-only FBX writer: binary (7100..7700 record layout, optional zlib arrays) and ASCII 7.x
  * files with meshes, blend shape channels with in-betweens, DeformPercent curves and an
  * animation stack. Tests build their fixtures with it, round-trip them through mk_import_fbx,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* FBX import against the shared corpus: every "fbx" case of cases.json is imported, written as
  * a float blob and checked frame by frame with the conformance check `morphkit conform` uses
  * (playback/conform.c: the static state for "time": null, the first stack otherwise; world

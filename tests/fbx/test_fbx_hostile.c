@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Hostile input: the fuzz target's function (tests/fuzz/fuzz_fbx.c, LLVMFuzzerTestOneInput)
  * over every truncation length and seeded random byte changes of
  *   - writer-made fixtures (binary 7400/7500 raw and zlib, big-endian 7100 raw and 7500 zlib

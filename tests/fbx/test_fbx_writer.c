@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* FBX import of writer-made fixtures: every format the writer produces (binary 7100..7700,
  * 13/25-byte records, raw and zlib arrays, ASCII 7100..7700) imports to the same raw model and
  * evaluates to the positions computed here by hand from the fixture's definition (shape

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* libFuzzer target for the FBX importer (binary and ASCII): any input must give an error or
  * a raw model that passes mk_raw_validate, never a crash, hang or out-of-bounds access.
  * tests/fbx/test_fbx_hostile.c links this same function and runs it over every truncation and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* libFuzzer target for the glTF importer: arbitrary bytes as .gltf/.glb (external files are
  * refused when loading from memory, so only embedded/data-URI buffers are exercised). Every
  * input must either import or fail with a message; never crash, hang or read out of bounds.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* libFuzzer target: mk_asset_open on arbitrary bytes, then (if it opens) sampling and
  * evaluation of every mesh/clip. Any crash, overread or UB is a bug. The checksum would stop
  * nearly every mutation at the door, so the first byte of the input selects whether the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Writes fuzz seeds for fuzz_open: the test fixtures as blobs (q16 and float), each prefixed
  * with the "recompute checksum" selector byte. usage: make_seeds DIR */
 #include <stdio.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Helpers shared by the glTF tests, thin over the playback library: import a file, write it as
  * a float .morph blob, open it with the runtime and evaluate frames through the public jobs, so
  * the tests check the whole path an engine would use; corpus cases are checked by the same

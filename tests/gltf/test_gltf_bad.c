@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Bad glTF input gives a clear error, never a crash (run under ASan/UBSan in CI).
  *
  * Fixtures are generated here: one small valid .gltf (a triangle with one morph target and a

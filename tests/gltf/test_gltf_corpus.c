@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* glTF import against the corpus: every "gltf" case of cases.json matches its three.js
  * reference frames (positions within the case tolerance, normal directions), and every
  * derived variant (sparse, Draco, quantized, meshopt, gltfpack) evaluates to the same world

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* glTF export: export → re-import → the original's reference frames still match (every glTF
  * case of the corpus, .glb and .gltf, with and without the channel sidecar); progressive
  * channels and mixed curves survive a round trip through the sidecar; exported files pass the

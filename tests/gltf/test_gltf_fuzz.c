@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Regression run of the glTF fuzz target (tests/fuzz/fuzz_gltf.c) over the corpus: every
  * glTF/GLB file whole, truncated at a spread of lengths, and with random byte flips. The
  * target aborts when a failure has no message; ASan/UBSan catch the rest. .gltf files with

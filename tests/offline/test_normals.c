@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Target normals computed from target positions: they equal normals computed from scratch
  * on the deformed mesh (property), UV-seam duplicates smooth together, hard edges stay hard,
  * and tangents stay orthogonal to the new normals. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Offline core: deterministic writer, raw -> blob -> raw round trip, quantization within the
  * tolerance (with float fallback), raw validation errors, failing allocation K for every K,
  * atomic file writes. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* morphkit_render: silhouettes of the standard views, light direction and normals, depth,
  * the fill rule, font, color map, sheets and PNG bytes. */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The reference evaluator (see reference_eval.h): docs/semantics.md in double precision.
  *
  * The semantics part (key points, span rule, D(w), beta, the stacking recurrence, nlerp,

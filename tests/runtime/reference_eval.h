@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A second evaluator, for tests only: docs/semantics.md ("Channel displacement", "Stacking",
  * "Normals and tangents") written out in double precision, one vertex and one channel at a
  * time, straight from the raw model (offline/raw.h). It shares nothing with the runtime or

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Blob robustness: every truncation, random byte flips (with and without a recomputed
  * checksum, so validation beyond the checksum is exercised), and targeted corruptions each
  * give an error or a valid open -- never a crash or out-of-bounds read (run under ASan+UBSan

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Every interpolation mode of weight curves against hand-computed values, and the sampling job. */
 #include "check.h"
 #include "fixtures.h"

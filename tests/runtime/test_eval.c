@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Evaluation semantics (docs/semantics.md) against hand-computed values: in-betweens, negative full
  * weights, extrapolation, sequential stacking, nlerp/slerp normals, vertex ranges, strides. */
 #include <stdlib.h>

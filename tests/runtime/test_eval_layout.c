@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Block storage against a reference computed straight from the raw model: masks with one or
  * many runs of moved vertices (bit 0, bit 63, single bits, whole blocks, blocks stored dense
  * with zeros), partial last blocks, normals and tangents, float and int16 data; the store

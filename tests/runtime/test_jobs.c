@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Every invalid evaluation and sampling job is rejected with the right code (JobValidity
  * style): start from a valid job, break one field at a time. */
 #include <stdlib.h>

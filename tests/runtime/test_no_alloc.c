@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The runtime never allocates: open, sample and evaluate (every mode) under a malloc hook
  * that counts calls. The hook replaces the allocator for this test program only; under
  * AddressSanitizer (which owns malloc) the case reports itself skipped, and the symbol check

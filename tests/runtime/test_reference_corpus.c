@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The corpus frames under the modes its references do not cover. The corpus references
  * (ufbx, three.js, the authoring tools) are additive stacking with nlerp normals only; here
  * every case of cases.json is imported (mk_import_file), written as a float32 and an int16

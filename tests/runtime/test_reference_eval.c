@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The runtime against the reference evaluator (reference_eval.c, docs/semantics.md in double
  * precision from the raw model), not against itself.
  *
