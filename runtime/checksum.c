@@ -6,6 +6,7 @@
  *   tail bytes are zero-padded into a last word; h = fold of the lanes with the size. */
 #include <string.h>
 #include "format.h"
+#include "determinism.h"
 
 #define K1 0x9E3779B185EBCA87ull
 #define K2 0xC2B2AE3D27D4EB4Full

@@ -20,6 +20,7 @@
 #include <string.h>
 #include "format.h"
 #include "morphkit.h"
+#include "determinism.h"
 
 static double bezier1(double p0, double p1, double p2, double p3, double u)
 {

@@ -27,6 +27,7 @@
 #endif
 #include "format.h"
 #include "morphkit.h"
+#include "determinism.h"
 
 /* ---- channel spans ---- */
 

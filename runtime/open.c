@@ -10,6 +10,7 @@
 #include <string.h>
 #include "format.h"
 #include "morphkit.h"
+#include "determinism.h"
 
 /* ---- error message building ---- */
 
