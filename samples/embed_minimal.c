@@ -51,7 +51,7 @@ int main(int argc, char **argv)
             size_t stride = 6 * sizeof(float);
             float *vertices = malloc(stride * mesh.vertex_count);
             size_t scratch_size = mk_eval_scratch_size(&asset, m);
-            void *scratch = aligned_alloc(16, (scratch_size + 15) & ~(size_t)15);
+            void *scratch = aligned_alloc(16, (scratch_size + 31) & ~(size_t)15);   /* never 0 bytes */
             mk_eval_job job = {
                 .asset = &asset, .mesh = m, .vertex_count = MK_VERTICES_TO_END,
                 .weights = weights + mesh.first_channel, .weight_count = mesh.channel_count,
