@@ -48,6 +48,9 @@ typedef struct mk_bake_options {
      * refused and work is capped (samples <= 200, lattice dims <= 8, ARAP iterations <= 50,
      * in-betweens <= 32), so a hostile recipe cannot read files or run for hours. */
     int untrusted;
+    /* Called with the path of every file the recipe makes the bake read (cage OBJ files), e.g.
+     * for a build system's depfile; may be NULL. */
+    void (*file_read)(void *user, const char *path);
 } mk_bake_options;
 
 /* Applies a JSON recipe (docs/baking.md) to raw. options may be NULL (defaults). All or

@@ -467,6 +467,7 @@ static mk_result load_cage_file(recipe_ctx *ctx, const cJSON *ch, const char *pa
     mk_obj obj;
     if (mk_obj_read(full, ctx->scratch, &obj, &inner) != MK_OK)
         return mk_error_set(ctx->err, inner.code, inner.offset, "%s.%s: %s", path, field, inner.message);
+    if (ctx->options && ctx->options->file_read) ctx->options->file_read(ctx->options->user, full);
     *verts = obj.positions;
     *nv = obj.vertex_count;
     *tris = obj.triangles;

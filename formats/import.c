@@ -57,10 +57,11 @@ mk_result mk_import_file(const char *path, const mk_import_options *options, mk_
     size_t size;
     mk_result r =
         mk_read_file(&tmp, path, o.max_input_size ? o.max_input_size : MK_IMPORT_DEFAULT_MAX_INPUT, &data, &size, err);
-    if (r != MK_OK) {
+    if (r != MK_OK) {  /* the message names the file */
         mk_arena_free_all(&tmp);
         return r;
-    } /* the message names the file */
+    }
+    if (o.file_read) o.file_read(o.file_read_user, path);
     char *dir = NULL;
     if (!o.base_dir) {
         const char *slash = strrchr(path, '/');

@@ -18,6 +18,10 @@ typedef struct mk_import_options {
     const char *channels_sidecar;  /* glTF: path of a sidecar JSON grouping targets into channels */
     const char *channels_sidecar_text; /* ... or its text (channels_sidecar_size bytes) */
     size_t channels_sidecar_size;
+    /* Called with the path of every file the import reads (the source, the sidecar, glTF
+     * external buffers), e.g. for a build system's depfile; may be NULL. */
+    void (*file_read)(void *user, const char *path);
+    void *file_read_user;
 } mk_import_options;
 
 #define MK_IMPORT_DEFAULT_MAX_INPUT ((size_t)4 << 30)

@@ -10,7 +10,7 @@
 #include "import.h"
 
 extern const cli_verb cli_verb_import, cli_verb_info, cli_verb_play, cli_verb_bake, cli_verb_export, cli_verb_conform,
-    cli_verb_bench;
+    cli_verb_bench, cli_verb_embed;
 
 /* Prints the warnings of a raw model to stderr ("warning: ..."); nothing when there are none. */
 void cli_print_warnings(const mk_raw_asset *raw);
@@ -35,6 +35,21 @@ int cli_output_check(const cli_verb *verb, cli_output *out, const char *option, 
                      uint32_t input_count);
 /* Writes the outputs all or none (standard output last). Returns 0 or the exit status. */
 int cli_write_outputs(const cli_verb *verb, cli_output *outs, uint32_t count);
+
+/* ---- depfiles ---- */
+
+/* The files a command read, for a build system's depfile (make syntax, as ninja reads it):
+ * "OUTPUT: INPUT...". Collect with cli_depfile_add (it fits the importers' and the bakers'
+ * file_read callbacks); render with cli_depfile_text. */
+typedef struct cli_depfile {
+    char **paths;
+    size_t count, capacity;
+} cli_depfile;
+
+void cli_depfile_add(void *depfile, const char *path);
+/* The depfile's text for `target` (malloc'ed; NULL on OOM); frees the collected paths. */
+char *cli_depfile_text(cli_depfile *d, const char *target, size_t *size);
+void cli_depfile_free(cli_depfile *d);
 
 /* ---- progress ---- */
 

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Shared helpers of the verbs. */
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
@@ -58,6 +59,66 @@ int cli_write_outputs(const cli_verb *verb, cli_output *outs, uint32_t count)
         }
     }
     return 0;
+}
+
+void cli_depfile_add(void *user, const char *path)
+{
+    cli_depfile *d = user;
+    for (size_t i = 0; i < d->count; i++)
+        if (!strcmp(d->paths[i], path)) return;
+    if (d->count == d->capacity) {
+        size_t cap = d->capacity ? 2 * d->capacity : 8;
+        char **grown = realloc(d->paths, cap * sizeof *grown);
+        if (!grown) return;   /* a missing dependency only costs a rebuild that does not happen */
+        d->paths = grown;
+        d->capacity = cap;
+    }
+    size_t n = strlen(path);
+    char *copy = malloc(n + 1);
+    if (!copy) return;
+    memcpy(copy, path, n + 1);
+    d->paths[d->count++] = copy;
+}
+
+/* A path in make syntax: spaces and '#' escaped with '\\', '$' doubled. */
+static size_t escape_path(char *out, const char *path)
+{
+    size_t n = 0;
+    for (const char *p = path; *p; p++) {
+        if (*p == ' ' || *p == '#') { if (out) out[n] = '\\'; n++; }
+        if (*p == '$') { if (out) out[n] = '$'; n++; }
+        if (out) out[n] = *p;
+        n++;
+    }
+    return n;
+}
+
+char *cli_depfile_text(cli_depfile *d, const char *target, size_t *size)
+{
+    size_t n = escape_path(NULL, target) + 3;
+    for (size_t i = 0; i < d->count; i++) n += escape_path(NULL, d->paths[i]) + 3;
+    char *text = malloc(n + 1);
+    size_t at = 0;
+    if (text) {
+        at += escape_path(text, target);
+        text[at++] = ':';
+        for (size_t i = 0; i < d->count; i++) {
+            text[at++] = ' ';
+            at += escape_path(text + at, d->paths[i]);
+        }
+        text[at++] = '\n';
+        text[at] = 0;
+    }
+    cli_depfile_free(d);
+    *size = at;
+    return text;
+}
+
+void cli_depfile_free(cli_depfile *d)
+{
+    for (size_t i = 0; i < d->count; i++) free(d->paths[i]);
+    free(d->paths);
+    memset(d, 0, sizeof *d);
 }
 
 double cli_now_seconds(void)

@@ -8,7 +8,7 @@
 #include "cli.h"
 
 typedef struct bake_args {
-    const char *input, *output, *recipe;
+    const char *input, *output, *recipe, *depfile;
     int precision, quiet, all_meshes;
 } bake_args;
 
@@ -24,6 +24,10 @@ static const cli_option options[] = {
       "How deltas are stored (as for 'morphkit import').", "q16", "q16|float", 0, 0, 0, 0 },
     { "--all-meshes", NULL, CLI_FLAG, offsetof(bake_args, all_meshes),
       "Also write meshes that end up without channels (by default they are left out).", NULL, NULL, 0, 0, 0, 0 },
+    { "--depfile", "PATH", CLI_STRING, offsetof(bake_args, depfile),
+      "Also write a depfile for build systems (make syntax, as ninja and meson read it): the blob and every file the bake "
+      "read (the input, the recipe, the cages it names).",
+      NULL, NULL, 0, 0, 0, 0 },
     { "--quiet", NULL, CLI_FLAG, offsetof(bake_args, quiet),
       "No progress lines and no solver details (results are still printed).", NULL, NULL, 0, 0, 0, 0 },
 };
@@ -49,7 +53,14 @@ const cli_verb cli_verb_bake = {
 typedef struct bake_ui {
     int quiet;
     cli_progress progress;
+    cli_depfile deps;
 } bake_ui;
+
+static void on_file_read(void *user, const char *path)
+{
+    bake_ui *ui = user;
+    cli_depfile_add(&ui->deps, path);
+}
 
 static void on_progress(void *user, const char *stage, double fraction)
 {
@@ -92,60 +103,58 @@ static int run_bake(void *p)
     const cli_verb *verb = &cli_verb_bake;
     static const char *const extensions[] = { ".morph", NULL };
     const char *inputs[] = { a->input, a->recipe };
-    cli_output out;
-    int status = cli_output_check(verb, &out, "-o", a->output, extensions, "a .morph blob", 0, inputs, 2);
+    cli_output outs[2];
+    int status = cli_output_check(verb, &outs[0], "-o", a->output, extensions, "a .morph blob", 0, inputs, 2);
     if (status >= 0) return status;
+    if (a->depfile && (status = cli_output_check(verb, &outs[1], "--depfile", a->depfile, NULL, "a depfile", 0, inputs, 2)) >= 0)
+        return status;
 
     bake_ui ui = { .quiet = a->quiet };
     cli_progress_init(&ui.progress, a->quiet);
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err;
-    mk_import_options io = { .keep_plain_meshes = 1 }; /* a plain mesh is a baker's natural input */
+    /* A plain mesh is a baker's natural input: meshes without targets are kept. */
+    mk_import_options io = { .keep_plain_meshes = 1, .file_read = a->depfile ? cli_depfile_add : NULL,
+                             .file_read_user = &ui.deps };
+    void *recipe = NULL, *blob = NULL;
+    size_t recipe_size = 0, size = 0;
+    char *dep_text = NULL;
     mk_result r = mk_import_file(a->input, &io, &raw, &err);
-    if (r != MK_OK) {
-        mk_raw_free(&raw);
-        return cli_fail(verb->name, &err);
-    }
-    void *recipe = NULL;
-    size_t recipe_size = 0;
-    r = mk_read_file(&raw.arena, a->recipe, (size_t)64 << 20, &recipe, &recipe_size, &err);
-    if (r != MK_OK) {
-        mk_raw_free(&raw);
-        return cli_fail(verb->name, &err);
-    }
-
+    if (r == MK_OK) r = mk_read_file(&raw.arena, a->recipe, (size_t)64 << 20, &recipe, &recipe_size, &err);
+    if (r == MK_OK && a->depfile) cli_depfile_add(&ui.deps, a->recipe);
     char dir[4096];
     dir_of(a->recipe, dir, sizeof dir);
-    mk_bake_options bo = { .base_dir = dir, .progress = on_progress, .channel_done = on_channel, .user = &ui };
+    mk_bake_options bo = { .base_dir = dir, .progress = on_progress, .channel_done = on_channel, .user = &ui,
+                           .file_read = a->depfile ? on_file_read : NULL };
     mk_bake_report report;
-    r = mk_bake_recipe(&raw, recipe, recipe_size, &bo, &report, &err);
-    if (r != MK_OK) {
-        cli_print_warnings(&raw);
-        mk_raw_free(&raw);
-        return cli_fail(verb->name, &err);
-    }
-    if (!a->all_meshes) mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");
+    if (r == MK_OK) r = mk_bake_recipe(&raw, recipe, recipe_size, &bo, &report, &err);
+    if (r == MK_OK && !a->all_meshes) mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");
     cli_print_warnings(&raw);
-
-    void *blob = NULL;
-    size_t size = 0;
     mk_write_report wr;
     mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16 };
-    r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &wr, &err);
+    if (r == MK_OK) r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &wr, &err);
     if (r != MK_OK) {
-        mk_raw_free(&raw);
-        return cli_fail(verb->name, &err);
+        status = cli_fail(verb->name, &err);
+        goto done;
     }
-    out.file.data = blob;
-    out.file.size = size;
-    status = cli_write_outputs(verb, &out, 1);
+    outs[0].file.data = blob;
+    outs[0].file.size = size;
+    if (a->depfile) {
+        dep_text = cli_depfile_text(&ui.deps, a->output, &outs[1].file.size);
+        outs[1].file.data = dep_text;
+        if (!dep_text) { fprintf(stderr, "morphkit bake: out of memory\n"); status = CLI_EXIT_FAILURE; goto done; }
+    }
+    status = cli_write_outputs(verb, outs, a->depfile ? 2 : 1);
     if (status == 0) {
         printf("%s -> %s: %u channels baked, %u targets, max playback error %.3g x diagonal, %zu bytes\n", a->input,
                a->output, report.channels_added, report.targets_added, report.max_error, size);
         printf("precision: %u int16 targets, %u float targets; max position quantization error %.3g\n",
                wr.quantized_targets, wr.float_targets, wr.max_position_error);
     }
+done:
+    free(dep_text);
+    cli_depfile_free(&ui.deps);
     mk_raw_free(&raw);
     return status;
 }

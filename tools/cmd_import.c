@@ -7,7 +7,7 @@
 #include "cli.h"
 
 typedef struct import_args {
-    const char *input, *output, *channels;
+    const char *input, *output, *channels, *depfile;
     int stacking, precision, stacking_given, quiet, all_meshes;
     double tolerance;
 } import_args;
@@ -35,6 +35,10 @@ static const cli_option options[] = {
     { "--all-meshes", NULL, CLI_FLAG, offsetof(import_args, all_meshes),
       "Also keep meshes without morph targets (by default only meshes with targets are imported).", NULL, NULL, 0, 0, 0,
       0 },
+    { "--depfile", "PATH", CLI_STRING, offsetof(import_args, depfile),
+      "Also write a depfile for build systems (make syntax, as ninja and meson read it): the blob and every file the "
+      "import read (the source, the sidecar, glTF buffers).",
+      NULL, NULL, 0, 0, 0, 0 },
     { "--quiet", NULL, CLI_FLAG, offsetof(import_args, quiet), "No progress lines (results are still printed).", NULL,
       NULL, 0, 0, 0, 0 },
 };
@@ -66,11 +70,15 @@ static int run_import(void *p)
                                a->input);
     const char *inputs[] = { a->input, a->channels };
     static const char *const extensions[] = { ".morph", NULL };
-    cli_output out;
-    int status = cli_output_check(verb, &out, "-o", a->output, extensions, "a .morph blob", 0, inputs, 2);
+    cli_output outs[2];
+    int status = cli_output_check(verb, &outs[0], "-o", a->output, extensions, "a .morph blob", 0, inputs, 2);
     if (status >= 0) return status;
+    if (a->depfile && (status = cli_output_check(verb, &outs[1], "--depfile", a->depfile, NULL, "a depfile", 0, inputs, 2)) >= 0)
+        return status;
+    cli_depfile deps = { 0 };
 
-    mk_import_options io = { .channels_sidecar = a->channels, .keep_plain_meshes = a->all_meshes };
+    mk_import_options io = { .channels_sidecar = a->channels, .keep_plain_meshes = a->all_meshes,
+                             .file_read = a->depfile ? cli_depfile_add : NULL, .file_read_user = &deps };
     if (a->stacking_given) io.stacking = a->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
     mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16,
                             .tolerance = (float)a->tolerance };
@@ -91,11 +99,19 @@ static int run_import(void *p)
     if (r == MK_OK) r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &report, &err);
     if (r != MK_OK) {
         mk_raw_free(&raw);
+        cli_depfile_free(&deps);
         return cli_fail(verb->name, &err);
     }
-    out.file.data = blob;
-    out.file.size = size;
-    status = cli_write_outputs(verb, &out, 1);
+    outs[0].file.data = blob;
+    outs[0].file.size = size;
+    char *dep_text = NULL;
+    if (a->depfile) {
+        dep_text = cli_depfile_text(&deps, a->output, &outs[1].file.size);
+        outs[1].file.data = dep_text;
+        if (!dep_text) { mk_raw_free(&raw); fprintf(stderr, "morphkit import: out of memory\n"); return CLI_EXIT_FAILURE; }
+    }
+    status = cli_write_outputs(verb, outs, a->depfile ? 2 : 1);
+    free(dep_text);
     if (status == 0) {
         uint32_t targets = 0;
         for (uint32_t c = 0; c < raw.channel_count; c++) targets += raw.channels[c].target_count;

@@ -71,6 +71,8 @@ struct FsContext {
     uint64_t max_size;
     std::string failure;           // first refused or missing external file, for the error
     mk_result failure_code = MK_OK;
+    void (*file_read)(void *user, const char *path) = nullptr;
+    void *file_read_user = nullptr;
 };
 
 // RFC 3986 scheme: a letter, then letters, digits, '+', '-', '.', up to ':' (before any '/').
@@ -173,6 +175,7 @@ bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::strin
         if (err) *err += "read error on '" + file + "'\n";
         return false;
     }
+    if (ctx->file_read) ctx->file_read(ctx->file_read_user, file.c_str());
     return true;
 }
 
@@ -643,8 +646,9 @@ std::string first_line(const std::string &s)
     return s.substr(start, end == std::string::npos ? std::string::npos : end - start);
 }
 
-mk_result load(mk_arena *arena, const unsigned char *bytes, size_t size, int is_binary,
-               const char *base_dir, uint64_t max_file_size, mk_gltf_doc *out, mk_error *err)
+mk_result load(mk_arena *arena, const unsigned char *bytes, size_t size, int is_binary, const char *base_dir,
+               uint64_t max_file_size, void (*file_read)(void *, const char *), void *file_read_user,
+               mk_gltf_doc *out, mk_error *err)
 {
     if (is_binary < 0) is_binary = size >= 4 && std::memcmp(bytes, "glTF", 4) == 0;
     if (size > 0xffffffffu) return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "glTF input larger than 4 GiB");
@@ -716,6 +720,8 @@ mk_result load(mk_arena *arena, const unsigned char *bytes, size_t size, int is_
     fsctx.base_dir = base_dir ? base_dir : "";
     const std::string marker = kBaseMarker;
     fsctx.max_size = max_file_size;
+    fsctx.file_read = file_read;
+    fsctx.file_read_user = file_read_user;
     tinygltf::FsCallbacks fs;
     fs.FileExists = fs_exists;
     fs.ExpandFilePath = fs_expand;
@@ -758,14 +764,15 @@ mk_result load(mk_arena *arena, const unsigned char *bytes, size_t size, int is_
 } // namespace
 
 extern "C" mk_result mk_gltf_doc_load(mk_arena *arena, const void *data, size_t size, int is_binary,
-                                      const char *base_dir, uint64_t max_file_size, mk_gltf_doc *out,
-                                      mk_error *err)
+                                      const char *base_dir, uint64_t max_file_size,
+                                      void (*file_read)(void *user, const char *path), void *file_read_user,
+                                      mk_gltf_doc *out, mk_error *err)
 {
     if (!arena || !out || (!data && size)) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "glTF: invalid argument");
     std::memset(out, 0, sizeof *out);
     try {
         mk_result r = load(arena, static_cast<const unsigned char *>(data), size, is_binary, base_dir,
-                           max_file_size, out, err);
+                           max_file_size, file_read, file_read_user, out, err);
         if (r != MK_OK) std::memset(out, 0, sizeof *out);
         return r;
     } catch (const std::bad_alloc &) {

@@ -167,11 +167,13 @@ typedef struct mk_gltf_doc {
  * URIs resolve against base_dir only, never the working directory; absolute paths and schemes
  * other than data: are refused (MK_ERROR_UNSUPPORTED), a missing file is MK_ERROR_IO naming the
  * URI and the path tried.
- * max_file_size bounds every external file (0 = no bound). Warnings of the parser are dropped;
+ * max_file_size bounds every external file (0 = no bound). file_read (may be NULL) is called
+ * with the path of every external file read. Warnings of the parser are dropped;
  * errors name the parser's complaint. */
 mk_result mk_gltf_doc_load(mk_arena *arena, const void *data, size_t size, int is_binary,
-                           const char *base_dir, uint64_t max_file_size, mk_gltf_doc *out,
-                           mk_error *err);
+                           const char *base_dir, uint64_t max_file_size,
+                           void (*file_read)(void *user, const char *path), void *file_read_user,
+                           mk_gltf_doc *out, mk_error *err);
 void mk_gltf_doc_free(mk_gltf_doc *doc);
 
 #ifdef __cplusplus

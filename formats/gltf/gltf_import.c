@@ -529,13 +529,16 @@ mk_result mk_import_gltf(const void *data, size_t size, const mk_import_options 
         void *text;
         r = mk_read_file(&tmp, options->channels_sidecar, (size_t)1 << 28, &text, &sidecar_size, err);
         sidecar_text = text;
+        if (r == MK_OK && options->file_read) options->file_read(options->file_read_user, options->channels_sidecar);
     }
     if (r == MK_OK && sidecar_text) {
         r = mk_gltf_sidecar_parse(&tmp, sidecar_text, sidecar_size, options->channels_sidecar ? options->channels_sidecar : "sidecar",
                                   &sc, err);
         im.sidecar = &sc;
     }
-    if (r == MK_OK) r = mk_gltf_doc_load(&tmp, data, size, -1, options ? options->base_dir : NULL, limit, &im.doc, err);
+    if (r == MK_OK)
+        r = mk_gltf_doc_load(&tmp, data, size, -1, options ? options->base_dir : NULL, limit, options ? options->file_read : NULL,
+                             options ? options->file_read_user : NULL, &im.doc, err);
     if (r == MK_OK) r = import_doc(&im, err);
     mk_gltf_doc_free(&im.doc);
     mk_arena_free_all(&tmp);
