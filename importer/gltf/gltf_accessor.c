@@ -122,6 +122,13 @@ mk_result mk_gltf_view_bytes(mk_gltf_reader *r, int32_t vi, const uint8_t **data
     return MK_OK;
 }
 
+/* One component as float. Normalized integers follow the spec's conversion table (animation
+ * samplers; KHR_mesh_quantization has the same): f = max(c / 127.0, -1.0), c / 255.0,
+ * max(c / 32767.0, -1.0), c / 65535.0; the float division rounds once, so these are the
+ * correctly rounded values.
+ * `normalized` is ignored for FLOAT (the spec forbids it there; the value is unambiguous).
+ * UNSIGNED_INT is never float data (mk_gltf_read_floats refuses it); here it only reads sparse
+ * indices, which are not normalized. */
 static float read_component(const uint8_t *p, int type, int normalized)
 {
     switch (type) {
@@ -129,7 +136,7 @@ static float read_component(const uint8_t *p, int type, int normalized)
     case MK_GLTF_UNSIGNED_BYTE: { uint8_t c = p[0]; return normalized ? c / 255.0f : (float)c; }
     case MK_GLTF_SHORT: { int16_t c; memcpy(&c, p, 2); return normalized ? fmaxf(c / 32767.0f, -1.0f) : (float)c; }
     case MK_GLTF_UNSIGNED_SHORT: { uint16_t c; memcpy(&c, p, 2); return normalized ? c / 65535.0f : (float)c; }
-    case MK_GLTF_UNSIGNED_INT: { uint32_t c; memcpy(&c, p, 4); return normalized ? (float)(c / 4294967295.0) : (float)c; }
+    case MK_GLTF_UNSIGNED_INT: { uint32_t c; memcpy(&c, p, 4); return (float)c; }
     default: { float c; memcpy(&c, p, 4); return c; }
     }
 }
@@ -159,6 +166,9 @@ mk_result mk_gltf_read_floats(mk_gltf_reader *r, int32_t index, int components, 
     int cs = component_size(a->component_type);
     if (!cs)
         return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%s: accessor %d has unsupported componentType %d", what, index, a->component_type);
+    if (a->component_type == MK_GLTF_UNSIGNED_INT)
+        return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%s: accessor %d has componentType 5125 (UNSIGNED_INT), which glTF allows for indices only",
+                            what, index);
     if (a->components != components)
         return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%s: accessor %d has %d components, expected %d", what, index, a->components, components);
     /* 2^28 elements x 4 floats stays far below size_t limits; real assets are much smaller. */
@@ -211,10 +221,15 @@ mk_result mk_gltf_read_floats(mk_gltf_reader *r, int32_t index, int components, 
             if (a->sparse_indices_type == MK_GLTF_UNSIGNED_INT) {
                 uint32_t u; memcpy(&u, ib + a->sparse_indices_offset + k * is, 4); at = u;   /* exact, not via float */
             }
-            if (at >= n || (k > 0 && at <= prev))
+            /* The spec: indices MUST strictly increase (so no duplicates) and be < count. */
+            if (at >= n)
                 return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX,
-                                    "%s: accessor %d: sparse index %llu (entry %llu) out of range or not strictly increasing",
-                                    what, index, (unsigned long long)at, (unsigned long long)k);
+                                    "%s: accessor %d: sparse index %llu (entry %llu) is past the accessor's %llu elements",
+                                    what, index, (unsigned long long)at, (unsigned long long)k, (unsigned long long)n);
+            if (k > 0 && at <= prev)
+                return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX,
+                                    "%s: accessor %d: sparse index %llu (entry %llu) after %llu: sparse indices must strictly increase",
+                                    what, index, (unsigned long long)at, (unsigned long long)k, (unsigned long long)prev);
             prev = at;
             const uint8_t *p = vb + a->sparse_values_offset + k * elem;
             for (int c = 0; c < components; c++) f[at * components + c] = read_component(p + c * cs, a->component_type, a->normalized);
