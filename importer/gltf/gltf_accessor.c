@@ -1,11 +1,13 @@
 /* glTF accessor decoding (spec §3.6.2), KHR_mesh_quantization component types and
- * EXT_meshopt_compression bufferViews. tinygltf parses accessors but applies neither sparse
- * substitution nor meshopt, and accepts accessors without bufferView; all of that is done here,
- * with every byte range checked before it is read. */
+ * EXT_meshopt_compression bufferViews (streams by libmeshoptimizer, filters by gltf_meshopt.c).
+ * tinygltf parses accessors but applies neither sparse substitution nor meshopt, and accepts
+ * accessors without bufferView; all of that is done here, with every byte range checked before
+ * it is read. */
 #include <math.h>
 #include <string.h>
 #include <meshoptimizer.h>
 #include "gltf_accessor.h"
+#include "gltf_meshopt.h"
 
 mk_result mk_gltf_reader_init(mk_gltf_reader *r, const mk_gltf_doc *doc, mk_arena *arena, mk_error *err)
 {
@@ -28,9 +30,11 @@ static int component_size(int type)
     }
 }
 
-/* Decodes an EXT_meshopt_compression view. The decoders in libmeshoptimizer validate the
- * compressed stream themselves (they are meant for untrusted input) but assert on their size
- * arguments, so those are checked here first (extension README, "Compressing buffer views"). */
+/* Decodes an EXT_meshopt_compression view. The byte-stream decoders of libmeshoptimizer
+ * validate the compressed stream themselves (they are meant for untrusted input) but assert on
+ * their size arguments, so those are checked here first (extension README, "Compressing buffer
+ * views"). The filters are ours (gltf_meshopt.c): the library's round some octahedral normals
+ * one step away from the README's formula. */
 static mk_result decode_meshopt(mk_gltf_reader *r, int32_t vi, mk_error *err)
 {
     const mk_gltf_doc *d = r->doc;
@@ -62,13 +66,13 @@ static mk_result decode_meshopt(mk_gltf_reader *r, int32_t vi, mk_error *err)
             if (v->mo_filter == MK_MESHOPT_OCTAHEDRAL) {
                 if (stride != 4 && stride != 8)
                     return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "bufferView %d: OCTAHEDRAL filter needs byteStride 4 or 8", vi);
-                meshopt_decodeFilterOct(out, (size_t)count, (size_t)stride);
+                mk_meshopt_filter_octahedral(out, (size_t)count, (size_t)stride);
             } else if (v->mo_filter == MK_MESHOPT_QUATERNION) {
                 if (stride != 8)
                     return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "bufferView %d: QUATERNION filter needs byteStride 8", vi);
-                meshopt_decodeFilterQuat(out, (size_t)count, (size_t)stride);
+                mk_meshopt_filter_quaternion(out, (size_t)count, (size_t)stride);
             } else if (v->mo_filter == MK_MESHOPT_EXPONENTIAL) {
-                meshopt_decodeFilterExp(out, (size_t)count, (size_t)stride);
+                mk_meshopt_filter_exponential(out, (size_t)count, (size_t)stride);
             } else if (v->mo_filter != MK_MESHOPT_NONE) {
                 return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "bufferView %d: unknown meshopt filter", vi);
             }
