@@ -1,12 +1,14 @@
 /* SPDX-License-Identifier: MIT */
 /* glTF accessor decoding (spec §3.6.2), KHR_mesh_quantization component types and
- * EXT_meshopt_compression bufferViews. tinygltf parses accessors but applies neither sparse
- * substitution nor meshopt, and accepts accessors without bufferView; all of that is done here,
- * with every byte range checked before it is read. */
+ * EXT_meshopt_compression bufferViews (streams by libmeshoptimizer, filters by gltf_meshopt.c).
+ * tinygltf parses accessors but applies neither sparse substitution nor meshopt, and accepts
+ * accessors without bufferView; all of that is done here, with every byte range checked before
+ * it is read. */
 #include <math.h>
 #include <string.h>
 #include <meshoptimizer.h>
 #include "gltf_accessor.h"
+#include "gltf_meshopt.h"
 
 mk_result mk_gltf_reader_init(mk_gltf_reader *r, const mk_gltf_doc *doc, mk_arena *arena, mk_error *err)
 {
@@ -29,9 +31,11 @@ static int component_size(int type)
     }
 }
 
-/* Decodes an EXT_meshopt_compression view. The decoders in libmeshoptimizer validate the
- * compressed stream themselves (they are meant for untrusted input) but assert on their size
- * arguments, so those are checked here first (extension README, "Compressing buffer views"). */
+/* Decodes an EXT_meshopt_compression view. The byte-stream decoders of libmeshoptimizer
+ * validate the compressed stream themselves (they are meant for untrusted input) but assert on
+ * their size arguments, so those are checked here first (extension README, "Compressing buffer
+ * views"). The filters are ours (gltf_meshopt.c): the library's round some octahedral normals
+ * one step away from the README's formula. */
 static mk_result decode_meshopt(mk_gltf_reader *r, int32_t vi, mk_error *err)
 {
     const mk_gltf_doc *d = r->doc;
@@ -63,13 +67,13 @@ static mk_result decode_meshopt(mk_gltf_reader *r, int32_t vi, mk_error *err)
             if (v->mo_filter == MK_MESHOPT_OCTAHEDRAL) {
                 if (stride != 4 && stride != 8)
                     return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "bufferView %d: OCTAHEDRAL filter needs byteStride 4 or 8", vi);
-                meshopt_decodeFilterOct(out, (size_t)count, (size_t)stride);
+                mk_meshopt_filter_octahedral(out, (size_t)count, (size_t)stride);
             } else if (v->mo_filter == MK_MESHOPT_QUATERNION) {
                 if (stride != 8)
                     return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "bufferView %d: QUATERNION filter needs byteStride 8", vi);
-                meshopt_decodeFilterQuat(out, (size_t)count, (size_t)stride);
+                mk_meshopt_filter_quaternion(out, (size_t)count, (size_t)stride);
             } else if (v->mo_filter == MK_MESHOPT_EXPONENTIAL) {
-                meshopt_decodeFilterExp(out, (size_t)count, (size_t)stride);
+                mk_meshopt_filter_exponential(out, (size_t)count, (size_t)stride);
             } else if (v->mo_filter != MK_MESHOPT_NONE) {
                 return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "bufferView %d: unknown meshopt filter", vi);
             }
@@ -123,6 +127,13 @@ mk_result mk_gltf_view_bytes(mk_gltf_reader *r, int32_t vi, const uint8_t **data
     return MK_OK;
 }
 
+/* One component as float. Normalized integers follow the spec's conversion table (animation
+ * samplers; KHR_mesh_quantization has the same): f = max(c / 127.0, -1.0), c / 255.0,
+ * max(c / 32767.0, -1.0), c / 65535.0; the float division rounds once, so these are the
+ * correctly rounded values.
+ * `normalized` is ignored for FLOAT (the spec forbids it there; the value is unambiguous).
+ * UNSIGNED_INT is never float data (mk_gltf_read_floats refuses it); here it only reads sparse
+ * indices, which are not normalized. */
 static float read_component(const uint8_t *p, int type, int normalized)
 {
     switch (type) {
@@ -130,7 +141,7 @@ static float read_component(const uint8_t *p, int type, int normalized)
     case MK_GLTF_UNSIGNED_BYTE: { uint8_t c = p[0]; return normalized ? c / 255.0f : (float)c; }
     case MK_GLTF_SHORT: { int16_t c; memcpy(&c, p, 2); return normalized ? fmaxf(c / 32767.0f, -1.0f) : (float)c; }
     case MK_GLTF_UNSIGNED_SHORT: { uint16_t c; memcpy(&c, p, 2); return normalized ? c / 65535.0f : (float)c; }
-    case MK_GLTF_UNSIGNED_INT: { uint32_t c; memcpy(&c, p, 4); return normalized ? (float)(c / 4294967295.0) : (float)c; }
+    case MK_GLTF_UNSIGNED_INT: { uint32_t c; memcpy(&c, p, 4); return (float)c; }
     default: { float c; memcpy(&c, p, 4); return c; }
     }
 }
@@ -160,6 +171,9 @@ mk_result mk_gltf_read_floats(mk_gltf_reader *r, int32_t index, int components, 
     int cs = component_size(a->component_type);
     if (!cs)
         return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%s: accessor %d has unsupported componentType %d", what, index, a->component_type);
+    if (a->component_type == MK_GLTF_UNSIGNED_INT)
+        return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%s: accessor %d has componentType 5125 (UNSIGNED_INT), which glTF allows for indices only",
+                            what, index);
     if (a->components != components)
         return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX, "%s: accessor %d has %d components, expected %d", what, index, a->components, components);
     /* 2^28 elements x 4 floats stays far below size_t limits; real assets are much smaller. */
@@ -212,10 +226,15 @@ mk_result mk_gltf_read_floats(mk_gltf_reader *r, int32_t index, int components, 
             if (a->sparse_indices_type == MK_GLTF_UNSIGNED_INT) {
                 uint32_t u; memcpy(&u, ib + a->sparse_indices_offset + k * is, 4); at = u;   /* exact, not via float */
             }
-            if (at >= n || (k > 0 && at <= prev))
+            /* The spec: indices MUST strictly increase (so no duplicates) and be < count. */
+            if (at >= n)
                 return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX,
-                                    "%s: accessor %d: sparse index %llu (entry %llu) out of range or not strictly increasing",
-                                    what, index, (unsigned long long)at, (unsigned long long)k);
+                                    "%s: accessor %d: sparse index %llu (entry %llu) is past the accessor's %llu elements",
+                                    what, index, (unsigned long long)at, (unsigned long long)k, (unsigned long long)n);
+            if (k > 0 && at <= prev)
+                return mk_error_set(err, MK_ERROR_PARSE, UINT64_MAX,
+                                    "%s: accessor %d: sparse index %llu (entry %llu) after %llu: sparse indices must strictly increase",
+                                    what, index, (unsigned long long)at, (unsigned long long)k, (unsigned long long)prev);
             prev = at;
             const uint8_t *p = vb + a->sparse_values_offset + k * elem;
             for (int c = 0; c < components; c++) f[at * components + c] = read_component(p + c * cs, a->component_type, a->normalized);

@@ -396,6 +396,13 @@ static void prop_vec3(out *o, const char *name, const double v[3])
     prop_end(o);
 }
 
+/* A vec3 property unless all three components equal `fallback` (the FBX default). */
+static void prop_vec3_unless(out *o, const char *name, const double v[3], double fallback)
+{
+    if (v[0] == fallback && v[1] == fallback && v[2] == fallback) return;
+    prop_vec3(o, name, v);
+}
+
 /* Array leaf whose values are written as `kind` in a type-mixed binary file (else 'd'). */
 static void leaf_array_as(out *o, const char *name, char kind, const double *values, size_t count)
 {
@@ -598,11 +605,19 @@ static void write_scene(out *o, const fbxw_scene *sc)
         values_end(o, 1);
         double one[3] = { 1, 1, 1 };
         const double *s = (mesh->scaling[0] == 0 && mesh->scaling[1] == 0 && mesh->scaling[2] == 0) ? one : mesh->scaling;
+        int inherit = mesh->inherit_type ? mesh->inherit_type - 1 : mesh->ignore_parent_scale ? 2 : 1;
         prop_begin(o, "RotationOrder", "enum", "", ""); v_i64(o, mesh->rotation_order, 'I'); prop_end(o);
-        prop_begin(o, "InheritType", "enum", "", ""); v_i64(o, mesh->ignore_parent_scale ? 2 : 1, 'I'); prop_end(o);
+        prop_begin(o, "InheritType", "enum", "", ""); v_i64(o, inherit, 'I'); prop_end(o);
         prop_vec3(o, "PreRotation", mesh->pre_rotation);
+        prop_vec3_unless(o, "PostRotation", mesh->post_rotation, 0);
+        prop_vec3_unless(o, "RotationOffset", mesh->rotation_offset, 0);
         prop_vec3(o, "RotationPivot", mesh->rotation_pivot);
+        prop_vec3_unless(o, "ScalingOffset", mesh->scaling_offset, 0);
+        prop_vec3_unless(o, "ScalingPivot", mesh->scaling_pivot, 0);
         prop_vec3(o, "GeometricTranslation", mesh->geometric_translation);
+        prop_vec3_unless(o, "GeometricRotation", mesh->geometric_rotation, 0);
+        if (mesh->geometric_scaling[0] != 0 || mesh->geometric_scaling[1] != 0 || mesh->geometric_scaling[2] != 0)
+            prop_vec3_unless(o, "GeometricScaling", mesh->geometric_scaling, 1);
         prop_vec3(o, "Lcl Translation", mesh->translation);
         prop_vec3(o, "Lcl Rotation", mesh->rotation);
         prop_begin(o, "Lcl Scaling", "Lcl Scaling", "", "A");

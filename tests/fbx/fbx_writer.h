@@ -48,11 +48,19 @@ typedef struct fbxw_mesh {
     const int32_t *polygon_vertex_index; /* last of each polygon as ~index */
     const double *normals;        /* ByPolygonVertex, 3 per polygon vertex, or NULL */
     const double *uvs;            /* ByPolygonVertex, 2 per polygon vertex, or NULL */
+    /* Model transform properties (Properties70). Lcl Translation/Rotation/Scaling,
+     * PreRotation, RotationPivot, GeometricTranslation, RotationOrder and InheritType are always
+     * written; the others only when not at their default (zero, or one for the scalings), so
+     * fixtures that leave them alone also cover the importer's defaults. */
     double translation[3], rotation[3], scaling[3];  /* scaling 0,0,0 means 1,1,1 */
-    double pre_rotation[3], rotation_pivot[3];
-    double geometric_translation[3];
-    int rotation_order;
+    double pre_rotation[3], post_rotation[3];
+    double rotation_offset[3], rotation_pivot[3];
+    double scaling_offset[3], scaling_pivot[3];
+    double geometric_translation[3], geometric_rotation[3];
+    double geometric_scaling[3];  /* 0,0,0 means 1,1,1 (not written) */
+    int rotation_order;           /* 0 XYZ .. 5 ZYX (6 spheric), written as is */
     int ignore_parent_scale;      /* writes InheritType 2 (Rrs) instead of 1 (RSrs) */
+    int inherit_type;             /* 0: as ignore_parent_scale says; FBXW_INHERIT(n) writes InheritType n */
     uint32_t channel_count;
     const fbxw_channel *channels;
     int parent;                   /* index of the parent mesh's model, or -1 */
@@ -80,5 +88,7 @@ int fbxw_write(const fbxw_scene *scene, unsigned char **data, size_t *size);
 int fbxw_write_file(const fbxw_scene *scene, const char *path);
 
 #define FBXW_KTIME_PER_SECOND 46186158000LL
+/* fbxw_mesh.inherit_type for InheritType n (0 RrSs, 1 RSrs, 2 Rrs, or any other value). */
+#define FBXW_INHERIT(n) ((n) + 1)
 
 #endif

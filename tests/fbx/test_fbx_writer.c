@@ -571,7 +571,10 @@ static void test_tiny_full_weights(void)
 /* Rotation order and pre-rotation: a point at (1,0,0) under T(1,0,0) and R(90,0,90).
  * XYZ applies X first: (1,0,0) -> (1,0,0) -> (0,1,0), + T = (1,1,0).
  * ZYX applies Z first: (1,0,0) -> (0,1,0) -> (0,0,1), + T = (1,0,1).
- * R(90,0,0) XYZ with PreRotation(0,0,90): Rpre after R: (1,0,0) -> (1,0,0) -> (0,1,0) + T. */
+ * R(90,0,0) XYZ with PreRotation(0,0,90): Rpre after R: (1,0,0) -> (1,0,0) -> (0,1,0) + T.
+ * A smoke test on evaluated positions: with a zero Y angle several orders agree, so the six
+ * orders, every transform property and parent chains are checked against the full formula in
+ * test_fbx_transform.c. */
 static void test_rotation_order(void)
 {
     static const double points[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };

@@ -426,7 +426,7 @@ static void test_structure_errors(void)
     expect_error(edit(fixture_json(&f), "{\"bufferView\":0,\"byteOffset\":36,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"",
                       "{\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"sparse\":{\"count\":2,\"indices\":{\"bufferView\":1,\"componentType\":5123},"
                       "\"values\":{\"bufferView\":0,\"byteOffset\":0}}"),
-                 MK_ERROR_PARSE, "not strictly increasing");
+                 MK_ERROR_PARSE, "must strictly increase");
     /* An unknown required extension is refused, not half-imported. */
     fixture_default(&f);
     expect_error(edit(fixture_json(&f), "\"scene\":0,", "\"scene\":0,\"extensionsRequired\":[\"EXT_future_geometry\"],"),

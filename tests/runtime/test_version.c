@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* One version: the header's MK_VERSION_* agree with the project version meson reads from
  * VERSION (passed in as MK_PROJECT_VERSION), and the library reports the header's number. */
 #include <stdio.h>
