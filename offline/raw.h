@@ -120,8 +120,4 @@ mk_result mk_raw_validate(const mk_raw_asset *raw, mk_error *err);
  * authored base normals are kept at weight 0. */
 mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int force, mk_error *err);
 
-void mk_mat4_identity(float m[16]);
-/* out = a * b for column-major 4x4 double matrices (out may alias a or b). */
-void mk_mat4d_multiply(double out[16], const double a[16], const double b[16]);
-
 #endif

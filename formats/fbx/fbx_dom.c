@@ -426,12 +426,6 @@ int fbx_prop_number_opt(fbx_props props, const char *name, double *out)
     return fbx_value_float(&p->values[at], out);
 }
 
-double fbx_prop_number(fbx_props props, const char *name, double fallback)
-{
-    double x;
-    return fbx_prop_number_opt(props, name, &x) ? x : fallback;
-}
-
 int fbx_prop_vec3(fbx_props props, const char *name, double out[3])
 {
     const fbx_node *p = fbx_prop_find(props, name);
@@ -452,10 +446,3 @@ int fbx_prop_int64(fbx_props props, const char *name, int64_t *out)
     return fbx_value_int(&p->values[at], out);
 }
 
-int fbx_prop_string(fbx_props props, const char *name, const char **data, uint32_t *length)
-{
-    const fbx_node *p = fbx_prop_find(props, name);
-    uint32_t at = fbx_prop_payload(props);
-    if (!p || p->value_count <= at) return 0;
-    return fbx_value_string(&p->values[at], data, length);
-}

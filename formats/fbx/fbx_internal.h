@@ -33,7 +33,6 @@ typedef struct fbx_value {
     uint8_t kind;           /* fbx_value_kind */
     uint8_t type;           /* binary type code ('i','l','f','d','b','c') or 'a' (ASCII array) */
     uint8_t encoding;       /* binary arrays: 0 raw, 1 zlib */
-    uint8_t unused;
     uint32_t count;         /* arrays: declared element count */
     uint64_t offset;        /* byte offset of the value in the file */
     union {
@@ -142,13 +141,11 @@ typedef struct fbx_props {
 fbx_props fbx_props_of(const fbx_node *object);
 /* The P node with that name, or NULL. */
 const fbx_node *fbx_prop_find(fbx_props props, const char *name);
-/* Number (first value after the metadata), or `fallback`. */
-double fbx_prop_number(fbx_props props, const char *name, double fallback);
+/* Number (first value after the metadata); returns 0 and leaves out unchanged when absent. */
 int fbx_prop_number_opt(fbx_props props, const char *name, double *out);
 /* 3 numbers; returns 0 and leaves out unchanged when absent. */
 int fbx_prop_vec3(fbx_props props, const char *name, double out[3]);
 int fbx_prop_int64(fbx_props props, const char *name, int64_t *out);
-int fbx_prop_string(fbx_props props, const char *name, const char **data, uint32_t *length);
 /* Value index where a P node's payload starts. */
 uint32_t fbx_prop_payload(fbx_props props);
 

@@ -27,6 +27,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "mat4.h"
 #include "fbx_anim.h"
 #include "fbx_mesh.h"
 #include "fbx_transform.h"
@@ -464,7 +465,7 @@ static void node_world(scene *s, uint32_t o, double out[16])
     }
     double parent[16];
     if (cur >= 0 && s->world_state[cur] == 2) memcpy(parent, s->world + 16 * (size_t)cur, sizeof parent);
-    else fbx_mat_identity(parent);
+    else mk_mat4d_identity(parent);
     for (int i = n - 1; i >= 0; i--) {
         double local[16], geometric[16];
         const fbx_node *node = s->objects[chain[i]].node;
@@ -478,16 +479,16 @@ static void node_world(scene *s, uint32_t o, double out[16])
             double scale[3], t[3] = { 0, 0, 0 }, undo[16], move[16];
             fbx_model_scaling(s->objects[up].node, scale);
             fbx_prop_vec3(fbx_props_of(node), "Lcl Translation", t);
-            fbx_mat_identity(move);
+            mk_mat4d_identity(move);
             for (int k = 0; k < 3; k++) move[12 + k] = -t[k];
-            fbx_mat_multiply(local, move, local);
-            fbx_mat_identity(undo);
+            mk_mat4d_multiply(local, move, local);
+            mk_mat4d_identity(undo);
             for (int k = 0; k < 3; k++) undo[5 * k] = scale[k] != 0.0 ? 1.0 / scale[k] : 1.0;
-            fbx_mat_multiply(local, undo, local);
+            mk_mat4d_multiply(local, undo, local);
             for (int k = 0; k < 3; k++) move[12 + k] = t[k];
-            fbx_mat_multiply(local, move, local);
+            mk_mat4d_multiply(local, move, local);
         }
-        fbx_mat_multiply(w, parent, local);
+        mk_mat4d_multiply(w, parent, local);
         s->world_state[chain[i]] = 2;
         memcpy(parent, w, sizeof parent);
     }
@@ -500,7 +501,7 @@ static void world_transform(scene *s, uint32_t o, float out[16])
     double world[16], local[16], geometric[16];
     node_world(s, o, world);
     fbx_model_transforms(s->objects[o].node, local, geometric);
-    fbx_mat_multiply(world, world, geometric);
+    mk_mat4d_multiply(world, world, geometric);
     for (int i = 0; i < 16; i++) out[i] = (float)world[i];
 }
 

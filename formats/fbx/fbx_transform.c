@@ -16,17 +16,12 @@
  */
 #include <math.h>
 #include <string.h>
+#include "mat4.h"
 #include "fbx_transform.h"
-
-static void identity(double m[16])
-{
-    memset(m, 0, 16 * sizeof(double));
-    m[0] = m[5] = m[10] = m[15] = 1.0;
-}
 
 static void translation(double m[16], const double t[3], double sign)
 {
-    identity(m);
+    mk_mat4d_identity(m);
     m[12] = sign * t[0];
     m[13] = sign * t[1];
     m[14] = sign * t[2];
@@ -34,7 +29,7 @@ static void translation(double m[16], const double t[3], double sign)
 
 static void scaling(double m[16], const double s[3])
 {
-    identity(m);
+    mk_mat4d_identity(m);
     m[0] = s[0];
     m[5] = s[1];
     m[10] = s[2];
@@ -44,7 +39,7 @@ static void axis_rotation(double m[16], int axis, double degrees)
 {
     double a = degrees * (3.14159265358979323846 / 180.0);
     double c = cos(a), s = sin(a);
-    identity(m);
+    mk_mat4d_identity(m);
     int i = (axis + 1) % 3, j = (axis + 2) % 3;
     m[i * 4 + i] = c;
     m[j * 4 + i] = -s;
@@ -57,7 +52,7 @@ static void euler(double m[16], const double degrees[3], int order)
 {
     static const int sequence[6][3] = { { 0, 1, 2 }, { 0, 2, 1 }, { 1, 2, 0 }, { 1, 0, 2 }, { 2, 0, 1 }, { 2, 1, 0 } };
     if (order < 0 || order > 5) order = 0;  /* 6 = spheric XYZ: treated as XYZ */
-    identity(m);
+    mk_mat4d_identity(m);
     for (int k = 0; k < 3; k++) {
         int axis = sequence[order][k];
         double r[16];
@@ -161,14 +156,4 @@ void fbx_model_scaling(const fbx_node *model, double out[3])
 {
     out[0] = out[1] = out[2] = 1.0;
     fbx_prop_vec3(fbx_props_of(model), "Lcl Scaling", out);
-}
-
-void fbx_mat_multiply(double out[16], const double a[16], const double b[16])
-{
-    mk_mat4d_multiply(out, a, b);
-}
-
-void fbx_mat_identity(double m[16])
-{
-    identity(m);
 }

@@ -11,7 +11,5 @@ void fbx_model_transforms(const fbx_node *model, double local[16], double geomet
  * model's Lcl Scaling (1,1,1 when absent). */
 int fbx_model_inherit_type(const fbx_node *model);
 void fbx_model_scaling(const fbx_node *model, double out[3]);
-void fbx_mat_multiply(double out[16], const double a[16], const double b[16]);
-void fbx_mat_identity(double m[16]);
 
 #endif

@@ -14,6 +14,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include "mat4.h"
 #include "blob_io.h"
 #include "gltf_internal.h"
 

@@ -51,7 +51,8 @@ def module_of(path):
     return best
 
 
-files = subprocess.run(["git", "-C", root, "ls-files"], capture_output=True, text=True).stdout.split()
+files = subprocess.run(["git", "-C", root, "ls-files", "--cached", "--others", "--exclude-standard"],
+                       capture_output=True, text=True).stdout.split()
 if not files:  # not a git checkout: walk the tree
     for d, _, names in os.walk(root):
         if "/build" in d or "/." in d or "node_modules" in d:

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <string.h>
+#include "mat4.h"
 #include "fixtures.h"
 
 #define PI 3.14159265358979323846

@@ -7,6 +7,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include "mat4.h"
 #include "bake.h"
 
 static void make_mesh(mk_raw_asset *raw)

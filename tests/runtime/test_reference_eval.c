@@ -25,6 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "mat4.h"
 #include "check.h"
 #include "fixtures.h"
 #include "reference_eval.h"
