@@ -591,7 +591,7 @@ static mk_result resolve_mesh(recipe_ctx *ctx, const cJSON *item, const char *pa
             *mesh = m;
             return MK_OK;
         }
-    char names[160] = "";
+    char names[120] = "";
     for (uint32_t m = 0; m < ctx->raw->mesh_count; m++) {
         size_t n = strlen(names);
         const char *name = ctx->raw->meshes[m].name ? ctx->raw->meshes[m].name : "";

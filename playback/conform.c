@@ -58,6 +58,7 @@ mk_result pb_conform_weights(const pb_case *c, const pb_frame_spec *f, const mk_
 /* The import mesh a reference mesh names, or -1. */
 static int find_mesh(const mk_asset *a, const pb_ref_mesh *rm)
 {
+    if (rm->mesh_index >= 0) return rm->mesh_index < (int32_t)a->mesh_count ? rm->mesh_index : -1;
     for (uint32_t i = 0; i < a->mesh_count; i++) {
         mk_mesh_info m;
         mk_mesh_get(a, i, &m);
@@ -92,6 +93,9 @@ static void compare_mesh(frame_state *s, uint32_t mi, const pb_ref_mesh *rm)
      * disjoint channel ranges, so the frame's weight array takes them in place). */
     for (uint32_t k = 0; k < s->f->forced_count && k < m.channel_count; k++)
         s->weights[m.first_channel + k] = (float)s->f->forced[k];
+    if (s->f->weights_from_reference)
+        for (uint32_t k = 0; k < rm->weight_count && k < m.channel_count; k++)
+            s->weights[m.first_channel + k] = (float)rm->weights[k];
     if (rm->weights && rm->weight_count) {
         if (rm->weight_count != m.channel_count) {
             snprintf(res->failure, sizeof res->failure, "mesh '%.100s': the reference has %u channels, the import %u",
@@ -115,7 +119,8 @@ static void compare_mesh(frame_state *s, uint32_t mi, const pb_ref_mesh *rm)
     mk_error err;
     if (!pos || (m.has_normals && !nrm)) {
         snprintf(res->failure, sizeof res->failure, "out of memory");
-    } else if (pb_eval_mesh(a, mi, s->weights, s->o->stacking, s->o->normal_mode, pos, nrm, &err) != MK_OK) {
+    } else if (pb_eval_mesh(a, mi, s->weights, s->o->stacking ? s->o->stacking : s->c->stacking,
+                            s->o->normal_mode_given ? s->o->normal_mode : s->c->normal_mode, pos, nrm, &err) != MK_OK) {
         snprintf(res->failure, sizeof res->failure, "mesh '%.100s': evaluation failed: %.300s", m.name, err.message);
     } else {
         if (s->c->world) pb_to_world(m.world, pos, nrm, m.vertex_count);

@@ -9,8 +9,9 @@
 #include "manifest.h"
 
 typedef struct pb_conform_options {
-    mk_stacking stacking;        /* 0: each mesh's stored stacking */
-    mk_normal_mode normal_mode;  /* default nlerp */
+    mk_stacking stacking;        /* 0: the case's "stacking" (else each mesh's stored one) */
+    mk_normal_mode normal_mode;  /* with normal_mode_given; else the case's "normals" */
+    int normal_mode_given;
     double normal_tolerance_deg; /* largest normal angle; 0 means 1 degree */
     double weight_tolerance;     /* largest |weight - reference weight|; 0 means 1e-5 */
 } pb_conform_options;

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 #include "blob_io.h"
+#include "morphkit.h"
 #include "manifest.h"
 
 #define MANIFEST_MAX_BYTES ((size_t)256 << 20)
@@ -39,6 +40,7 @@ static mk_result read_frame(pb_manifest *m, const char *path, const char *where,
     if (!cJSON_IsString(file) || !file->valuestring[0])
         return field_error(err, path, where, "\"file\" must name the reference frame");
     f->file = dup_string(m, file);
+    f->weights_from_reference = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(j, "weights_from_reference"));
     f->clip = -1;
     if (time && !cJSON_IsNull(time)) {
         if (!cJSON_IsNumber(time) || !isfinite(time->valuedouble)) {
@@ -84,20 +86,30 @@ static mk_result read_case(pb_manifest *m, const char *path, uint32_t index, con
     const cJSON *source = cJSON_GetObjectItemCaseSensitive(j, "source");
     if (!cJSON_IsString(source) || !source->valuestring[0])
         return field_error(err, path, where, "needs a \"source\" file");
-    static const char *const formats[] = { "fbx", "gltf" };
-    int format = choice(cJSON_GetObjectItemCaseSensitive(j, "format"), formats, 2);
-    if (format < 0) return field_error(err, path, where, "\"format\" must be fbx or gltf");
+    static const char *const formats[] = { "fbx", "gltf", "morph" };
+    int format = choice(cJSON_GetObjectItemCaseSensitive(j, "format"), formats, 3);
+    if (format < 0) return field_error(err, path, where, "\"format\" must be fbx, gltf or morph");
+    static const char *const stackings[] = { "additive", "sequential" }, *const normal_modes[] = { "nlerp", "slerp" };
+    const cJSON *stacking_item = cJSON_GetObjectItemCaseSensitive(j, "stacking");
+    const cJSON *normals_item = cJSON_GetObjectItemCaseSensitive(j, "normals");
+    int stacking = stacking_item ? choice(stacking_item, stackings, 2) : -1;
+    int normal_mode = normals_item ? choice(normals_item, normal_modes, 2) : 0;
+    if (stacking_item && stacking < 0) return field_error(err, path, where, "\"stacking\" must be additive or sequential");
+    if (normal_mode < 0) return field_error(err, path, where, "\"normals\" must be nlerp or slerp");
+    c->stacking = stacking < 0 ? MK_STACKING_ASSET : stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
+    c->normal_mode = normal_mode ? MK_NORMALS_SLERP : MK_NORMALS_NLERP;
     const cJSON *ref = cJSON_GetObjectItemCaseSensitive(j, "reference");
     snprintf(w, sizeof w, "%.250s.reference", where);
     if (!cJSON_IsObject(ref)) return field_error(err, path, w, "must be an object (kind, space, match, tolerance)");
-    static const char *const kinds[] = { "ufbx-json", "three-json", "morphkit-json", "obj" };
+    static const char *const kinds[] = { "ufbx-json", "three-json", "morphkit-json", "morphkit-frame", "obj" };
     static const char *const spaces[] = { "mesh-local", "world" };
     static const char *const matches[] = { "vertices", "control_points" };
     static const char *const sizes[] = { "diagonal", "largest_coordinate" };
-    int kind = choice(cJSON_GetObjectItemCaseSensitive(ref, "kind"), kinds, 4);
+    int kind = choice(cJSON_GetObjectItemCaseSensitive(ref, "kind"), kinds, 5);
     int space = choice(cJSON_GetObjectItemCaseSensitive(ref, "space"), spaces, 2);
     int match = choice(cJSON_GetObjectItemCaseSensitive(ref, "match"), matches, 2);
-    if (kind < 0) return field_error(err, path, w, "\"kind\" must be ufbx-json, three-json, morphkit-json or obj");
+    if (kind < 0)
+        return field_error(err, path, w, "\"kind\" must be ufbx-json, three-json, morphkit-json, morphkit-frame or obj");
     if (space < 0) return field_error(err, path, w, "\"space\" must be world or mesh-local");
     if (match < 0) return field_error(err, path, w, "\"match\" must be control_points or vertices");
     const cJSON *tol = cJSON_GetObjectItemCaseSensitive(ref, "tolerance");
@@ -112,11 +124,10 @@ static mk_result read_case(pb_manifest *m, const char *path, uint32_t index, con
     if (size < 0) return field_error(err, path, w, "\"relative_to\" must be diagonal or largest_coordinate");
     c->name = dup_string(m, name);
     c->source = dup_string(m, source);
-    c->gltf = format == 1;
-    c->kind = kind == 0   ? PB_REF_UFBX_JSON
-              : kind == 1 ? PB_REF_THREE_JSON
-              : kind == 2 ? PB_REF_MORPHKIT_JSON
-                          : PB_REF_OBJ;
+    c->gltf = format == 1;   /* "morph" sources name clips like FBX: the first unless a frame names one */
+    static const pb_reference_kind kind_values[] = { PB_REF_UFBX_JSON, PB_REF_THREE_JSON, PB_REF_MORPHKIT_JSON,
+                                                     PB_REF_MORPHKIT_FRAME, PB_REF_OBJ };
+    c->kind = kind_values[kind];
     c->world = space == 1;
     c->by_control_point = match == 1;
     c->tolerance = tol ? tol->valuedouble : 0;

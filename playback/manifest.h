@@ -10,6 +10,7 @@ typedef enum pb_reference_kind {
     PB_REF_UFBX_JSON,     /* meshes[] by FBX node name, positions per control point, world space */
     PB_REF_THREE_JSON,    /* meshes[] by glTF node/mesh/primitive, positions and normals per vertex */
     PB_REF_MORPHKIT_JSON, /* frames written by 'morphkit frames' / 'morphkit play' */
+    PB_REF_MORPHKIT_FRAME,/* the binary frame format (.mkf) of 'morphkit frames' */
     PB_REF_OBJ            /* v lines of the one mesh with channels */
 } pb_reference_kind;
 
@@ -20,6 +21,7 @@ typedef struct pb_frame_spec {
     uint32_t forced_count; /* "weights": forced weights in the mesh's channel order */
     double *forced;        /* NULL when the frame forces none */
     const char *file;      /* the reference file, relative to the manifest's folder */
+    int weights_from_reference; /* play each mesh with the weights its reference lists (golden frames) */
 } pb_frame_spec;
 
 typedef struct pb_case {
@@ -33,6 +35,8 @@ typedef struct pb_case {
     double relative_tolerance; /* times the reference's size (0: none); a frame passes within
                                 * either tolerance */
     int relative_to_largest;   /* the size is the largest |coordinate| (else the bounding-box diagonal) */
+    mk_stacking stacking;      /* "stacking" the references were made with (0: each mesh's stored one) */
+    mk_normal_mode normal_mode;/* "normals": nlerp (default) or slerp */
     uint32_t frame_count;
     pb_frame_spec *frames;
 } pb_case;

@@ -11,6 +11,7 @@ typedef struct pb_ref_mesh {
     const char *label;                            /* for reports */
     const char *node;                             /* FBX model / node name, or NULL */
     int32_t gltf_node, gltf_mesh, gltf_primitive; /* -1 when not given */
+    int32_t mesh_index;         /* the asset's mesh (frames written by morphkit), or -1 */
     int has_channels;                             /* the reference lists channels (or weights) for this mesh */
     uint32_t weight_count;                        /* the channel weights the reference evaluated with */
     double *weights;

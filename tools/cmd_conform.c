@@ -11,7 +11,7 @@
 
 typedef struct conform_args {
     const char *manifest, *filter;
-    int precision, stacking, stacking_given, normals, json;
+    int precision, stacking, stacking_given, normals, normals_given, json;
     double normal_tolerance, weight_tolerance;
 } conform_args;
 
@@ -26,11 +26,11 @@ static const cli_option options[] = {
       "or float.",
       "q16", "q16|float", 0, 0, 0, 0 },
     { "--stacking", "MODE", CLI_CHOICE, offsetof(conform_args, stacking),
-      "Channel stacking to play with. Default: each mesh's stored stacking (references from other software are "
-      "additive).",
+      "Channel stacking to play with. Default: the case's \"stacking\", else each mesh's stored one.",
       NULL, "additive|sequential", 0, 0, 0, offsetof(conform_args, stacking_given) },
-    { "--normals", "MODE", CLI_CHOICE, offsetof(conform_args, normals), "How normal changes combine.", "nlerp",
-      "nlerp|slerp", 0, 0, 0, 0 },
+    { "--normals", "MODE", CLI_CHOICE, offsetof(conform_args, normals),
+      "How normal changes combine. Default: the case's \"normals\" (nlerp when it names none).", NULL, "nlerp|slerp", 0,
+      0, 0, offsetof(conform_args, normals_given) },
     { "--normal-tolerance", "DEG", CLI_NUMBER, offsetof(conform_args, normal_tolerance),
       "Largest angle, in degrees, between a normal and the reference's (where the reference has normals).", "1", NULL,
       1e-9, 180, 0, 0 },
@@ -149,6 +149,7 @@ static int run_conform(void *p)
                     : args->stacking      ? MK_STACKING_SEQUENTIAL
                                           : MK_STACKING_ADDITIVE,
         .normal_mode = args->normals ? MK_NORMALS_SLERP : MK_NORMALS_NLERP,
+        .normal_mode_given = args->normals_given,
         .normal_tolerance_deg = args->normal_tolerance,
         .weight_tolerance = args->weight_tolerance,
     };

@@ -7,78 +7,8 @@
 #include "asset.h"
 #include "cli.h"
 #include "frame.h"
-#include "json_write.h"
+#include "frame_write.h"
 #include "weights_arg.h"
-
-static void write_json(FILE *f, const mk_asset *a, float **pos, float **nrm, const char *space, double time,
-                       int32_t clip, const float *weights)
-{
-    json_writer w;
-    json_begin(&w, f, 0);
-    json_object(&w, NULL);
-    json_string(&w, "reference", "morphkit play");
-    if (clip >= 0) json_number(&w, "time", time);
-    json_string(&w, "coordinates", space);
-    json_array(&w, "meshes");
-    for (uint32_t i = 0; i < a->mesh_count; i++) {
-        mk_mesh_info m;
-        mk_mesh_get(a, i, &m);
-        json_object(&w, NULL);
-        json_string(&w, "name", m.name);
-        json_string(&w, "node", m.name);
-        if (m.gltf_node >= 0) {
-            json_int(&w, "gltf_node", m.gltf_node);
-            json_int(&w, "gltf_mesh", m.gltf_mesh);
-            json_int(&w, "gltf_primitive", m.gltf_primitive);
-        }
-        json_int(&w, "vertices", m.vertex_count);
-        json_array(&w, "channels");
-        for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
-            mk_channel_info ch;
-            mk_channel_get(a, c, &ch);
-            json_object(&w, NULL);
-            json_string(&w, "name", ch.name);
-            json_number(&w, "weight", weights[c]);
-            json_end_object(&w);
-        }
-        json_end_array(&w);
-        json_floats(&w, "positions", pos[i], 3u * (size_t)m.vertex_count);
-        if (nrm[i]) json_floats(&w, "normals", nrm[i], 3u * (size_t)m.vertex_count);
-        json_array(&w, "control_points");
-        for (uint32_t v = 0; v < m.vertex_count; v++) json_int(&w, NULL, m.control_points[v]);
-        json_end_array(&w);
-        json_end_object(&w);
-    }
-    json_end_array(&w);
-    json_end_object(&w);
-}
-
-static void write_obj(FILE *f, const mk_asset *a, float **pos, float **nrm)
-{
-    fprintf(f, "# morphkit play\n");
-    uint32_t base = 1;
-    for (uint32_t i = 0; i < a->mesh_count; i++) {
-        mk_mesh_info m;
-        mk_mesh_get(a, i, &m);
-        fprintf(f, "o %s\n", m.name);
-        for (uint32_t v = 0; v < m.vertex_count; v++)
-            fprintf(f, "v %.9g %.9g %.9g\n", (double)pos[i][3 * v], (double)pos[i][3 * v + 1],
-                    (double)pos[i][3 * v + 2]);
-        if (nrm[i])
-            for (uint32_t v = 0; v < m.vertex_count; v++)
-                fprintf(f, "vn %.9g %.9g %.9g\n", (double)nrm[i][3 * v], (double)nrm[i][3 * v + 1],
-                        (double)nrm[i][3 * v + 2]);
-        for (uint32_t t = 0; t < m.triangle_count; t++) {
-            uint32_t x = m.triangles[3 * t] + base, y = m.triangles[3 * t + 1] + base,
-                     z = m.triangles[3 * t + 2] + base;
-            if (nrm[i])
-                fprintf(f, "f %u//%u %u//%u %u//%u\n", x, x, y, y, z, z);
-            else
-                fprintf(f, "f %u %u %u\n", x, y, z);
-        }
-        base += m.vertex_count;
-    }
-}
 
 typedef struct play_args {
     const char *input, *output, *clip, *weights;
@@ -102,8 +32,7 @@ static const cli_option options[] = {
       NULL, -1e9, 1e9, 0, offsetof(play_args, time_given) },
     { "--weights", "NAME=V,...", CLI_STRING, offsetof(play_args, weights),
       "Channel weights (1 = 100 %) set after the clip is sampled, by channel name, NODE/CHANNEL or index. A name sets "
-      "that "
-      "channel on every primitive of its node.",
+      "that channel on every primitive of its node.",
       NULL, NULL, 0, 0, 0, 0 },
     { "--stacking", "MODE", CLI_CHOICE, offsetof(play_args, stacking),
       "Channel stacking. Default: each mesh's stored stacking.", NULL, "additive|sequential", 0, 0, 0,
@@ -195,49 +124,22 @@ static int run_play(void *p)
         }
         clip = 0;
     }
-    float *weights = calloc(a->channel_count + 1u, sizeof(float));
-    float **pos = calloc(a->mesh_count + 1u, sizeof(float *)), **nrm = calloc(a->mesh_count + 1u, sizeof(float *));
     char *text = NULL, why[1024];
     size_t text_size = 0;
-    if (!weights || !pos || !nrm) {
-        fprintf(stderr, "morphkit play: out of memory\n");
-        status = 1;
-        goto done;
-    }
-    if (pb_frame_weights(a, clip, args->time, weights, &err)) {
-        status = cli_fail(verb->name, &err);
-        goto done;
-    }
-    if (args->weights && weights_arg_apply(a, args->weights, weights, why, sizeof why) != 0) {
+    pb_frame frame = { .asset = a, .clip = clip, .time = args->time, .stacking = stacking, .normal_mode = nmode,
+                       .world = !args->space };
+    frame.weights = calloc(a->channel_count + 1u, sizeof(float));
+    if (!frame.weights) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
+    if (pb_frame_weights(a, clip, args->time, frame.weights, &err)) { status = cli_fail(verb->name, &err); goto done; }
+    if (args->weights && weights_arg_apply(a, args->weights, frame.weights, why, sizeof why) != 0) {
         status = cli_usage_error(verb, "--weights: %s", why);
         goto done;
     }
-    for (uint32_t i = 0; i < a->mesh_count; i++) {
-        mk_mesh_info m;
-        mk_mesh_get(a, i, &m);
-        pos[i] = malloc(12u * (size_t)m.vertex_count);
-        nrm[i] = m.has_normals ? malloc(12u * (size_t)m.vertex_count) : NULL;
-        if (!pos[i] || (m.has_normals && !nrm[i])) {
-            fprintf(stderr, "morphkit play: out of memory\n");
-            status = 1;
-            goto done;
-        }
-        if (pb_eval_mesh(a, i, weights, stacking, nmode, pos[i], nrm[i], &err)) {
-            status = cli_fail(verb->name, &err);
-            goto done;
-        }
-        if (!args->space) pb_to_world(m.world, pos[i], nrm[i], m.vertex_count);
-    }
+    if (pb_frame_evaluate(&frame, &err) != MK_OK) { status = cli_fail(verb->name, &err); goto done; }
     FILE *f = open_memstream(&text, &text_size);
-    if (!f) {
-        fprintf(stderr, "morphkit play: out of memory\n");
-        status = 1;
-        goto done;
-    }
-    if (obj)
-        write_obj(f, a, pos, nrm);
-    else
-        write_json(f, a, pos, nrm, space, args->time, clip, weights);
+    if (!f) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
+    if (obj) pb_frame_write_obj(f, &frame, "morphkit play");
+    else pb_frame_write_json(f, &frame, "morphkit play");
     fclose(f);
     out.file.data = text;
     out.file.size = text_size;
@@ -248,26 +150,21 @@ static int run_play(void *p)
     if (clip >= 0) {
         mk_clip_info ci;
         mk_clip_get(a, (uint32_t)clip, &ci);
-        fprintf(report, "%s: clip '%s' at %g s%s", args->input, ci.name, args->time,
-                args->weights ? ", then --weights" : "");
+        fprintf(report, "%s: clip '%s' at %g s%s", args->input, ci.name, args->time, args->weights ? ", then --weights" : "");
     } else {
-        fprintf(report, "%s: %s", args->input,
-                args->weights ? "default weights, then --weights" : "default weights (no clip)");
+        fprintf(report, "%s: %s", args->input, args->weights ? "default weights, then --weights" : "default weights (no clip)");
     }
     fprintf(report, "; %u mesh%s (%s space, %s) written to %s\n", a->mesh_count, a->mesh_count == 1 ? "" : "es", space,
             obj ? "OBJ" : "JSON", out.to_stdout ? "standard output" : args->output);
     for (uint32_t c = 0; c < a->channel_count; c++) {
         mk_channel_info ch;
         mk_channel_get(a, c, &ch);
-        fprintf(report, "  %-32s %8.4f\n", ch.name, (double)weights[c]);
+        fprintf(report, "  %-32s %8.4f\n", ch.name, (double)frame.weights[c]);
     }
 done:
     free(text);
-    for (uint32_t i = 0; pos && i < a->mesh_count; i++) free(pos[i]);
-    for (uint32_t i = 0; nrm && i < a->mesh_count; i++) free(nrm[i]);
-    free(pos);
-    free(nrm);
-    free(weights);
+    pb_frame_free(&frame);
+    free(frame.weights);
     pb_asset_free(&l);
     return status;
 }
