@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <cjson/cJSON.h>
 #include "bake.h"
 #include "bake_util.h"
 #include "barr.h"
@@ -802,6 +803,23 @@ static void bake_keeps_existing_channels(void)
     mk_raw_free(&raw);
 }
 
+/* The channel reports of a bake, kept with copies of their names. */
+typedef struct recorded_channels {
+    mk_bake_channel_report reports[16];
+    char names[16][64];
+    uint32_t count;
+} recorded_channels;
+
+static void record_channels(void *user, const mk_bake_channel_report *c)
+{
+    recorded_channels *rec = user;
+    if (rec->count >= 16) return;
+    rec->reports[rec->count] = *c;
+    snprintf(rec->names[rec->count], sizeof rec->names[0], "%s", c->name);
+    rec->reports[rec->count].name = rec->names[rec->count];
+    rec->count++;
+}
+
 /* Every recipe in samples/recipes bakes on a tube like samples/make_example's (radius 0.5,
  * y from 0 to 2), including the cage OBJ files that resolve against the recipe directory. */
 static void sample_recipes_bake(void)
@@ -832,18 +850,43 @@ static void sample_recipes_bake(void)
         unsigned char *json = check_read_file(path, &size);
         CHECK_MSG(json != NULL, "missing %s", path);
         if (json) {
+            recorded_channels rec = { 0 };
             mk_bake_options o;
             memset(&o, 0, sizeof o);
             o.base_dir = dir;
+            o.channel_done = record_channels;
+            o.user = &rec;
             mk_bake_report rep;
             mk_error err;
             mk_result r = mk_bake_recipe(&raw, (const char *)json, size, &o, &rep, &err);
             CHECK_MSG(r == MK_OK, "%s: %s", names[k], err.message);
             CHECK(rep.channels_added >= 1);
             CHECK(r != MK_OK || mk_raw_validate(&raw, &err) == MK_OK);
-            /* auto channels meet their tolerance; each baked channel moves something */
+            /* Each baked channel moves something. */
             for (uint32_t c = 0; r == MK_OK && c < raw.channel_count; c++)
                 CHECK_MSG(max_delta(&raw.channels[c]) > 1e-3, "%s: channel %s moves nothing", names[k], raw.channels[c].name);
+            /* Channels with "inbetweens": "auto" meet their tolerance (default 0.001 of the
+             * diagonal), measured on the sampling grid. */
+            cJSON *recipe = cJSON_ParseWithLength((const char *)json, size);
+            const cJSON *ch;
+            int auto_channels = 0;
+            cJSON_ArrayForEach(ch, cJSON_GetObjectItem(recipe, "channels")) {
+                const char *inb = cJSON_GetStringValue(cJSON_GetObjectItem(ch, "inbetweens"));
+                if (!inb || strcmp(inb, "auto") != 0) continue;
+                const cJSON *tol = cJSON_GetObjectItem(ch, "tolerance");
+                double tolerance = cJSON_IsNumber(tol) ? tol->valuedouble : 0.001;
+                const char *name = cJSON_GetStringValue(cJSON_GetObjectItem(ch, "name"));
+                for (uint32_t i = 0; i < rec.count; i++)
+                    if (name && !strcmp(rec.reports[i].name, name)) {
+                        auto_channels++;
+                        CHECK_MSG(rec.reports[i].max_error <= tolerance, "%s: channel %s error %g > tolerance %g", names[k],
+                                  name, rec.reports[i].max_error, tolerance);
+                        CHECK_MSG(rec.reports[i].error_measured_on_grid, "%s: channel %s error not measured on the grid",
+                                  names[k], name);
+                    }
+            }
+            if (k == 0) CHECK_MSG(auto_channels > 0, "%s has no auto channel to check", names[k]);
+            cJSON_Delete(recipe);
             free(json);
         }
         mk_raw_free(&raw);

@@ -1,14 +1,15 @@
 /* SPDX-License-Identifier: MIT */
-/* Regression run of the glTF fuzz target (tests/fuzz/fuzz_gltf.c) over the corpus: every
- * glTF/GLB file whole, truncated at a spread of lengths, and with random byte flips. The
- * target aborts when a failure has no message; ASan/UBSan catch the rest. .gltf files with
- * external buffers fail early from memory (no base directory), so their JSON parsing is what
- * gets exercised; GLB files exercise everything. */
+/* Regression run of the glTF importer with the fuzz target's settings (tests/fuzz/fuzz_gltf.c)
+ * over the corpus: every glTF/GLB file whole, truncated at a spread of lengths, and with random
+ * byte flips. Each input either imports to a model that validates, or fails with a valid code
+ * and a message; ASan/UBSan catch the rest. The whole files must import (their damaged copies
+ * are measured against that). .gltf files with external buffers fail early from memory (no
+ * base directory), so their JSON parsing is what gets exercised; GLB files exercise everything. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
-#include "../fuzz/fuzz_gltf.c"
+#include "gltf_import.h"
 
 static const char *files[] = {
     "gltf/AnimatedMorphCube/glTF/AnimatedMorphCube.gltf",
@@ -42,6 +43,28 @@ static uint32_t next(void)
     return (uint32_t)state;
 }
 
+/* One input with the fuzz target's limits: 1 when it imported. */
+static int import_checked(const unsigned char *data, size_t size)
+{
+    mk_raw_asset raw;
+    mk_allocator limit = { 0 };
+    limit.memory_limit = (size_t)256 << 20;
+    mk_raw_init(&raw, &limit);
+    mk_import_options options = { .max_input_size = (size_t)64 << 20 };
+    mk_error err;
+    memset(&err, 0, sizeof err);
+    mk_result r = mk_import_gltf(data, size, &options, &raw, &err);
+    if (r == MK_OK) {
+        mk_error verr;
+        CHECK_MSG(mk_raw_validate(&raw, &verr) == MK_OK, "an imported model does not validate: %s", verr.message);
+    } else {
+        CHECK_MSG(r > MK_OK && r < MK_RESULT_COUNT && err.message[0] != 0 && err.code == r,
+                  "a failure without a valid code and message (%d)", (int)r);
+    }
+    mk_raw_free(&raw);
+    return r == MK_OK;
+}
+
 static void test_fuzz_seeds(void)
 {
     const char *corpus = check_corpus_dir();
@@ -54,17 +77,20 @@ static void test_fuzz_seeds(void)
         if (!data) continue;
         found++;
         unsigned char *copy = malloc(size + 1);
+        /* The whole GLB files import (.gltf files need their folder, absent from memory). */
+        int whole = import_checked(data, size);
+        if (strstr(files[i], ".glb")) CHECK_MSG(whole, "%s does not import from memory", files[i]);
         size_t step = size / 200 + 1;
         for (size_t n = 0; n <= size; n += step) {
             memcpy(copy, data, n);
-            CHECK(LLVMFuzzerTestOneInput(copy, n) == 0);
+            import_checked(copy, n);
             runs++;
         }
         for (int k = 0; k < 200; k++) {
             memcpy(copy, data, size);
             int flips = 1 + (int)(next() % 8);
             for (int f = 0; f < flips; f++) copy[next() % size] ^= (unsigned char)(1u << (next() % 8));
-            CHECK(LLVMFuzzerTestOneInput(copy, size) == 0);
+            import_checked(copy, size);
             runs++;
         }
         free(copy);

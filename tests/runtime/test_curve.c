@@ -1,5 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Every interpolation mode of weight curves against hand-computed values, and the sampling job. */
+#include <float.h>
+#include <math.h>
 #include "check.h"
 #include "fixtures.h"
 
@@ -95,11 +97,19 @@ static void test_cursor_matches_search(void)
     CHECK(same);
 }
 
+/* docs/semantics.md: a cubic segment's value saturates at +-FLT_MAX. Slope 3e38 over 100 s puts
+ * the first handle at 1e40: the midpoint is 3.75e39, past float range. */
 static void test_steep_slopes_stay_finite(void)
 {
     mk_key k[2] = { key(0, 0, MK_INTERP_CUBIC), key(100, 0, MK_INTERP_CUBIC) };
     k[0].right_slope = 3e38f;
-    CHECK(isfinite(mk_curve_eval(k, 2, 50.0, NULL)));
+    CHECK(mk_curve_eval(k, 2, 50.0, NULL) == FLT_MAX);
+    k[0].right_slope = -3e38f;
+    CHECK(mk_curve_eval(k, 2, 50.0, NULL) == -FLT_MAX);
+    /* Near the start the curve is still within range and keeps its value. */
+    k[0].right_slope = 1e30f;
+    float v = mk_curve_eval(k, 2, 1e-6, NULL);
+    CHECK(isfinite(v) && v > 0 && v < FLT_MAX);
 }
 
 static void test_span_without_targets(void)
