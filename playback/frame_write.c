@@ -81,6 +81,23 @@ static const char *stacking_name(mk_stacking s)
     return s == MK_STACKING_SEQUENTIAL ? "sequential" : s == MK_STACKING_ADDITIVE ? "additive" : "asset";
 }
 
+void pb_json_mesh_identity(json_writer *w, const mk_asset *a, uint32_t mesh)
+{
+    mk_mesh_info m;
+    mk_mesh_get(a, mesh, &m);
+    json_string(w, "name", m.name);
+    json_string(w, "node", m.name);
+    json_int(w, "mesh_index", mesh);
+    if (m.gltf_node >= 0) {
+        json_int(w, "gltf_node", m.gltf_node);
+        json_int(w, "gltf_mesh", m.gltf_mesh);
+        json_int(w, "gltf_primitive", m.gltf_primitive);
+    }
+    json_int(w, "vertices", m.vertex_count);
+    json_int(w, "control_point_count", m.control_point_count);
+    json_floats(w, "world", m.world, 16);
+}
+
 void pb_frame_write_json(FILE *file, const pb_frame *f, const char *producer)
 {
     const mk_asset *a = f->asset;
@@ -100,15 +117,7 @@ void pb_frame_write_json(FILE *file, const pb_frame *f, const char *producer)
         mk_mesh_info m;
         mk_mesh_get(a, i, &m);
         json_object(&w, NULL);
-        json_string(&w, "name", m.name);
-        json_string(&w, "node", m.name);
-        json_int(&w, "mesh_index", i);
-        if (m.gltf_node >= 0) {
-            json_int(&w, "gltf_node", m.gltf_node);
-            json_int(&w, "gltf_mesh", m.gltf_mesh);
-            json_int(&w, "gltf_primitive", m.gltf_primitive);
-        }
-        json_int(&w, "vertices", m.vertex_count);
+        pb_json_mesh_identity(&w, a, i);
         json_array(&w, "channels");
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
             mk_channel_info ch;
@@ -119,7 +128,6 @@ void pb_frame_write_json(FILE *file, const pb_frame *f, const char *producer)
             json_end_object(&w);
         }
         json_end_array(&w);
-        json_floats(&w, "world", m.world, 16);
         json_floats(&w, "positions", f->positions[i], 3u * (size_t)m.vertex_count);
         if (f->normals[i]) json_floats(&w, "normals", f->normals[i], 3u * (size_t)m.vertex_count);
         if (f->tangents && f->tangents[i]) json_floats(&w, "tangents", f->tangents[i], 4u * (size_t)m.vertex_count);

@@ -7,6 +7,7 @@
 #include <string.h>
 #include "asset.h"
 #include "cli.h"
+#include "frame_write.h"
 #include "json_write.h"
 
 static void precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *floats, double *max_error_bound)
@@ -106,17 +107,11 @@ static void print_json(FILE *f, const pb_asset *l, const char *path)
         mk_mesh_info m;
         mk_mesh_get(a, i, &m);
         json_object(&w, NULL);
-        json_string(&w, "name", m.name);
-        json_int(&w, "vertices", m.vertex_count);
-        json_int(&w, "control_points", m.control_point_count);
+        pb_json_mesh_identity(&w, a, i);
         json_int(&w, "triangles", m.triangle_count);
         json_bool(&w, "normals", m.has_normals);
         json_bool(&w, "tangents", m.has_tangents);
         json_string(&w, "stacking", m.stacking == MK_STACKING_SEQUENTIAL ? "sequential" : "additive");
-        json_int(&w, "gltf_node", m.gltf_node);
-        json_int(&w, "gltf_mesh", m.gltf_mesh);
-        json_int(&w, "gltf_primitive", m.gltf_primitive);
-        json_floats(&w, "world", m.world, 16);
         json_int(&w, "target_bytes", (long long)m.target_bytes);
         json_array(&w, "channels");
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
