@@ -14,6 +14,7 @@ static mk_result import_blob(const void *data, size_t size, const mk_import_opti
     mk_asset asset;
     if (r == MK_OK) r = mk_asset_open(data, size, &asset, err);
     if (r == MK_OK) r = mk_read_blob(&asset, out, err);
+    if (options) mk_phase_log_mark(options->phases, "open and read blob");
     return r != MK_OK ? r : mk_import_finish(out, options, err);
 }
 
@@ -62,6 +63,7 @@ mk_result mk_import_file(const char *path, const mk_import_options *options, mk_
         return r;
     }
     if (o.file_read) o.file_read(o.file_read_user, path);
+    mk_phase_log_mark(o.phases, "read file");
     char *dir = NULL;
     if (!o.base_dir) {
         const char *slash = strrchr(path, '/');

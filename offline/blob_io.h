@@ -3,6 +3,7 @@
 #ifndef MK_BLOB_IO_H
 #define MK_BLOB_IO_H
 
+#include "phase_log.h"
 #include "raw.h"
 
 typedef enum mk_precision {
@@ -19,6 +20,8 @@ typedef struct mk_write_options {
     /* Blocks of 64 vertices whose moved-vertex count is at least this are stored dense (all 64
      * vertices); 0 = 24. */
     uint32_t dense_threshold;
+    /* Phases of the write (quantize, lay out blocks, assemble); may be NULL. */
+    mk_phase_log *phases;
 } mk_write_options;
 
 typedef struct mk_write_report {

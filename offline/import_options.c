@@ -24,5 +24,7 @@ mk_result mk_import_finish(mk_raw_asset *raw, const mk_import_options *o, mk_err
     if (!o || !o->keep_plain_meshes) mk_raw_drop_plain_meshes(raw, NULL);
     mk_raw_sort_targets(raw);
     mk_result r = mk_raw_group_channels(raw, err);
-    return r != MK_OK ? r : mk_raw_validate(raw, err);
+    if (r == MK_OK) r = mk_raw_validate(raw, err);
+    if (o) mk_phase_log_mark(o->phases, "validate");
+    return r;
 }

@@ -4,6 +4,7 @@
 #ifndef MK_IMPORT_OPTIONS_H
 #define MK_IMPORT_OPTIONS_H
 
+#include "phase_log.h"
 #include "raw.h"
 
 typedef struct mk_import_options {
@@ -22,6 +23,9 @@ typedef struct mk_import_options {
      * external buffers), e.g. for a build system's depfile; may be NULL. */
     void (*file_read)(void *user, const char *path);
     void *file_read_user;
+    /* Where the import's time and memory go, phase by phase (read, parse, meshes, shapes,
+     * target normals, animation, validate); may be NULL. The caller starts the log. */
+    mk_phase_log *phases;
 } mk_import_options;
 
 #define MK_IMPORT_DEFAULT_MAX_INPUT ((size_t)4 << 30)

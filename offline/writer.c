@@ -348,8 +348,10 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
             bm->channel_count++;
         }
         bm->target_count = t_index - bm->first_target;
+        mk_phase_log_mark(opt.phases, "quantize");
         r = write_mesh_data(raw, mi, bm->first_channel, bm->channel_count, &plans[bm->first_target],
                             opt.dense_threshold, &data, &mesh_data[mi], &report, err);
+        mk_phase_log_mark(opt.phases, "lay out blocks");
         if (r) return r;
         bm->vertex_count = m->vertex_count;
         bm->control_point_count = m->control_points ? m->control_point_count : m->vertex_count;
@@ -449,6 +451,7 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
     mk_arena_release(arena, tracks);
     mk_arena_release(arena, keys);
     mk_arena_release(arena, mesh_data);
+    mk_phase_log_mark(opt.phases, "assemble and checksum");
     report.total_bytes = total;
     if (report_out) *report_out = report;
     *blob_out = blob;

@@ -8,7 +8,7 @@
 
 typedef struct import_args {
     const char *input, *output, *channels, *depfile;
-    int stacking, precision, stacking_given, quiet, all_meshes;
+    int stacking, precision, stacking_given, quiet, all_meshes, timings;
     double tolerance;
 } import_args;
 
@@ -35,6 +35,8 @@ static const cli_option options[] = {
     { "--all-meshes", NULL, CLI_FLAG, offsetof(import_args, all_meshes),
       "Also keep meshes without morph targets (by default only meshes with targets are imported).", NULL, NULL, 0, 0, 0,
       0 },
+    { "--timings", NULL, CLI_FLAG, offsetof(import_args, timings),
+      "Print where the import's time and memory went, phase by phase (to standard error).", NULL, NULL, 0, 0, 0, 0 },
     { "--depfile", "PATH", CLI_STRING, offsetof(import_args, depfile),
       "Also write a depfile for build systems (make syntax, as ninja and meson read it): the blob and every file the "
       "import read (the source, the sidecar, glTF buffers).",
@@ -77,11 +79,13 @@ static int run_import(void *p)
         return status;
     cli_depfile deps = { 0 };
 
-    mk_import_options io = { .channels_sidecar = a->channels, .keep_plain_meshes = a->all_meshes,
+    mk_phase_log phases;
+    mk_phase_log_start(&phases);
+    mk_import_options io = { .phases = a->timings ? &phases : NULL, .channels_sidecar = a->channels, .keep_plain_meshes = a->all_meshes,
                              .file_read = a->depfile ? cli_depfile_add : NULL, .file_read_user = &deps };
     if (a->stacking_given) io.stacking = a->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
     mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16,
-                            .tolerance = (float)a->tolerance };
+                            .tolerance = (float)a->tolerance, .phases = io.phases };
     /* Progress only for inputs big enough to take a while. */
     struct stat st;
     cli_progress progress;
@@ -112,6 +116,7 @@ static int run_import(void *p)
     }
     status = cli_write_outputs(verb, outs, a->depfile ? 2 : 1);
     free(dep_text);
+    mk_phase_log_mark(io.phases, "write file");
     if (status == 0) {
         uint32_t targets = 0;
         for (uint32_t c = 0; c < raw.channel_count; c++) targets += raw.channels[c].target_count;
@@ -125,5 +130,7 @@ static int run_import(void *p)
                    report.max_tangent_error);
     }
     mk_raw_free(&raw);
+    mk_phase_log_mark(io.phases, "release");
+    if (status == 0 && io.phases) mk_phase_log_print(io.phases, stderr);
     return status;
 }

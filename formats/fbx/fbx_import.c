@@ -32,11 +32,13 @@ mk_result mk_import_fbx(const void *data, size_t size, const mk_import_options *
     r = doc.binary ? fbx_parse_binary(&doc) : fbx_parse_ascii(&doc);
     if (r == MK_OK && doc.root.child_count == 0)
         r = mk_error_set(err, MK_ERROR_PARSE, 0, "not an FBX file: no nodes found (%zu bytes)", size);
+    mk_phase_log_mark(options->phases, "parse");
     if (r == MK_OK) {
         fbx_link_parents(&doc.root);
         r = fbx_convert(&doc, options, out);
     }
     fbx_doc_free(&doc);
     mk_arena_free_all(&scratch);
+    mk_phase_log_mark(options->phases, "release parse data");
     return r != MK_OK ? r : mk_import_finish(out, options, err);
 }

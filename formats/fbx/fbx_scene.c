@@ -883,7 +883,9 @@ static mk_result convert_meshes(scene *s)
         mk_raw_mesh *mesh = mk_raw_add_meshes(raw, 1);
         if (!mesh) return mk_error_oom(doc->err, "FBX mesh");
         fbx_mesh_map map;
+        mk_phase_log_mark(s->options->phases, "scene");
         mk_result r = fbx_build_mesh(doc, raw, geometry, mesh, &map);
+        mk_phase_log_mark(s->options->phases, "meshes");
         if (r != MK_OK) return r;
         mesh = &raw->meshes[mesh_index];
         if (mesh->vertex_count == 0) {
@@ -911,6 +913,7 @@ static mk_result convert_meshes(scene *s)
             r = legacy_shapes(s, geometry, geometry, o, mesh_index, &map);
         }
         fbx_mesh_map_free(doc, &map);
+        mk_phase_log_mark(s->options->phases, "shapes");
         if (r != MK_OK) return r;
         int needs_normals = 0;
         for (uint32_t c = first_channel; c < raw->channel_count; c++)
@@ -918,6 +921,7 @@ static mk_result convert_meshes(scene *s)
                 if (!raw->channels[c].targets[k].normals) needs_normals = 1;
         if (needs_normals) {
             r = mk_raw_compute_target_normals(raw, mesh_index, 0, doc->err);
+            mk_phase_log_mark(s->options->phases, "target normals");
             if (r != MK_OK) return r;
         }
     }
@@ -1151,6 +1155,8 @@ mk_result fbx_convert(fbx_doc *doc, const mk_import_options *options, mk_raw_ass
         if (!s.world || !s.world_state) r = mk_error_oom(doc->err, "FBX transforms");
     }
     if (r == MK_OK) r = convert_meshes(&s);
+    mk_phase_log_mark(options->phases, "scene");
     if (r == MK_OK) r = doc->version >= 7000 ? animation_7x(&s) : animation_takes(&s);
+    mk_phase_log_mark(options->phases, "animation");
     return r;
 }

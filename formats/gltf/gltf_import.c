@@ -540,8 +540,12 @@ mk_result mk_import_gltf(const void *data, size_t size, const mk_import_options 
     if (r == MK_OK)
         r = mk_gltf_doc_load(&tmp, data, size, -1, options ? options->base_dir : NULL, limit, options ? options->file_read : NULL,
                              options ? options->file_read_user : NULL, &im.doc, err);
+    mk_phase_log *phases = options ? options->phases : NULL;
+    mk_phase_log_mark(phases, "parse");
     if (r == MK_OK) r = import_doc(&im, err);
+    mk_phase_log_mark(phases, "convert");
     mk_gltf_doc_free(&im.doc);
     mk_arena_free_all(&tmp);
+    mk_phase_log_mark(phases, "release parse data");
     return r != MK_OK ? r : mk_import_finish(out, options, err);
 }
