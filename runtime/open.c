@@ -120,7 +120,7 @@ const char *mk_result_name(mk_result code)
 
 /* ---- validation helpers ---- */
 
-/* Where arrays may lie (the whole blob). */
+/* Where arrays may lie: the whole blob (sections) or the DATA section (mesh arrays). */
 typedef struct region {
     uint64_t begin, end;
     const char *name;
@@ -131,7 +131,7 @@ typedef struct validator {
     const uint8_t *data;
     uint64_t size;
     mk_error *err;
-    region blob;
+    region blob, data_section;
 } validator;
 
 static const char *const kind_names[MK_SECTION_KIND_COUNT] = {
@@ -236,6 +236,28 @@ static mk_result validate_sections(validator *v, mk_asset *a)
     for (uint32_t k = 1; k < MK_SECTION_KIND_COUNT; k++)
         if (FAILS("section.missing", found[k] == NULL))
             return fail2(v->err, MK_ERROR_CORRUPT, table, "required section kind ", k, kind_names[k], NONE, " is missing");
+    /* Sections never overlap each other or the header and section table (empty ones lie
+     * anywhere). */
+    const uint64_t table_end = table + (uint64_t)h->section_count * sizeof(mk_blob_section);
+    for (uint32_t k = 1; k < MK_SECTION_KIND_COUNT; k++) {
+        const mk_blob_section *s = found[k];
+        if (FAILS("section.overlaps_table", s->size && s->offset < table_end))
+            return fail3(v->err, MK_ERROR_CORRUPT, s->offset, "section ", found_at[k], kind_names[k], NONE,
+                         ": overlaps the header and section table, which end at byte ", table_end, "");
+        for (uint32_t j = k + 1; j < MK_SECTION_KIND_COUNT; j++) {
+            const mk_blob_section *t = found[j];
+            if (FAILS("section.overlap", s->size && t->size && s->offset < t->offset + t->size && t->offset < s->offset + s->size)) {
+                start_message(v->err, MK_ERROR_CORRUPT, t->offset);
+                say(v->err, "section ");
+                say_u64(v->err, found_at[j]);
+                say(v->err, kind_names[j]);
+                say(v->err, " overlaps section ");
+                say_u64(v->err, found_at[k]);
+                say(v->err, kind_names[k]);
+                return end_message(v->err, MK_ERROR_CORRUPT);
+            }
+        }
+    }
 
     a->strings = (const char *)(v->data + found[MK_SECTION_STRINGS]->offset);
     a->strings_size = found[MK_SECTION_STRINGS]->size;
@@ -245,6 +267,8 @@ static mk_result validate_sections(validator *v, mk_asset *a)
     if (FAILS("strings.trailing_nul", a->strings[a->strings_size - 1] != 0))
         return fail(v->err, MK_ERROR_CORRUPT, found[MK_SECTION_STRINGS]->offset + a->strings_size - 1, "string section",
                     NONE, " does not end with a NUL byte: its last string is unterminated");
+    v->data_section.begin = found[MK_SECTION_DATA]->offset;
+    v->data_section.end = found[MK_SECTION_DATA]->offset + found[MK_SECTION_DATA]->size;
     a->meshes = (const mk_blob_mesh *)(v->data + found[MK_SECTION_MESHES]->offset);
     a->mesh_count = (uint32_t)found[MK_SECTION_MESHES]->count;
     a->channels = (const mk_blob_channel *)(v->data + found[MK_SECTION_CHANNELS]->offset);
@@ -308,14 +332,14 @@ static mk_result validate_meshes(validator *v, const mk_asset *a)
         uint64_t bad = first_not_finite(m->world, 16);
         if (FAILS("mesh.world", bad < 16))
             return fail2(v->err, MK_ERROR_NOT_FINITE, at, "mesh ", i, ": world transform element ", bad, " is not finite");
-        if ((r = CHECK_ARRAY("mesh.positions", m->positions, m->vertex_count, 12, &v->blob, "mesh ", i, " positions")))
+        if ((r = CHECK_ARRAY("mesh.positions", m->positions, m->vertex_count, 12, &v->data_section, "mesh ", i, " positions")))
             return r;
         bad = first_not_finite((const float *)(v->data + m->positions), 3ull * m->vertex_count);
         if (FAILS("mesh.positions_finite", bad < 3ull * m->vertex_count))
             return fail2(v->err, MK_ERROR_NOT_FINITE, m->positions + 4 * bad, "mesh ", i, ": base position of vertex ",
                          bad / 3, " is not finite");
         if (m->flags & MK_MESH_HAS_NORMALS) {
-            if ((r = CHECK_ARRAY("mesh.normals", m->normals, m->vertex_count, 12, &v->blob, "mesh ", i, " normals")))
+            if ((r = CHECK_ARRAY("mesh.normals", m->normals, m->vertex_count, 12, &v->data_section, "mesh ", i, " normals")))
                 return r;
             bad = first_not_finite((const float *)(v->data + m->normals), 3ull * m->vertex_count);
             if (FAILS("mesh.normals_finite", bad < 3ull * m->vertex_count))
@@ -323,21 +347,21 @@ static mk_result validate_meshes(validator *v, const mk_asset *a)
                              bad / 3, " is not finite");
         }
         if (m->flags & MK_MESH_HAS_TANGENTS) {
-            if ((r = CHECK_ARRAY("mesh.tangents", m->tangents, m->vertex_count, 16, &v->blob, "mesh ", i, " tangents")))
+            if ((r = CHECK_ARRAY("mesh.tangents", m->tangents, m->vertex_count, 16, &v->data_section, "mesh ", i, " tangents")))
                 return r;
             bad = first_not_finite((const float *)(v->data + m->tangents), 4ull * m->vertex_count);
             if (FAILS("mesh.tangents_finite", bad < 4ull * m->vertex_count))
                 return fail2(v->err, MK_ERROR_NOT_FINITE, m->tangents + 4 * bad, "mesh ", i, ": base tangent of vertex ",
                              bad / 4, " is not finite");
         }
-        if ((r = CHECK_ARRAY("mesh.triangles", m->triangles, m->triangle_count, 12, &v->blob, "mesh ", i, " triangles")))
+        if ((r = CHECK_ARRAY("mesh.triangles", m->triangles, m->triangle_count, 12, &v->data_section, "mesh ", i, " triangles")))
             return r;
         const uint32_t *tri = (const uint32_t *)(v->data + m->triangles);
         for (uint64_t k = 0; k < 3ull * m->triangle_count; k++)
             if (FAILS("mesh.triangle_index", tri[k] >= m->vertex_count))
                 return fail3(v->err, MK_ERROR_CORRUPT, m->triangles + 4 * k, "mesh ", i, ": triangle ", k / 3,
                              " has vertex index ", tri[k], " out of range");
-        if ((r = CHECK_ARRAY("mesh.control_points", m->control_points, m->vertex_count, 4, &v->blob, "mesh ", i,
+        if ((r = CHECK_ARRAY("mesh.control_points", m->control_points, m->vertex_count, 4, &v->data_section, "mesh ", i,
                              " control points")))
             return r;
         const uint32_t *cp = (const uint32_t *)(v->data + m->control_points);
@@ -441,13 +465,13 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
 {
     const mk_blob_mesh *m = &a->meshes[mi];
     mk_result r;
-    if ((r = CHECK_ARRAY("mesh.block_table", m->block_entries, (uint64_t)m->block_count + 1, 4, &v->blob, "mesh ",
+    if ((r = CHECK_ARRAY("mesh.block_table", m->block_entries, (uint64_t)m->block_count + 1, 4, &v->data_section, "mesh ",
                          mi, " block table")))
         return r;
-    if ((r = CHECK_ARRAY("mesh.entries", m->entries, m->entry_count, sizeof(mk_blob_entry), &v->blob, "mesh ", mi,
+    if ((r = CHECK_ARRAY("mesh.entries", m->entries, m->entry_count, sizeof(mk_blob_entry), &v->data_section, "mesh ", mi,
                          " entries")))
         return r;
-    if ((r = CHECK_ARRAY("mesh.target_data", m->target_data, m->target_data_size, 1, &v->blob, "mesh ", mi,
+    if ((r = CHECK_ARRAY("mesh.target_data", m->target_data, m->target_data_size, 1, &v->data_section, "mesh ", mi,
                          " target data")))
         return r;
     const uint32_t *first = (const uint32_t *)(v->data + m->block_entries);
@@ -622,6 +646,7 @@ mk_result mk_asset_open(const void *data, size_t size, mk_asset *out, mk_error *
     v.size = size;
     v.err = err;
     v.blob = (region){ 0, size, "the blob", MK_ERROR_TRUNCATED };
+    v.data_section = (region){ 0, 0, "the DATA section", MK_ERROR_CORRUPT };
     mk_result r;
     if ((r = validate_sections(&v, &a))) return r;
     if ((r = validate_meshes(&v, &a))) return r;

@@ -184,6 +184,11 @@ PATCH(section_misaligned) { section(c, MK_SECTION_CLIPS)->offset += 8; }
 PATCH(section_past_end) { section(c, MK_SECTION_CHANNELS)->offset = (uint64_t)1 << 40; }
 PATCH(section_straddles_end) { section(c, MK_SECTION_KEYS)->offset = c->size - 16; }
 PATCH(section_missing) { header(c)->section_count--; }    /* DATA is the table's last */
+PATCH(section_over_table) { section(c, MK_SECTION_STRINGS)->offset = 64; }
+PATCH(section_over_header) { section(c, MK_SECTION_TARGETS)->offset = 0; }
+PATCH(section_overlap_same) { section(c, MK_SECTION_CHANNELS)->offset = section(c, MK_SECTION_MESHES)->offset; }
+PATCH(section_overlap_straddles) { section(c, MK_SECTION_KEYS)->offset = section(c, MK_SECTION_TRACKS)->offset + 16; }
+PATCH(section_overlap_data) { section(c, MK_SECTION_CLIPS)->offset = data_end(c) - 16 * c->a.clip_count * 2; }
 PATCH(strings_start) { *(char *)WRITABLE(c->a.strings) = 'x'; }
 PATCH(strings_empty)
 {
@@ -230,6 +235,7 @@ PATCH(mesh_world_inf) { mesh(c, 1)->world[13] = INFINITY; }
 PATCH(mesh_world_nan) { mesh(c, 2)->world[0] = NAN; }
 PATCH(positions_misaligned) { mesh(c, 0)->positions += 4; }
 PATCH(positions_past_data) { mesh(c, last_mesh(c))->positions = data_end(c) - 16; }
+PATCH(positions_outside_data) { mesh(c, 1)->positions = section(c, MK_SECTION_KEYS)->offset; }
 PATCH(positions_nan) { floats_at(c, mesh(c, 2)->positions)[3 * 149 + 2] = NAN; }
 PATCH(positions_inf) { floats_at(c, mesh(c, 0)->positions)[0] = -INFINITY; }
 PATCH(normals_misaligned) { mesh(c, 2)->normals += 12; }
@@ -407,6 +413,11 @@ static const corruption corruptions[] = {
     { "section.bounds", section_past_end, "CHANNELS at 2^40", MK_ERROR_TRUNCATED, "(CHANNELS): array of 6 x 32 bytes is not inside the blob", 0 },
     { "section.bounds", section_straddles_end, "KEYS over the blob's end", MK_ERROR_TRUNCATED, "(KEYS): array of 10 x 32 bytes is not inside the blob", 0 },
     { "section.missing", section_missing, "DATA left out of the table", MK_ERROR_CORRUPT, "required section kind 8 (DATA) is missing", 0 },
+    { "section.overlaps_table", section_over_table, "STRINGS over the section table", MK_ERROR_CORRUPT, "(STRINGS): overlaps the header and section table, which end at byte 320", 0 },
+    { "section.overlaps_table", section_over_header, "TARGETS over the header", MK_ERROR_CORRUPT, "(TARGETS): overlaps the header", 0 },
+    { "section.overlap", section_overlap_same, "CHANNELS on MESHES", MK_ERROR_CORRUPT, "section 2 (CHANNELS) overlaps section 1 (MESHES)", 0 },
+    { "section.overlap", section_overlap_straddles, "KEYS 16 bytes into TRACKS", MK_ERROR_CORRUPT, "section 6 (KEYS) overlaps section 5 (TRACKS)", 0 },
+    { "section.overlap", section_overlap_data, "CLIPS inside DATA", MK_ERROR_CORRUPT, "(DATA) overlaps section 4 (CLIPS)", 0 },
     { "strings.leading_nul", strings_start, "first string byte 'x'", MK_ERROR_CORRUPT, "string section does not start with a NUL byte", 0 },
     { "strings.leading_nul", strings_empty, "empty string section", MK_ERROR_CORRUPT, "string section does not start with a NUL byte", 0 },
     { "strings.trailing_nul", strings_end, "last string byte 'x'", MK_ERROR_CORRUPT, "does not end with a NUL byte: its last string is unterminated", 0 },
@@ -435,22 +446,23 @@ static const corruption corruptions[] = {
     { "mesh.world", mesh_world_inf, "world[13] = inf", MK_ERROR_NOT_FINITE, "mesh 1: world transform element 13 is not finite", 0 },
     { "mesh.world", mesh_world_nan, "world[0] = NaN", MK_ERROR_NOT_FINITE, "mesh 2: world transform element 0 is not finite", 0 },
     { "mesh.positions.align", positions_misaligned, "positions at +4", MK_ERROR_BAD_ALIGNMENT, "mesh 0 positions: array is not 16-byte aligned", 0 },
-    { "mesh.positions.bounds", positions_past_data, "positions over the end", MK_ERROR_TRUNCATED, "mesh 3 positions: array of 3 x 12 bytes is not inside the blob", 0 },
+    { "mesh.positions.bounds", positions_past_data, "positions over the end", MK_ERROR_CORRUPT, "mesh 3 positions: array of 3 x 12 bytes is not inside the DATA section", 0 },
+    { "mesh.positions.bounds", positions_outside_data, "positions in KEYS", MK_ERROR_CORRUPT, "mesh 1 positions: array of 3 x 12 bytes is not inside the DATA section", 0 },
     { "mesh.positions_finite", positions_nan, "last vertex z = NaN", MK_ERROR_NOT_FINITE, "mesh 2: base position of vertex 149 is not finite", 0 },
     { "mesh.positions_finite", positions_inf, "first vertex x = -inf", MK_ERROR_NOT_FINITE, "mesh 0: base position of vertex 0 is not finite", 0 },
     { "mesh.normals.align", normals_misaligned, "normals at +12", MK_ERROR_BAD_ALIGNMENT, "mesh 2 normals: array is not 16-byte aligned", 0 },
-    { "mesh.normals.bounds", normals_past_data, "normals over the end", MK_ERROR_TRUNCATED, "mesh 2 normals: array of 150 x 12 bytes is not inside the blob", 0 },
+    { "mesh.normals.bounds", normals_past_data, "normals over the end", MK_ERROR_CORRUPT, "mesh 2 normals: array of 150 x 12 bytes is not inside the DATA section", 0 },
     { "mesh.normals_finite", normals_nan, "normal NaN", MK_ERROR_NOT_FINITE, "mesh 0: base normal of vertex 1 is not finite", 0 },
     { "mesh.tangents.align", tangents_misaligned, "tangents at +8", MK_ERROR_BAD_ALIGNMENT, "mesh 0 tangents: array is not 16-byte aligned", 0 },
-    { "mesh.tangents.bounds", tangents_past_data, "tangents over the end", MK_ERROR_TRUNCATED, "mesh 0 tangents: array of 4 x 16 bytes is not inside the blob", 0 },
+    { "mesh.tangents.bounds", tangents_past_data, "tangents over the end", MK_ERROR_CORRUPT, "mesh 0 tangents: array of 4 x 16 bytes is not inside the DATA section", 0 },
     { "mesh.tangents_finite", tangents_inf, "handedness -inf", MK_ERROR_NOT_FINITE, "mesh 0: base tangent of vertex 3 is not finite", 0 },
     { "mesh.triangles.align", triangles_misaligned, "triangles at +4", MK_ERROR_BAD_ALIGNMENT, "mesh 2 triangles: array is not 16-byte aligned", 0 },
-    { "mesh.triangles.bounds", triangles_past_data, "triangles over the end", MK_ERROR_TRUNCATED, "mesh 3 triangles: array of 1 x 12 bytes is not inside the blob", 0 },
-    { "mesh.triangles.bounds", triangles_count, "2^30 triangles", MK_ERROR_TRUNCATED, "mesh 1 triangles: array of 1073741824 x 12 bytes", 0 },
+    { "mesh.triangles.bounds", triangles_past_data, "triangles over the end", MK_ERROR_CORRUPT, "mesh 3 triangles: array of 1 x 12 bytes is not inside the DATA section", 0 },
+    { "mesh.triangles.bounds", triangles_count, "2^30 triangles", MK_ERROR_CORRUPT, "mesh 1 triangles: array of 1073741824 x 12 bytes", 0 },
     { "mesh.triangle_index", triangle_index, "index = vertex count", MK_ERROR_CORRUPT, "mesh 2: triangle 147 has vertex index 150 out of range", 0 },
     { "mesh.triangle_index", triangle_index_huge, "index 2^32 - 1", MK_ERROR_CORRUPT, "mesh 3: triangle 0 has vertex index 4294967295 out of range", 0 },
     { "mesh.control_points.align", control_points_misaligned, "control points at +4", MK_ERROR_BAD_ALIGNMENT, "mesh 1 control points: array is not 16-byte aligned", 0 },
-    { "mesh.control_points.bounds", control_points_past_data, "control points over the end", MK_ERROR_TRUNCATED, "mesh 3 control points: array of 3 x 4 bytes is not inside the blob", 0 },
+    { "mesh.control_points.bounds", control_points_past_data, "control points over the end", MK_ERROR_CORRUPT, "mesh 3 control points: array of 3 x 4 bytes is not inside the DATA section", 0 },
     { "mesh.control_point_index", control_point_index, "control point = count", MK_ERROR_CORRUPT, "mesh 0: vertex 3 has control point 3 out of range", 0 },
     { "meshes.channels_owned", meshes_channel_left, "last channel without mesh", MK_ERROR_CORRUPT, "meshes own 5 of the 6 channels", 0 },
     { "meshes.targets_owned", meshes_target_left, "last target without mesh", MK_ERROR_CORRUPT, "meshes own 8 of the 9 targets", 0 },
@@ -490,12 +502,12 @@ static const corruption corruptions[] = {
     { "target.scale_negative", target_position_scale_negative, "position scale -0.5", MK_ERROR_CORRUPT, "target 7: position scale is negative", 0 },
 
     { "mesh.block_table.align", block_table_misaligned, "block table at +4", MK_ERROR_BAD_ALIGNMENT, "mesh 2 block table: array is not 16-byte aligned", 0 },
-    { "mesh.block_table.bounds", block_table_past_data, "block table at the end", MK_ERROR_TRUNCATED, "mesh 2 block table: array of 4 x 4 bytes is not inside the blob", 0 },
+    { "mesh.block_table.bounds", block_table_past_data, "block table at the end", MK_ERROR_CORRUPT, "mesh 2 block table: array of 4 x 4 bytes is not inside the DATA section", 0 },
     { "mesh.entries.align", entries_misaligned, "entries at +8", MK_ERROR_BAD_ALIGNMENT, "mesh 0 entries: array is not 16-byte aligned", 0 },
-    { "mesh.entries.bounds", entries_past_data, "entries over the end", MK_ERROR_TRUNCATED, "mesh 3 entries: array of 1 x 16 bytes is not inside the blob", 0 },
-    { "mesh.entries.bounds", entries_count_overflow, "2^60 entries (the size overflows)", MK_ERROR_TRUNCATED, "mesh 2 entries: array of 1152921504606846976 x 16 bytes", 0 },
+    { "mesh.entries.bounds", entries_past_data, "entries over the end", MK_ERROR_CORRUPT, "mesh 3 entries: array of 1 x 16 bytes is not inside the DATA section", 0 },
+    { "mesh.entries.bounds", entries_count_overflow, "2^60 entries (the size overflows)", MK_ERROR_CORRUPT, "mesh 2 entries: array of 1152921504606846976 x 16 bytes", 0 },
     { "mesh.target_data.align", target_data_misaligned, "target data at +4", MK_ERROR_BAD_ALIGNMENT, "mesh 2 target data: array is not 16-byte aligned", 0 },
-    { "mesh.target_data.bounds", target_data_past_data, "target data 16 bytes longer", MK_ERROR_TRUNCATED, "mesh 3 target data: array of", 0 },
+    { "mesh.target_data.bounds", target_data_past_data, "target data 16 bytes longer", MK_ERROR_CORRUPT, "mesh 3 target data: array of", 0 },
     { "block_table.first", block_table_first, "table starts at 1", MK_ERROR_CORRUPT, "mesh 2: block table starts at entry 1 instead of 0", 0 },
     { "block_table.last", block_table_last, "table ends one short", MK_ERROR_CORRUPT, "mesh 2: block table ends at entry 10 instead of the entry count 11", 0 },
     { "block_table.last", block_table_last_huge, "table ends at 2^32 - 1", MK_ERROR_CORRUPT, "mesh 0: block table ends at entry 4294967295", 0 },
