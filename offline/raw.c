@@ -245,8 +245,10 @@ mk_result mk_raw_validate(const mk_raw_asset *raw, mk_error *err)
     }
     for (uint32_t i = 0; i < raw->clip_count; i++) {
         const mk_raw_clip *clip = &raw->clips[i];
-        if (!isfinite(clip->start) || !isfinite(clip->duration) || clip->duration < 0)
-            return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX, "clip %u: start/duration not finite or negative", i);
+        if (!isfinite(clip->start) || !isfinite(clip->duration))
+            return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX, "clip %u: start/duration not finite", i);
+        if (clip->duration < 0)  /* as mk_asset_open judges the blob it would become */
+            return mk_error_set(err, MK_ERROR_CORRUPT, UINT64_MAX, "clip %u: negative duration %g", i, (double)clip->duration);
         for (uint32_t t = 0; t < clip->track_count; t++) {
             const mk_raw_track *tr = &clip->tracks[t];
             if (tr->channel >= raw->channel_count)

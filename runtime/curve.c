@@ -21,6 +21,7 @@
 #include "format.h"
 #include "morphkit.h"
 #include "determinism.h"
+#include "error.h"
 
 static double bezier1(double p0, double p1, double p2, double p3, double u)
 {
@@ -93,31 +94,18 @@ float mk_curve_eval(const mk_key *keys, uint32_t count, double time, uint32_t *c
     return segment_value(&keys[k], &keys[k + 1], time);
 }
 
-static mk_result sample_fail(mk_error *err, mk_result code, const char *message)
-{
-    if (err) {
-        err->code = code;
-        err->offset = UINT64_MAX;
-        size_t n = strlen(message);
-        if (n > sizeof err->message - 1) n = sizeof err->message - 1;
-        memcpy(err->message, message, n);
-        err->message[n] = 0;
-    }
-    return code;
-}
-
 mk_result mk_sample_validate(const mk_sample_job *job, mk_error *err)
 {
-    if (!job || !job->asset) return sample_fail(err, MK_ERROR_INVALID_ARGUMENT, "sample job or its asset is NULL");
+    if (!job || !job->asset) return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "sample job or its asset is NULL");
     const mk_asset *a = job->asset;
-    if (job->clip >= a->clip_count) return sample_fail(err, MK_ERROR_OUT_OF_RANGE, "sample job: clip index out of range");
-    if (!isfinite(job->time)) return sample_fail(err, MK_ERROR_NOT_FINITE, "sample job: time is NaN or infinite");
+    if (job->clip >= a->clip_count) return mk_error_fail(err, MK_ERROR_OUT_OF_RANGE, MK_NO_OFFSET, "sample job: clip index out of range");
+    if (!isfinite(job->time)) return mk_error_fail(err, MK_ERROR_NOT_FINITE, MK_NO_OFFSET, "sample job: time is NaN or infinite");
     if (a->channel_count && !job->weights)
-        return sample_fail(err, MK_ERROR_INVALID_ARGUMENT, "sample job: weights output is NULL");
+        return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "sample job: weights output is NULL");
     if (job->weight_count < a->channel_count)
-        return sample_fail(err, MK_ERROR_BUFFER_TOO_SMALL, "sample job: weight_count is less than the asset's channel count");
+        return mk_error_fail(err, MK_ERROR_BUFFER_TOO_SMALL, MK_NO_OFFSET, "sample job: weight_count is less than the asset's channel count");
     if (job->cursors && job->cursor_count < a->clips[job->clip].track_count)
-        return sample_fail(err, MK_ERROR_BUFFER_TOO_SMALL, "sample job: fewer cursors than the clip has tracks");
+        return mk_error_fail(err, MK_ERROR_BUFFER_TOO_SMALL, MK_NO_OFFSET, "sample job: fewer cursors than the clip has tracks");
     return MK_OK;
 }
 

@@ -28,6 +28,7 @@
 #include "format.h"
 #include "morphkit.h"
 #include "determinism.h"
+#include "error.h"
 
 /* ---- channel spans ---- */
 
@@ -100,19 +101,6 @@ size_t mk_eval_scratch_size(const mk_asset *asset, uint32_t mesh)
 
 /* ---- validation ---- */
 
-static mk_result job_fail(mk_error *err, mk_result code, const char *message)
-{
-    if (err) {
-        err->code = code;
-        err->offset = UINT64_MAX;
-        size_t n = strlen(message);
-        if (n > sizeof err->message - 1) n = sizeof err->message - 1;
-        memcpy(err->message, message, n);
-        err->message[n] = 0;
-    }
-    return code;
-}
-
 static int span_ok(const void *p, size_t stride, size_t size, uint32_t count, size_t elem)
 {
     if ((uintptr_t)p % 4 || stride % 4 || stride < elem) return 0;
@@ -130,44 +118,44 @@ static uint32_t job_vertex_count(const mk_eval_job *job)
 
 mk_result mk_eval_validate(const mk_eval_job *job, mk_error *err)
 {
-    if (!job || !job->asset) return job_fail(err, MK_ERROR_INVALID_ARGUMENT, "eval job or its asset is NULL");
+    if (!job || !job->asset) return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job or its asset is NULL");
     const mk_asset *a = job->asset;
-    if (job->mesh >= a->mesh_count) return job_fail(err, MK_ERROR_OUT_OF_RANGE, "eval job: mesh index out of range");
+    if (job->mesh >= a->mesh_count) return mk_error_fail(err, MK_ERROR_OUT_OF_RANGE, MK_NO_OFFSET, "eval job: mesh index out of range");
     const mk_blob_mesh *m = &a->meshes[job->mesh];
     if (job->first_vertex > m->vertex_count
         || (job->vertex_count != MK_VERTICES_TO_END && job->vertex_count > m->vertex_count - job->first_vertex))
-        return job_fail(err, MK_ERROR_OUT_OF_RANGE, "eval job: vertex range exceeds the mesh");
+        return mk_error_fail(err, MK_ERROR_OUT_OF_RANGE, MK_NO_OFFSET, "eval job: vertex range exceeds the mesh");
     if (job->weight_count != m->channel_count)
-        return job_fail(err, MK_ERROR_OUT_OF_RANGE, "eval job: weight_count differs from the mesh's channel count");
+        return mk_error_fail(err, MK_ERROR_OUT_OF_RANGE, MK_NO_OFFSET, "eval job: weight_count differs from the mesh's channel count");
     if (m->channel_count && !job->weights)
-        return job_fail(err, MK_ERROR_INVALID_ARGUMENT, "eval job: weights is NULL");
+        return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: weights is NULL");
     for (uint32_t c = 0; c < m->channel_count; c++)
-        if (!isfinite(job->weights[c])) return job_fail(err, MK_ERROR_NOT_FINITE, "eval job: a weight is NaN or infinite");
+        if (!isfinite(job->weights[c])) return mk_error_fail(err, MK_ERROR_NOT_FINITE, MK_NO_OFFSET, "eval job: a weight is NaN or infinite");
     if ((unsigned)job->stacking > MK_STACKING_SEQUENTIAL)
-        return job_fail(err, MK_ERROR_INVALID_ARGUMENT, "eval job: unknown stacking mode");
+        return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: unknown stacking mode");
     if ((unsigned)job->normal_mode > MK_NORMALS_SLERP)
-        return job_fail(err, MK_ERROR_INVALID_ARGUMENT, "eval job: unknown normal mode");
+        return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: unknown normal mode");
     if ((unsigned)job->store_mode > MK_STORE_STREAMING)
-        return job_fail(err, MK_ERROR_INVALID_ARGUMENT, "eval job: unknown store mode");
+        return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: unknown store mode");
     if (!job->scratch || (uintptr_t)job->scratch % 16)
-        return job_fail(err, MK_ERROR_INVALID_ARGUMENT, "eval job: scratch is NULL or not 16-byte aligned");
+        return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: scratch is NULL or not 16-byte aligned");
     if (job->scratch_size < scratch_bytes(m->target_count, m->channel_count))
-        return job_fail(err, MK_ERROR_BUFFER_TOO_SMALL, "eval job: scratch is smaller than mk_eval_scratch_size()");
+        return mk_error_fail(err, MK_ERROR_BUFFER_TOO_SMALL, MK_NO_OFFSET, "eval job: scratch is smaller than mk_eval_scratch_size()");
     uint32_t n = job_vertex_count(job);
-    if (!job->positions) return job_fail(err, MK_ERROR_INVALID_ARGUMENT, "eval job: positions output is NULL");
+    if (!job->positions) return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: positions output is NULL");
     if (!span_ok(job->positions, stride_or(job->positions_stride, 12), job->positions_size, n, 12))
-        return job_fail(err, MK_ERROR_BUFFER_TOO_SMALL, "eval job: positions span is too small or misaligned");
+        return mk_error_fail(err, MK_ERROR_BUFFER_TOO_SMALL, MK_NO_OFFSET, "eval job: positions span is too small or misaligned");
     if (job->normals) {
         if (!(m->flags & MK_MESH_HAS_NORMALS))
-            return job_fail(err, MK_ERROR_UNSUPPORTED, "eval job: normals requested but the mesh has no normals");
+            return mk_error_fail(err, MK_ERROR_UNSUPPORTED, MK_NO_OFFSET, "eval job: normals requested but the mesh has no normals");
         if (!span_ok(job->normals, stride_or(job->normals_stride, 12), job->normals_size, n, 12))
-            return job_fail(err, MK_ERROR_BUFFER_TOO_SMALL, "eval job: normals span is too small or misaligned");
+            return mk_error_fail(err, MK_ERROR_BUFFER_TOO_SMALL, MK_NO_OFFSET, "eval job: normals span is too small or misaligned");
     }
     if (job->tangents) {
         if (!(m->flags & MK_MESH_HAS_TANGENTS))
-            return job_fail(err, MK_ERROR_UNSUPPORTED, "eval job: tangents requested but the mesh has no tangents");
+            return mk_error_fail(err, MK_ERROR_UNSUPPORTED, MK_NO_OFFSET, "eval job: tangents requested but the mesh has no tangents");
         if (!span_ok(job->tangents, stride_or(job->tangents_stride, 16), job->tangents_size, n, 16))
-            return job_fail(err, MK_ERROR_BUFFER_TOO_SMALL, "eval job: tangents span is too small or misaligned");
+            return mk_error_fail(err, MK_ERROR_BUFFER_TOO_SMALL, MK_NO_OFFSET, "eval job: tangents span is too small or misaligned");
     }
     return MK_OK;
 }

@@ -11,54 +11,72 @@
 #include "format.h"
 #include "morphkit.h"
 #include "determinism.h"
+#include "error.h"
 
-/* ---- error message building ---- */
-
-static void append(char *buf, size_t *len, const char *s)
+/* ---- named checks ----
+ *
+ * Every way mk_asset_open rejects its input is one check with a unique name, "area.rule". A
+ * check is written `if (FAILS("area.rule", condition)) return fail...(...)`; the arrays checked
+ * by check_array are named once per call site, CHECK_ARRAY("area.array", ...), which stands
+ * for two checks, "area.array.align" and "area.array.bounds". Nothing else returns an error.
+ *
+ * In normal builds FAILS(name, condition) is just the condition. Test builds
+ * (-DMK_OPEN_CHECK_IDS, tests/runtime/test_open_checks.c) record the name of the check that
+ * rejected the last blob in mk_open_rejected_by, and can force one check's condition false
+ * (mk_open_disabled_check) to prove that its test fails without it. That test reads this file,
+ * lists every FAILS and CHECK_ARRAY name, and fails when one has no corruption test that trips
+ * it, when a name is used twice, when a failure return is not guarded by FAILS, or when
+ * docs/format.md does not list the name. */
+#ifdef MK_OPEN_CHECK_IDS
+extern const char *mk_open_rejected_by;
+extern const char *mk_open_disabled_check;
+const char *mk_open_rejected_by;
+const char *mk_open_disabled_check;
+static int check_fails(const char *name)
 {
-    while (*s && *len + 1 < 256) buf[(*len)++] = *s++;
-    buf[*len] = 0;
+    if (mk_open_disabled_check && strcmp(name, mk_open_disabled_check) == 0) return 0;
+    mk_open_rejected_by = name;
+    return 1;
+}
+#define FAILS(name, condition) ((condition) && check_fails(name))
+#else
+#define FAILS(name, condition) (condition)
+#endif
+
+/* ---- error messages (runtime/error.h) ---- */
+
+#define NONE UINT64_MAX            /* a number left out of a message */
+#define NO_OFFSET MK_NO_OFFSET
+#define say mk_error_text
+#define say_u64 mk_error_number
+#define start_message mk_error_start
+#define end_message mk_error_end
+
+/* Message "<s0><n0><s1><n1><s2><n2><s3>" (a number of NONE is left out), then
+ * " (byte offset N)" when the offset is known. */
+static mk_result fail3(mk_error *err, mk_result code, uint64_t offset, const char *s0, uint64_t n0, const char *s1,
+                       uint64_t n1, const char *s2, uint64_t n2, const char *s3)
+{
+    start_message(err, code, offset);
+    say(err, s0);
+    if (n0 != NONE) say_u64(err, n0);
+    say(err, s1);
+    if (n1 != NONE) say_u64(err, n1);
+    say(err, s2);
+    if (n2 != NONE) say_u64(err, n2);
+    say(err, s3);
+    return end_message(err, code);
 }
 
-static void append_u64(char *buf, size_t *len, uint64_t v)
+static mk_result fail2(mk_error *err, mk_result code, uint64_t offset, const char *s0, uint64_t n0, const char *s1,
+                       uint64_t n1, const char *s2)
 {
-    char digits[24];
-    int n = 0;
-    do { digits[n++] = (char)('0' + v % 10); v /= 10; } while (v);
-    char tmp[2] = { 0, 0 };
-    while (n--) { tmp[0] = digits[n]; append(buf, len, tmp); }
+    return fail3(err, code, offset, s0, n0, s1, n1, s2, NONE, "");
 }
 
-#define NO_INDEX UINT64_MAX
-#define NO_OFFSET UINT64_MAX
-
-/* Message: "<a><i1><b><i2><c>" (an index of NO_INDEX is left out) plus " (byte offset N)"
- * when the offset is known. */
-static mk_result fail_with(mk_error *err, mk_result code, uint64_t offset, const char *a, uint64_t i1,
-                           const char *b, uint64_t i2, const char *c)
+static mk_result fail(mk_error *err, mk_result code, uint64_t offset, const char *s0, uint64_t n0, const char *s1)
 {
-    if (!err) return code;
-    size_t len = 0;
-    err->code = code;
-    err->offset = offset;
-    err->message[0] = 0;
-    append(err->message, &len, a);
-    if (i1 != NO_INDEX) append_u64(err->message, &len, i1);
-    append(err->message, &len, b);
-    if (i2 != NO_INDEX) append_u64(err->message, &len, i2);
-    append(err->message, &len, c);
-    if (offset != NO_OFFSET) {
-        append(err->message, &len, " (byte offset ");
-        append_u64(err->message, &len, offset);
-        append(err->message, &len, ")");
-    }
-    return code;
-}
-
-static mk_result fail(mk_error *err, mk_result code, uint64_t offset, const char *a, uint64_t index,
-                      const char *b)
-{
-    return fail_with(err, code, offset, a, index, b, NO_INDEX, "");
+    return fail3(err, code, offset, s0, n0, s1, NONE, "", NONE, "");
 }
 
 const char *mk_result_name(mk_result code)
@@ -73,50 +91,88 @@ const char *mk_result_name(mk_result code)
 
 /* ---- validation helpers ---- */
 
+/* Where arrays may lie: the whole blob (sections) or the DATA section (mesh arrays). */
+typedef struct region {
+    uint64_t begin, end;
+    const char *name;
+    mk_result code;                /* of an array outside it */
+} region;
+
 typedef struct validator {
     const uint8_t *data;
     uint64_t size;
     mk_error *err;
+    region blob, data_section;
 } validator;
 
-/* Is [offset, offset + count * elem) inside the blob and offset 16-aligned? */
-static mk_result check_array(const validator *v, uint64_t offset, uint64_t count, uint64_t elem,
-                             const char *what, uint64_t index, const char *field)
+static const char *const kind_names[MK_SECTION_KIND_COUNT] = {
+    "", " (STRINGS)", " (MESHES)", " (CHANNELS)", " (TARGETS)", " (CLIPS)", " (TRACKS)", " (KEYS)", " (DATA)",
+};
+
+/* The array [offset, offset + count * elem) must start 16-aligned and lie inside `in`
+ * (overflow-safe). The message names the array: "<what><index><field>: ...". */
+#define CHECK_ARRAY(name, ...) check_array(v, name ".align", name ".bounds", __VA_ARGS__)
+static mk_result check_array(const validator *v, const char *align_check, const char *bounds_check, uint64_t offset,
+                             uint64_t count, uint64_t elem, const region *in, const char *what, uint64_t index,
+                             const char *field)
 {
-    (void)field;
-    if (offset % MK_ALIGN)
-        return fail(v->err, MK_ERROR_BAD_ALIGNMENT, offset, what, index, ": array is not 16-byte aligned");
-    if (elem && count > (UINT64_MAX / elem))
-        return fail(v->err, MK_ERROR_CORRUPT, offset, what, index, ": array size overflows");
-    uint64_t bytes = count * elem;
-    if (offset > v->size || bytes > v->size - offset)
-        return fail(v->err, MK_ERROR_TRUNCATED, offset, what, index, ": array extends past the end of the blob");
+    (void)align_check;             /* used by FAILS in test builds only */
+    (void)bounds_check;
+    if (FAILS(align_check, offset % MK_ALIGN != 0)) {
+        start_message(v->err, MK_ERROR_BAD_ALIGNMENT, offset);
+        say(v->err, what);
+        say_u64(v->err, index);
+        say(v->err, field);
+        say(v->err, ": array is not 16-byte aligned");
+        return end_message(v->err, MK_ERROR_BAD_ALIGNMENT);
+    }
+    if (FAILS(bounds_check, offset < in->begin || offset > in->end || (elem && count > (in->end - offset) / elem))) {
+        start_message(v->err, in->code, offset);
+        say(v->err, what);
+        say_u64(v->err, index);
+        say(v->err, field);
+        say(v->err, ": array of ");
+        say_u64(v->err, count);
+        say(v->err, " x ");
+        say_u64(v->err, elem);
+        say(v->err, " bytes is not inside ");
+        say(v->err, in->name);
+        say(v->err, " [");
+        say_u64(v->err, in->begin);
+        say(v->err, ", ");
+        say_u64(v->err, in->end);
+        say(v->err, ")");
+        return end_message(v->err, in->code);
+    }
     return MK_OK;
 }
 
-static int all_finite(const float *p, uint64_t n)
+/* Index of the first element of p[0..n) that is not finite, or n. */
+static uint64_t first_not_finite(const float *p, uint64_t n)
 {
     for (uint64_t i = 0; i < n; i++)
-        if (!isfinite(p[i])) return 0;
-    return 1;
+        if (!isfinite(p[i])) return i;
+    return n;
 }
 
 static int valid_string(const mk_asset *a, uint32_t offset) { return offset < a->strings_size; }
 
-/* Reserved fields must be zero, so a later version can give them a meaning. */
-static int all_zero(const uint32_t *p, size_t n)
+/* Index of the first nonzero element of p[0..n) (reserved fields must be zero, so a later
+ * version can give them a meaning), or n. */
+static size_t first_nonzero(const uint32_t *p, size_t n)
 {
     for (size_t i = 0; i < n; i++)
-        if (p[i]) return 0;
-    return 1;
+        if (p[i]) return i;
+    return n;
 }
 
+static uint64_t offset_of(const validator *v, const void *p) { return (uint64_t)((const uint8_t *)p - v->data); }
 
 static mk_result validate_sections(validator *v, mk_asset *a)
 {
     const mk_blob_header *h = a->header;
-    uint64_t table = sizeof(mk_blob_header);
-    if ((uint64_t)h->section_count > (v->size - table) / sizeof(mk_blob_section))
+    const uint64_t table = sizeof(mk_blob_header);
+    if (FAILS("section.table", (uint64_t)h->section_count > (v->size - table) / sizeof(mk_blob_section)))
         return fail(v->err, MK_ERROR_TRUNCATED, table, "section table of ", h->section_count,
                     " sections extends past the end of the blob");
     static const uint32_t element_sizes[MK_SECTION_KIND_COUNT] = {
@@ -125,31 +181,65 @@ static mk_result validate_sections(validator *v, mk_asset *a)
     };
     const mk_blob_section *sections = (const mk_blob_section *)(v->data + table);
     const mk_blob_section *found[MK_SECTION_KIND_COUNT] = { 0 };
+    uint32_t found_at[MK_SECTION_KIND_COUNT] = { 0 };
     for (uint32_t i = 0; i < h->section_count; i++) {
         const mk_blob_section *s = &sections[i];
         uint64_t at = table + (uint64_t)i * sizeof(mk_blob_section);
-        if (s->kind == 0 || s->kind >= MK_SECTION_KIND_COUNT)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "section ", i, ": unknown kind");
-        if (found[s->kind])
-            return fail(v->err, MK_ERROR_CORRUPT, at, "section ", i, ": kind appears twice");
-        if (s->element_size != element_sizes[s->kind])
-            return fail(v->err, MK_ERROR_CORRUPT, at, "section ", i, ": wrong element size for its kind");
-        if (s->count > UINT64_MAX / s->element_size || s->size != s->count * s->element_size)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "section ", i, ": size does not match count");
-        mk_result r = check_array(v, s->offset, s->count, s->element_size, "section ", i, "");
+        if (FAILS("section.kind", s->kind == 0 || s->kind >= MK_SECTION_KIND_COUNT))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "section ", i, ": unknown kind ", s->kind, "");
+        const char *kind = kind_names[s->kind];
+        if (FAILS("section.duplicate", found[s->kind] != NULL))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "section ", i, kind, NONE, ": kind appears twice (also section ",
+                         found_at[s->kind], ")");
+        if (FAILS("section.element_size", s->element_size != element_sizes[s->kind]))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "section ", i, kind, NONE, ": element size ", s->element_size,
+                         " is wrong for its kind");
+        if (FAILS("section.size", s->count > UINT64_MAX / s->element_size || s->size != s->count * s->element_size))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "section ", i, kind, NONE, ": size ", s->size,
+                         " is not count x element size");
+        if (FAILS("section.count", s->kind != MK_SECTION_STRINGS && s->kind != MK_SECTION_DATA && s->count > UINT32_MAX))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "section ", i, kind, NONE, ": more than 2^32 elements");
+        mk_result r = CHECK_ARRAY("section", s->offset, s->count, s->element_size, &v->blob, "section ", i, kind);
         if (r) return r;
-        if (s->kind != MK_SECTION_STRINGS && s->kind != MK_SECTION_DATA && s->count > UINT32_MAX)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "section ", i, ": more than 2^32 elements");
         found[s->kind] = s;
+        found_at[s->kind] = i;
     }
     for (uint32_t k = 1; k < MK_SECTION_KIND_COUNT; k++)
-        if (!found[k]) return fail(v->err, MK_ERROR_CORRUPT, table, "required section kind ", k, " is missing");
+        if (FAILS("section.missing", found[k] == NULL))
+            return fail2(v->err, MK_ERROR_CORRUPT, table, "required section kind ", k, kind_names[k], NONE, " is missing");
+    /* Sections never overlap each other or the header and section table (empty ones lie
+     * anywhere). */
+    const uint64_t table_end = table + (uint64_t)h->section_count * sizeof(mk_blob_section);
+    for (uint32_t k = 1; k < MK_SECTION_KIND_COUNT; k++) {
+        const mk_blob_section *s = found[k];
+        if (FAILS("section.overlaps_table", s->size && s->offset < table_end))
+            return fail3(v->err, MK_ERROR_CORRUPT, s->offset, "section ", found_at[k], kind_names[k], NONE,
+                         ": overlaps the header and section table, which end at byte ", table_end, "");
+        for (uint32_t j = k + 1; j < MK_SECTION_KIND_COUNT; j++) {
+            const mk_blob_section *t = found[j];
+            if (FAILS("section.overlap", s->size && t->size && s->offset < t->offset + t->size && t->offset < s->offset + s->size)) {
+                start_message(v->err, MK_ERROR_CORRUPT, t->offset);
+                say(v->err, "section ");
+                say_u64(v->err, found_at[j]);
+                say(v->err, kind_names[j]);
+                say(v->err, " overlaps section ");
+                say_u64(v->err, found_at[k]);
+                say(v->err, kind_names[k]);
+                return end_message(v->err, MK_ERROR_CORRUPT);
+            }
+        }
+    }
 
     a->strings = (const char *)(v->data + found[MK_SECTION_STRINGS]->offset);
     a->strings_size = found[MK_SECTION_STRINGS]->size;
-    if (a->strings_size == 0 || a->strings[0] != 0 || a->strings[a->strings_size - 1] != 0)
-        return fail(v->err, MK_ERROR_CORRUPT, found[MK_SECTION_STRINGS]->offset, "string section", NO_INDEX,
-                    " does not start and end with a NUL byte");
+    if (FAILS("strings.leading_nul", a->strings_size == 0 || a->strings[0] != 0))
+        return fail(v->err, MK_ERROR_CORRUPT, found[MK_SECTION_STRINGS]->offset, "string section", NONE,
+                    " does not start with a NUL byte (string offset 0 is the empty string)");
+    if (FAILS("strings.trailing_nul", a->strings[a->strings_size - 1] != 0))
+        return fail(v->err, MK_ERROR_CORRUPT, found[MK_SECTION_STRINGS]->offset + a->strings_size - 1, "string section",
+                    NONE, " does not end with a NUL byte: its last string is unterminated");
+    v->data_section.begin = found[MK_SECTION_DATA]->offset;
+    v->data_section.end = found[MK_SECTION_DATA]->offset + found[MK_SECTION_DATA]->size;
     a->meshes = (const mk_blob_mesh *)(v->data + found[MK_SECTION_MESHES]->offset);
     a->mesh_count = (uint32_t)found[MK_SECTION_MESHES]->count;
     a->channels = (const mk_blob_channel *)(v->data + found[MK_SECTION_CHANNELS]->offset);
@@ -165,56 +255,167 @@ static mk_result validate_sections(validator *v, mk_asset *a)
     return MK_OK;
 }
 
+static mk_result validate_meshes(validator *v, const mk_asset *a)
+{
+    uint32_t next_channel = 0, next_target = 0;
+    for (uint32_t i = 0; i < a->mesh_count; i++) {
+        const mk_blob_mesh *m = &a->meshes[i];
+        uint64_t at = offset_of(v, m);
+        mk_result r;
+        if (FAILS("mesh.name", !valid_string(a, m->name)))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": name string offset ", m->name, " is out of range");
+        if (FAILS("mesh.vertex_count_zero", m->vertex_count == 0))
+            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": has no vertices");
+        if (FAILS("mesh.vertex_count_max", m->vertex_count > MK_MAX_VERTICES))   /* block arithmetic in eval stays in uint32 */
+            return fail2(v->err, MK_ERROR_UNSUPPORTED, at, "mesh ", i, ": has ", m->vertex_count,
+                         " vertices, more than a mesh may have (2^32 - 64)");
+        if (FAILS("mesh.block_count", (uint64_t)m->block_count != ((uint64_t)m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": block count ", m->block_count,
+                         " does not match its ", m->vertex_count, " vertices");
+        /* Meshes own consecutive channel and target ranges, in order. */
+        if (FAILS("mesh.first_channel", m->first_channel != next_channel))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": first channel ", m->first_channel,
+                         " does not follow the previous mesh's channels (expected ", next_channel, ")");
+        if (FAILS("mesh.channel_count", m->channel_count > a->channel_count - next_channel))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": its ", m->channel_count,
+                         " channels run past the end of the channel table (", a->channel_count, " channels)");
+        if (FAILS("mesh.first_target", m->first_target != next_target))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": first target ", m->first_target,
+                         " does not follow the previous mesh's targets (expected ", next_target, ")");
+        if (FAILS("mesh.target_count", m->target_count > a->target_count - next_target))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": its ", m->target_count,
+                         " targets run past the end of the target table (", a->target_count, " targets)");
+        next_channel += m->channel_count;
+        next_target += m->target_count;
+        if (FAILS("mesh.stacking", m->stacking != MK_STACKING_ADDITIVE && m->stacking != MK_STACKING_SEQUENTIAL))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": unknown stacking mode ", m->stacking, "");
+        if (FAILS("mesh.flags", (m->flags & ~3u) != 0))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": unknown flags (", m->flags, ")");
+        size_t reserved = first_nonzero(m->reserved, 2);
+        if (FAILS("mesh.reserved", reserved < 2))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": reserved field ", reserved, " is not zero");
+        if (FAILS("mesh.normals_offset", !(m->flags & MK_MESH_HAS_NORMALS) && m->normals != 0))
+            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i,
+                        ": normals offset is set but the mesh's flags say it has no normals");
+        if (FAILS("mesh.tangents_offset", !(m->flags & MK_MESH_HAS_TANGENTS) && m->tangents != 0))
+            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i,
+                        ": tangents offset is set but the mesh's flags say it has no tangents");
+        uint64_t bad = first_not_finite(m->world, 16);
+        if (FAILS("mesh.world", bad < 16))
+            return fail2(v->err, MK_ERROR_NOT_FINITE, at, "mesh ", i, ": world transform element ", bad, " is not finite");
+        if ((r = CHECK_ARRAY("mesh.positions", m->positions, m->vertex_count, 12, &v->data_section, "mesh ", i, " positions")))
+            return r;
+        bad = first_not_finite((const float *)(v->data + m->positions), 3ull * m->vertex_count);
+        if (FAILS("mesh.positions_finite", bad < 3ull * m->vertex_count))
+            return fail2(v->err, MK_ERROR_NOT_FINITE, m->positions + 4 * bad, "mesh ", i, ": base position of vertex ",
+                         bad / 3, " is not finite");
+        if (m->flags & MK_MESH_HAS_NORMALS) {
+            if ((r = CHECK_ARRAY("mesh.normals", m->normals, m->vertex_count, 12, &v->data_section, "mesh ", i, " normals")))
+                return r;
+            bad = first_not_finite((const float *)(v->data + m->normals), 3ull * m->vertex_count);
+            if (FAILS("mesh.normals_finite", bad < 3ull * m->vertex_count))
+                return fail2(v->err, MK_ERROR_NOT_FINITE, m->normals + 4 * bad, "mesh ", i, ": base normal of vertex ",
+                             bad / 3, " is not finite");
+        }
+        if (m->flags & MK_MESH_HAS_TANGENTS) {
+            if ((r = CHECK_ARRAY("mesh.tangents", m->tangents, m->vertex_count, 16, &v->data_section, "mesh ", i, " tangents")))
+                return r;
+            bad = first_not_finite((const float *)(v->data + m->tangents), 4ull * m->vertex_count);
+            if (FAILS("mesh.tangents_finite", bad < 4ull * m->vertex_count))
+                return fail2(v->err, MK_ERROR_NOT_FINITE, m->tangents + 4 * bad, "mesh ", i, ": base tangent of vertex ",
+                             bad / 4, " is not finite");
+        }
+        if ((r = CHECK_ARRAY("mesh.triangles", m->triangles, m->triangle_count, 12, &v->data_section, "mesh ", i, " triangles")))
+            return r;
+        const uint32_t *tri = (const uint32_t *)(v->data + m->triangles);
+        for (uint64_t k = 0; k < 3ull * m->triangle_count; k++)
+            if (FAILS("mesh.triangle_index", tri[k] >= m->vertex_count))
+                return fail3(v->err, MK_ERROR_CORRUPT, m->triangles + 4 * k, "mesh ", i, ": triangle ", k / 3,
+                             " has vertex index ", tri[k], " out of range");
+        if ((r = CHECK_ARRAY("mesh.control_points", m->control_points, m->vertex_count, 4, &v->data_section, "mesh ", i,
+                             " control points")))
+            return r;
+        const uint32_t *cp = (const uint32_t *)(v->data + m->control_points);
+        for (uint32_t k = 0; k < m->vertex_count; k++)
+            if (FAILS("mesh.control_point_index", cp[k] >= m->control_point_count))
+                return fail3(v->err, MK_ERROR_CORRUPT, m->control_points + 4ull * k, "mesh ", i, ": vertex ", k,
+                             " has control point ", cp[k], " out of range");
+    }
+    if (FAILS("meshes.channels_owned", next_channel != a->channel_count))
+        return fail2(v->err, MK_ERROR_CORRUPT, NO_OFFSET, "meshes own ", next_channel, " of the ", a->channel_count,
+                     " channels; the others belong to no mesh");
+    if (FAILS("meshes.targets_owned", next_target != a->target_count))
+        return fail2(v->err, MK_ERROR_CORRUPT, NO_OFFSET, "meshes own ", next_target, " of the ", a->target_count,
+                     " targets; the others belong to no mesh");
+    return MK_OK;
+}
+
 static mk_result validate_channels_and_targets(validator *v, const mk_asset *a)
 {
     for (uint32_t c = 0; c < a->channel_count; c++) {
         const mk_blob_channel *ch = &a->channels[c];
-        uint64_t at = (uint64_t)((const uint8_t *)ch - v->data);
-        if (!valid_string(a, ch->name) || !valid_string(a, ch->origin))
-            return fail(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": name or origin string out of range");
-        if (ch->mesh >= a->mesh_count)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": mesh index out of range");
+        uint64_t at = offset_of(v, ch);
+        if (FAILS("channel.name", !valid_string(a, ch->name)))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": name string offset ", ch->name, " is out of range");
+        if (FAILS("channel.origin", !valid_string(a, ch->origin)))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": origin string offset ", ch->origin, " is out of range");
+        if (FAILS("channel.mesh", ch->mesh >= a->mesh_count))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": mesh index ", ch->mesh, " is out of range");
         const mk_blob_mesh *m = &a->meshes[ch->mesh];
-        if (c < m->first_channel || c - m->first_channel >= m->channel_count)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": not inside its mesh's channel range");
-        if (ch->target_count == 0 || ch->first_target > a->target_count
-            || ch->target_count > a->target_count - ch->first_target)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": target range out of bounds");
-        if (ch->first_target < m->first_target
-            || ch->first_target + ch->target_count > m->first_target + m->target_count)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": targets outside its mesh's target range");
+        if (FAILS("channel.outside_mesh", c < m->first_channel || c - m->first_channel >= m->channel_count))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": is not one of mesh ", ch->mesh, "'s channels");
+        if (FAILS("channel.target_count", ch->target_count == 0))
+            return fail(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": has no targets");
+        if (FAILS("channel.target_range", ch->first_target > a->target_count || ch->target_count > a->target_count - ch->first_target))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": its ", ch->target_count, " targets from ",
+                         ch->first_target, " run past the end of the target table");
+        if (FAILS("channel.targets_outside_mesh", ch->first_target < m->first_target
+                  || ch->first_target + ch->target_count > m->first_target + m->target_count))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": its targets are not inside mesh ", ch->mesh, "'s targets");
         /* Channels tile their mesh's targets in order: the first starts at the mesh's first
          * target, each next one where the previous ended. */
         uint32_t expected = c == m->first_channel ? m->first_target
                           : a->channels[c - 1].first_target + a->channels[c - 1].target_count;
-        if (ch->first_target != expected)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": targets do not follow the previous channel's");
-        if (!isfinite(ch->default_weight))
+        if (FAILS("channel.targets_order", ch->first_target != expected))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": first target ", ch->first_target,
+                         " does not follow the previous channel's targets (expected ", expected, ")");
+        if (FAILS("channel.default_weight", !isfinite(ch->default_weight)))
             return fail(v->err, MK_ERROR_NOT_FINITE, at, "channel ", c, ": default weight is not finite");
-        if (!all_zero(ch->reserved, 2))
-            return fail(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": reserved fields are not zero");
+        size_t reserved = first_nonzero(ch->reserved, 2);
+        if (FAILS("channel.reserved", reserved < 2))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "channel ", c, ": reserved field ", reserved, " is not zero");
         for (uint32_t k = 0; k < ch->target_count; k++) {
             uint32_t t = ch->first_target + k;
             const mk_blob_target *tg = &a->targets[t];
-            uint64_t tat = (uint64_t)((const uint8_t *)tg - v->data);
-            if (tg->channel != c)
-                return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": channel index does not match");
-            if (!valid_string(a, tg->name))
-                return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": name string out of range");
-            if (!isfinite(tg->full_weight) || fabsf(tg->full_weight) < MK_MIN_FULL_WEIGHT_GAP)
-                return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": full weight is (nearly) zero or not finite");
-            if (k > 0 && !(tg->full_weight - a->targets[t - 1].full_weight >= MK_MIN_FULL_WEIGHT_GAP))
-                return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t,
-                            ": full weights of a channel must increase (by at least 1e-6)");
-            if (tg->flags & ~7u)
-                return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": unknown flags");
-            if (((tg->flags & MK_TARGET_HAS_NORMALS) && !(m->flags & MK_MESH_HAS_NORMALS))
-                || ((tg->flags & MK_TARGET_HAS_TANGENTS) && !(m->flags & MK_MESH_HAS_TANGENTS)))
-                return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t,
-                            ": has normal/tangent deltas but its mesh has no base normals/tangents");
-            if (!isfinite(tg->position_scale) || !isfinite(tg->normal_scale) || !isfinite(tg->tangent_scale)
-                || tg->position_scale < 0 || tg->normal_scale < 0 || tg->tangent_scale < 0)
-                return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": bad quantization scale");
+            uint64_t tat = offset_of(v, tg);
+            if (FAILS("target.channel", tg->channel != c))
+                return fail3(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": channel index ", tg->channel,
+                             " does not match its channel ", c, "");
+            if (FAILS("target.name", !valid_string(a, tg->name)))
+                return fail2(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": name string offset ", tg->name, " is out of range");
+            if (FAILS("target.full_weight_finite", !isfinite(tg->full_weight)))
+                return fail(v->err, MK_ERROR_NOT_FINITE, tat, "target ", t, ": full weight is not finite");
+            if (FAILS("target.full_weight_zero", fabsf(tg->full_weight) < MK_MIN_FULL_WEIGHT_GAP))
+                return fail(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": full weight is zero or nearly (|f| < 1e-6)");
+            if (FAILS("target.full_weight_order", k > 0 && !(tg->full_weight - a->targets[t - 1].full_weight >= MK_MIN_FULL_WEIGHT_GAP)))
+                return fail2(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": full weight does not exceed target ", t - 1,
+                             "'s by at least 1e-6 (a channel's full weights increase)");
+            if (FAILS("target.flags", (tg->flags & ~7u) != 0))
+                return fail2(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": unknown flags (", tg->flags, ")");
+            if (FAILS("target.normals", (tg->flags & MK_TARGET_HAS_NORMALS) && !(m->flags & MK_MESH_HAS_NORMALS)))
+                return fail2(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": has normal deltas but its mesh ", ch->mesh,
+                             " has no base normals");
+            if (FAILS("target.tangents", (tg->flags & MK_TARGET_HAS_TANGENTS) && !(m->flags & MK_MESH_HAS_TANGENTS)))
+                return fail2(v->err, MK_ERROR_CORRUPT, tat, "target ", t, ": has tangent deltas but its mesh ", ch->mesh,
+                             " has no base tangents");
+            const float scales[3] = { tg->position_scale, tg->normal_scale, tg->tangent_scale };
+            static const char *const scale_names[3] = { ": position scale", ": normal scale", ": tangent scale" };
+            for (int s = 0; s < 3; s++) {
+                if (FAILS("target.scale_finite", !isfinite(scales[s])))
+                    return fail2(v->err, MK_ERROR_NOT_FINITE, tat, "target ", t, scale_names[s], NONE, " is not finite");
+                if (FAILS("target.scale_negative", scales[s] < 0))
+                    return fail2(v->err, MK_ERROR_CORRUPT, tat, "target ", t, scale_names[s], NONE, " is negative");
+            }
         }
     }
     /* Channels must tile each mesh's targets completely (no target without a channel). */
@@ -223,9 +424,9 @@ static mk_result validate_channels_and_targets(validator *v, const mk_asset *a)
         uint32_t end = m->channel_count ? a->channels[m->first_channel + m->channel_count - 1].first_target
                                             + a->channels[m->first_channel + m->channel_count - 1].target_count
                                         : m->first_target;
-        if (end != m->first_target + m->target_count)
-            return fail(v->err, MK_ERROR_CORRUPT, (uint64_t)((const uint8_t *)m - v->data), "mesh ", i,
-                        ": its channels do not cover its targets");
+        if (FAILS("mesh.targets_without_channel", end != m->first_target + m->target_count))
+            return fail3(v->err, MK_ERROR_CORRUPT, offset_of(v, m), "mesh ", i, ": its channels end at target ", end,
+                         ", before its targets end at ", m->first_target + m->target_count, "");
     }
     return MK_OK;
 }
@@ -235,19 +436,29 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
 {
     const mk_blob_mesh *m = &a->meshes[mi];
     mk_result r;
-    if ((r = check_array(v, m->block_entries, (uint64_t)m->block_count + 1, 4, "mesh ", mi, "block table"))) return r;
-    if ((r = check_array(v, m->entries, m->entry_count, sizeof(mk_blob_entry), "mesh ", mi, "entries"))) return r;
-    if ((r = check_array(v, m->target_data, m->target_data_size, 1, "mesh ", mi, "target data"))) return r;
+    if ((r = CHECK_ARRAY("mesh.block_table", m->block_entries, (uint64_t)m->block_count + 1, 4, &v->data_section, "mesh ",
+                         mi, " block table")))
+        return r;
+    if ((r = CHECK_ARRAY("mesh.entries", m->entries, m->entry_count, sizeof(mk_blob_entry), &v->data_section, "mesh ", mi,
+                         " entries")))
+        return r;
+    if ((r = CHECK_ARRAY("mesh.target_data", m->target_data, m->target_data_size, 1, &v->data_section, "mesh ", mi,
+                         " target data")))
+        return r;
     const uint32_t *first = (const uint32_t *)(v->data + m->block_entries);
     const mk_blob_entry *entries = (const mk_blob_entry *)(v->data + m->entries);
-    if (first[0] != 0 || first[m->block_count] != m->entry_count)
-        return fail(v->err, MK_ERROR_CORRUPT, m->block_entries, "mesh ", mi, ": block table does not span the entries");
+    if (FAILS("block_table.first", first[0] != 0))
+        return fail2(v->err, MK_ERROR_CORRUPT, m->block_entries, "mesh ", mi, ": block table starts at entry ", first[0],
+                     " instead of 0");
+    if (FAILS("block_table.last", first[m->block_count] != m->entry_count))
+        return fail3(v->err, MK_ERROR_CORRUPT, m->block_entries + 4ull * m->block_count, "mesh ", mi,
+                     ": block table ends at entry ", first[m->block_count], " instead of the entry count ", m->entry_count, "");
     /* The whole table first: non-decreasing (so every value is <= entry_count) before any
      * block's entries are read. */
     for (uint32_t b = 0; b < m->block_count; b++)
-        if (first[b + 1] < first[b])
-            return fail(v->err, MK_ERROR_CORRUPT, m->block_entries + 4ull * b, "mesh ", mi,
-                        ": block table is not increasing");
+        if (FAILS("block_table.order", first[b + 1] < first[b]))
+            return fail3(v->err, MK_ERROR_CORRUPT, m->block_entries + 4ull * (b + 1), "mesh ", mi, ": block table decreases at block ",
+                         b + 1, " (entry ", first[b + 1], " after a later one)");
     for (uint32_t b = 0; b < m->block_count; b++) {
         uint32_t in_block = m->vertex_count - b * MK_BLOCK_SIZE;
         if (in_block > MK_BLOCK_SIZE) in_block = MK_BLOCK_SIZE;
@@ -255,87 +466,31 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
         for (uint32_t e = first[b]; e < first[b + 1]; e++) {
             const mk_blob_entry *en = &entries[e];
             uint64_t at = m->entries + (uint64_t)e * sizeof(mk_blob_entry);
-            if (en->target >= m->target_count)
-                return fail(v->err, MK_ERROR_CORRUPT, at, "entry ", e, ": target index out of range");
-            if (e > first[b] && en->target <= entries[e - 1].target)
-                return fail(v->err, MK_ERROR_CORRUPT, at, "entry ", e, ": targets of a block are not strictly increasing");
-            if (en->mask == 0 || (en->mask & ~allowed))
-                return fail(v->err, MK_ERROR_CORRUPT, at, "entry ", e, ": vertex mask is empty or past the mesh end");
+            if (FAILS("entry.target", en->target >= m->target_count))
+                return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": target index ", en->target,
+                             " is out of range");
+            if (FAILS("entry.order", e > first[b] && en->target <= entries[e - 1].target))
+                return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": target ", en->target,
+                             " repeats or precedes the previous entry's (a block's targets strictly increase)");
+            if (FAILS("entry.mask_empty", en->mask == 0))
+                return fail2(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": vertex mask is empty");
+            if (FAILS("entry.mask_past_end", (en->mask & ~allowed) != 0))
+                return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": vertex mask has bits past the mesh's last vertex (block ",
+                             b, ")");
             const mk_blob_target *tg = &a->targets[m->first_target + en->target];
             uint32_t count = mk_popcount64(en->mask);
             uint64_t bytes = mk_entry_data_size(tg->flags, count);
             uint64_t offset = (uint64_t)en->data * MK_ALIGN;
-            if (offset > m->target_data_size || bytes > m->target_data_size - offset)
-                return fail(v->err, MK_ERROR_CORRUPT, at, "entry ", e, ": data extends past the mesh's target data");
-            if (!(tg->flags & MK_TARGET_QUANTIZED)
-                && !all_finite((const float *)(v->data + m->target_data + offset), bytes / 4))
-                return fail(v->err, MK_ERROR_NOT_FINITE, m->target_data + offset, "entry ", e,
-                            ": delta data is not finite");
+            if (FAILS("entry.data", offset > m->target_data_size || bytes > m->target_data_size - offset))
+                return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": its ", bytes,
+                             " bytes of data run past the mesh's target data");
+            uint64_t bad = (tg->flags & MK_TARGET_QUANTIZED) ? bytes / 4
+                         : first_not_finite((const float *)(v->data + m->target_data + offset), bytes / 4);
+            if (FAILS("entry.data_finite", bad < bytes / 4))
+                return fail3(v->err, MK_ERROR_NOT_FINITE, m->target_data + offset + 4 * bad, "mesh ", mi, " entry ", e,
+                             ": delta value ", bad, " is not finite");
         }
     }
-    return MK_OK;
-}
-
-static mk_result validate_meshes(validator *v, const mk_asset *a)
-{
-    uint32_t next_channel = 0, next_target = 0;
-    for (uint32_t i = 0; i < a->mesh_count; i++) {
-        const mk_blob_mesh *m = &a->meshes[i];
-        uint64_t at = (uint64_t)((const uint8_t *)m - v->data);
-        mk_result r;
-        if (!valid_string(a, m->name))
-            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": name string out of range");
-        if (m->vertex_count == 0)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": has no vertices");
-        if (m->vertex_count > MK_MAX_VERTICES)   /* block arithmetic in eval stays in uint32 */
-            return fail(v->err, MK_ERROR_UNSUPPORTED, at, "mesh ", i, ": has more vertices than a mesh may have (2^32 - 64)");
-        if ((uint64_t)m->block_count != ((uint64_t)m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": block count does not match vertex count");
-        if (m->first_channel != next_channel || m->channel_count > a->channel_count - next_channel)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": channel range does not follow the previous mesh's");
-        if (m->first_target != next_target || m->target_count > a->target_count - next_target)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": target range does not follow the previous mesh's");
-        next_channel += m->channel_count;
-        next_target += m->target_count;
-        if (m->stacking != MK_STACKING_ADDITIVE && m->stacking != MK_STACKING_SEQUENTIAL)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": unknown stacking mode");
-        if (m->flags & ~3u)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": unknown flags");
-        if (!all_zero(m->reserved, 2))
-            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": reserved fields are not zero");
-        if ((!(m->flags & MK_MESH_HAS_NORMALS) && m->normals) || (!(m->flags & MK_MESH_HAS_TANGENTS) && m->tangents))
-            return fail(v->err, MK_ERROR_CORRUPT, at, "mesh ", i,
-                        ": normal or tangent offset is set but the mesh's flags say it has none");
-        if (!all_finite(m->world, 16))
-            return fail(v->err, MK_ERROR_NOT_FINITE, at, "mesh ", i, ": world transform is not finite");
-        if ((r = check_array(v, m->positions, m->vertex_count, 12, "mesh ", i, "positions"))) return r;
-        if (!all_finite((const float *)(v->data + m->positions), 3ull * m->vertex_count))
-            return fail(v->err, MK_ERROR_NOT_FINITE, m->positions, "mesh ", i, ": base positions are not finite");
-        if (m->flags & MK_MESH_HAS_NORMALS) {
-            if ((r = check_array(v, m->normals, m->vertex_count, 12, "mesh ", i, "normals"))) return r;
-            if (!all_finite((const float *)(v->data + m->normals), 3ull * m->vertex_count))
-                return fail(v->err, MK_ERROR_NOT_FINITE, m->normals, "mesh ", i, ": base normals are not finite");
-        }
-        if (m->flags & MK_MESH_HAS_TANGENTS) {
-            if ((r = check_array(v, m->tangents, m->vertex_count, 16, "mesh ", i, "tangents"))) return r;
-            if (!all_finite((const float *)(v->data + m->tangents), 4ull * m->vertex_count))
-                return fail(v->err, MK_ERROR_NOT_FINITE, m->tangents, "mesh ", i, ": base tangents are not finite");
-        }
-        if ((r = check_array(v, m->triangles, m->triangle_count, 12, "mesh ", i, "triangles"))) return r;
-        const uint32_t *tri = (const uint32_t *)(v->data + m->triangles);
-        for (uint64_t k = 0; k < 3ull * m->triangle_count; k++)
-            if (tri[k] >= m->vertex_count)
-                return fail(v->err, MK_ERROR_CORRUPT, m->triangles + 4 * k, "mesh ", i, ": triangle index out of range");
-        if ((r = check_array(v, m->control_points, m->vertex_count, 4, "mesh ", i, "control points"))) return r;
-        const uint32_t *cp = (const uint32_t *)(v->data + m->control_points);
-        for (uint32_t k = 0; k < m->vertex_count; k++)
-            if (cp[k] >= m->control_point_count)
-                return fail(v->err, MK_ERROR_CORRUPT, m->control_points + 4ull * k, "mesh ", i,
-                            ": control point index out of range");
-    }
-    if (next_channel != a->channel_count || next_target != a->target_count)
-        return fail(v->err, MK_ERROR_CORRUPT, NO_OFFSET, "meshes cover ", next_channel,
-                    " channels; the channel or target table has entries no mesh owns");
     return MK_OK;
 }
 
@@ -343,87 +498,126 @@ static mk_result validate_clips(validator *v, const mk_asset *a)
 {
     for (uint32_t i = 0; i < a->clip_count; i++) {
         const mk_blob_clip *c = &a->clips[i];
-        uint64_t at = (uint64_t)((const uint8_t *)c - v->data);
-        if (!valid_string(a, c->name))
-            return fail(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": name string out of range");
+        uint64_t at = offset_of(v, c);
+        if (FAILS("clip.name", !valid_string(a, c->name)))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": name string offset ", c->name, " is out of range");
         /* Clips tile the track table in order, so every track is validated once. */
-        uint32_t expected_track = i == 0 ? 0 : a->clips[i - 1].first_track + a->clips[i - 1].track_count;
-        if (c->first_track != expected_track || c->track_count > a->track_count - c->first_track)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": track range does not follow the previous clip's");
-        if (!isfinite(c->start) || !isfinite(c->duration) || c->duration < 0)
-            return fail(v->err, MK_ERROR_NOT_FINITE, at, "clip ", i, ": start or duration is not finite or negative");
-        if (!all_zero(c->reserved, 3))
-            return fail(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": reserved fields are not zero");
+        uint32_t expected = i == 0 ? 0 : a->clips[i - 1].first_track + a->clips[i - 1].track_count;
+        if (FAILS("clip.first_track", c->first_track != expected))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": first track ", c->first_track,
+                         " does not follow the previous clip's tracks (expected ", expected, ")");
+        if (FAILS("clip.track_count", c->track_count > a->track_count - c->first_track))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": its ", c->track_count,
+                         " tracks run past the end of the track table (", a->track_count, " tracks)");
+        if (FAILS("clip.start", !isfinite(c->start)))
+            return fail(v->err, MK_ERROR_NOT_FINITE, at, "clip ", i, ": start is not finite");
+        if (FAILS("clip.duration_finite", !isfinite(c->duration)))
+            return fail(v->err, MK_ERROR_NOT_FINITE, at, "clip ", i, ": duration is not finite");
+        if (FAILS("clip.duration_negative", c->duration < 0))
+            return fail(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": duration is negative");
+        size_t reserved = first_nonzero(c->reserved, 3);
+        if (FAILS("clip.reserved", reserved < 3))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "clip ", i, ": reserved field ", reserved, " is not zero");
     }
     uint32_t tracks_used = a->clip_count ? a->clips[a->clip_count - 1].first_track + a->clips[a->clip_count - 1].track_count : 0;
-    if (tracks_used != a->track_count)
-        return fail(v->err, MK_ERROR_CORRUPT, NO_OFFSET, "clips cover ", tracks_used,
-                    " tracks; the track table has tracks no clip owns");
+    if (FAILS("clips.tracks_owned", tracks_used != a->track_count))
+        return fail2(v->err, MK_ERROR_CORRUPT, NO_OFFSET, "clips own ", tracks_used, " of the ", a->track_count,
+                     " tracks; the others belong to no clip");
+    static const char *const key_fields[6] = {
+        ": time", ": value", ": right slope", ": right tangent weight", ": left slope", ": left tangent weight",
+    };
     for (uint32_t i = 0; i < a->track_count; i++) {
         const mk_blob_track *t = &a->tracks[i];
-        uint64_t at = (uint64_t)((const uint8_t *)t - v->data);
-        if (t->channel >= a->channel_count)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "track ", i, ": channel index out of range");
-        if (t->reserved)
+        uint64_t at = offset_of(v, t);
+        if (FAILS("track.channel", t->channel >= a->channel_count))
+            return fail2(v->err, MK_ERROR_CORRUPT, at, "track ", i, ": channel index ", t->channel, " is out of range");
+        if (FAILS("track.reserved", t->reserved != 0))
             return fail(v->err, MK_ERROR_CORRUPT, at, "track ", i, ": reserved field is not zero");
         /* Tracks tile the key table in order, so every key is validated once (O(size)). */
-        uint32_t expected_key = i == 0 ? 0 : a->tracks[i - 1].first_key + a->tracks[i - 1].key_count;
-        if (t->key_count == 0 || t->first_key != expected_key || t->key_count > a->key_count - t->first_key)
-            return fail(v->err, MK_ERROR_CORRUPT, at, "track ", i, ": key range empty or not following the previous track's");
+        if (FAILS("track.key_count", t->key_count == 0))
+            return fail(v->err, MK_ERROR_CORRUPT, at, "track ", i, ": has no keys");
+        uint32_t expected = i == 0 ? 0 : a->tracks[i - 1].first_key + a->tracks[i - 1].key_count;
+        if (FAILS("track.first_key", t->first_key != expected))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "track ", i, ": first key ", t->first_key,
+                         " does not follow the previous track's keys (expected ", expected, ")");
+        if (FAILS("track.key_range", t->key_count > a->key_count - t->first_key))
+            return fail3(v->err, MK_ERROR_CORRUPT, at, "track ", i, ": its ", t->key_count,
+                         " keys run past the end of the key table (", a->key_count, " keys)");
         for (uint32_t k = 0; k < t->key_count; k++) {
             const mk_key *key = &a->keys[t->first_key + k];
-            uint64_t kat = (uint64_t)((const uint8_t *)key - v->data);
-            if (!isfinite(key->time) || !isfinite(key->value) || !isfinite(key->right_slope)
-                || !isfinite(key->left_slope) || !isfinite(key->right_weight) || !isfinite(key->left_weight))
-                return fail(v->err, MK_ERROR_NOT_FINITE, kat, "key ", t->first_key + k, ": value is not finite");
-            if (key->interp >= MK_INTERP_COUNT)
-                return fail(v->err, MK_ERROR_CORRUPT, kat, "key ", t->first_key + k, ": unknown interpolation");
-            if (key->reserved)
-                return fail(v->err, MK_ERROR_CORRUPT, kat, "key ", t->first_key + k, ": reserved field is not zero");
+            uint64_t kat = offset_of(v, key);
+            const float fields[6] = { key->time, key->value, key->right_slope, key->right_weight, key->left_slope,
+                                      key->left_weight };
+            uint64_t bad = first_not_finite(fields, 6);
+            if (FAILS("key.finite", bad < 6))
+                return fail3(v->err, MK_ERROR_NOT_FINITE, kat, "track ", i, " key ", k, key_fields[bad], NONE, " is not finite");
+            if (FAILS("key.interp", key->interp >= MK_INTERP_COUNT))
+                return fail3(v->err, MK_ERROR_CORRUPT, kat, "track ", i, " key ", k, ": unknown interpolation ", key->interp, "");
+            if (FAILS("key.reserved", key->reserved != 0))
+                return fail2(v->err, MK_ERROR_CORRUPT, kat, "track ", i, " key ", k, ": reserved field is not zero");
             /* Bezier tangent weights must stay inside the interval so time is monotonic. */
-            if (!(key->right_weight > 0 && key->right_weight <= 1 && key->left_weight > 0 && key->left_weight <= 1))
-                return fail(v->err, MK_ERROR_CORRUPT, kat, "key ", t->first_key + k, ": tangent weight outside (0, 1]");
-            if (k > 0 && !(key->time > key[-1].time))
-                return fail(v->err, MK_ERROR_CORRUPT, kat, "key ", t->first_key + k, ": key times are not strictly increasing");
+            int weight = !(key->right_weight > 0 && key->right_weight <= 1) ? 3 : !(key->left_weight > 0 && key->left_weight <= 1) ? 5 : 0;
+            if (FAILS("key.tangent_weight", weight != 0))
+                return fail3(v->err, MK_ERROR_CORRUPT, kat, "track ", i, " key ", k, key_fields[weight], NONE,
+                             " is outside (0, 1]");
+            if (FAILS("key.time_order", k > 0 && !(key->time > key[-1].time)))
+                return fail2(v->err, MK_ERROR_CORRUPT, kat, "track ", i, " key ", k,
+                             ": time is not after the previous key's (times strictly increase)");
         }
     }
     uint32_t keys_used = a->track_count ? a->tracks[a->track_count - 1].first_key + a->tracks[a->track_count - 1].key_count : 0;
-    if (keys_used != a->key_count)
-        return fail(v->err, MK_ERROR_CORRUPT, NO_OFFSET, "tracks cover ", keys_used, " keys; the key table has keys no track owns");
+    if (FAILS("tracks.keys_owned", keys_used != a->key_count))
+        return fail2(v->err, MK_ERROR_CORRUPT, NO_OFFSET, "tracks own ", keys_used, " of the ", a->key_count,
+                     " keys; the others belong to no track");
     return MK_OK;
 }
 
 mk_result mk_asset_open(const void *data, size_t size, mk_asset *out, mk_error *err)
 {
     if (err) { err->code = MK_OK; err->offset = NO_OFFSET; err->message[0] = 0; }
-    if (!out) return fail(err, MK_ERROR_INVALID_ARGUMENT, NO_OFFSET, "output asset is NULL", NO_INDEX, "");
+    if (FAILS("args.output", out == NULL))
+        return fail(err, MK_ERROR_INVALID_ARGUMENT, NO_OFFSET, "output asset is NULL", NONE, "");
     memset(out, 0, sizeof *out);
-    if (!data) return fail(err, MK_ERROR_INVALID_ARGUMENT, NO_OFFSET, "blob pointer is NULL", NO_INDEX, "");
-    if ((uintptr_t)data % MK_ALIGN)
-        return fail(err, MK_ERROR_BAD_ALIGNMENT, NO_OFFSET, "blob memory is not 16-byte aligned", NO_INDEX, "");
-    if (size < sizeof(mk_blob_header))
+    if (FAILS("args.data", data == NULL))
+        return fail(err, MK_ERROR_INVALID_ARGUMENT, NO_OFFSET, "blob pointer is NULL", NONE, "");
+    if (FAILS("blob.alignment", (uintptr_t)data % MK_ALIGN != 0))
+        return fail(err, MK_ERROR_BAD_ALIGNMENT, NO_OFFSET, "blob memory is not 16-byte aligned", NONE, "");
+    if (FAILS("header.truncated", size < sizeof(mk_blob_header)))
         return fail(err, MK_ERROR_TRUNCATED, size, "blob of ", size, " bytes is shorter than the 64-byte header");
     mk_asset a;
     memset(&a, 0, sizeof a);
     a.data = data;
     a.size = size;
     a.header = (const mk_blob_header *)data;
-    if (memcmp(a.header->magic, MK_MAGIC, 8) != 0)
-        return fail(err, MK_ERROR_BAD_MAGIC, 0, "not a .morph blob (magic is not MORPHKIT)", NO_INDEX, "");
-    if (a.header->version != MK_FORMAT_VERSION)
-        return fail_with(err, MK_ERROR_BAD_VERSION, 8, "blob format version ", a.header->version,
-                         " is not supported; this runtime reads version ", MK_FORMAT_VERSION, "");
-    if (a.header->header_size != sizeof(mk_blob_header) || a.header->flags != 0 || !all_zero(a.header->reserved, 6))
-        return fail(err, MK_ERROR_CORRUPT, 12, "header size, flags or reserved fields", NO_INDEX,
-                    " are not those of this version (64, 0, 0)");
-    if (a.header->file_size != size)
-        return fail(err, size < a.header->file_size ? MK_ERROR_TRUNCATED : MK_ERROR_CORRUPT, 16,
-                    "blob is ", size, a.header->file_size > size ? " bytes, shorter than the header's file size"
-                                                                 : " bytes, longer than the header's file size");
-    if (mk_checksum((const uint8_t *)data + 32, size - 32) != a.header->checksum)
-        return fail(err, MK_ERROR_BAD_CHECKSUM, 24, "checksum mismatch: the blob was modified or damaged", NO_INDEX, "");
+    const mk_blob_header *h = a.header;
+    if (FAILS("header.magic", memcmp(h->magic, MK_MAGIC, 8) != 0))
+        return fail(err, MK_ERROR_BAD_MAGIC, 0, "not a .morph blob (magic is not MORPHKIT)", NONE, "");
+    if (FAILS("header.version", h->version != MK_FORMAT_VERSION))
+        return fail2(err, MK_ERROR_BAD_VERSION, 8, "blob format version ", h->version,
+                     " is not supported; this runtime reads version ", MK_FORMAT_VERSION, "");
+    if (FAILS("header.size", h->header_size != sizeof(mk_blob_header)))
+        return fail(err, MK_ERROR_CORRUPT, 12, "header size ", h->header_size, " is not 64");
+    if (FAILS("header.flags", h->flags != 0))
+        return fail(err, MK_ERROR_CORRUPT, 36, "header flags (", h->flags, ") are not zero");
+    size_t reserved = first_nonzero(h->reserved, 6);
+    if (FAILS("header.reserved", reserved < 6))
+        return fail(err, MK_ERROR_CORRUPT, 40 + 4 * reserved, "header reserved field ", reserved, " is not zero");
+    if (FAILS("header.file_size_short", h->file_size > size))
+        return fail2(err, MK_ERROR_TRUNCATED, 16, "blob is ", size, " bytes, shorter than the header's file size ",
+                     h->file_size, "");
+    if (FAILS("header.file_size_long", h->file_size < size))
+        return fail2(err, MK_ERROR_CORRUPT, 16, "blob is ", size, " bytes, longer than the header's file size ",
+                     h->file_size, "");
+    if (FAILS("header.checksum", mk_checksum((const uint8_t *)data + 32, size - 32) != h->checksum))
+        return fail(err, MK_ERROR_BAD_CHECKSUM, 24, "checksum mismatch: the blob was modified or damaged", NONE, "");
 
-    validator v = { (const uint8_t *)data, size, err };
+    validator v;
+    memset(&v, 0, sizeof v);
+    v.data = (const uint8_t *)data;
+    v.size = size;
+    v.err = err;
+    v.blob = (region){ 0, size, "the blob", MK_ERROR_TRUNCATED };
+    v.data_section = (region){ 0, 0, "the DATA section", MK_ERROR_CORRUPT };
     mk_result r;
     if ((r = validate_sections(&v, &a))) return r;
     if ((r = validate_meshes(&v, &a))) return r;

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "fixtures.h"
+#include "mat4.h"
 
 static void *dup_array(mk_raw_asset *raw, const void *src, size_t bytes)
 {
@@ -86,6 +87,164 @@ void fixture_basic(mk_raw_asset *raw)
     clip->tracks[1].keys = dup_array(raw, &c0, sizeof c0);
     /* Targets written above have normals only on channel 0; channels 1-3 compute none
      * here: validation allows a mix (absent normal deltas mean "normals do not change"). */
+}
+
+static void add_target_nt(mk_raw_asset *raw, mk_raw_channel *ch, float full, uint32_t count, const uint32_t *idx,
+                          const float *pos, const float *nrm, const float *tan)
+{
+    add_target(raw, ch, full, count, idx, pos, nrm);
+    if (tan) ch->targets[ch->target_count - 1].tangents = dup_array(raw, tan, 3 * count * sizeof *tan);
+}
+
+static mk_raw_track make_track(mk_raw_asset *raw, uint32_t channel, uint32_t key_count, const mk_key *keys)
+{
+    mk_raw_track t = { channel, key_count, dup_array(raw, keys, key_count * sizeof *keys) };
+    return t;
+}
+
+void fixture_rich(mk_raw_asset *raw)
+{
+    mk_raw_mesh *m = mk_raw_add_meshes(raw, 4);
+    static const float quad_p[] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0 };
+    static const float quad_n[] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1 };
+    static const float quad_t[] = { 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, -1 };
+    static const uint32_t quad_tri[] = { 0, 1, 3, 0, 3, 2 }, quad_cp[] = { 0, 1, 2, 2 };
+    m[0].name = mk_arena_strdup(&raw->arena, "face");
+    m[0].vertex_count = 4;
+    m[0].positions = dup_array(raw, quad_p, sizeof quad_p);
+    m[0].normals = dup_array(raw, quad_n, sizeof quad_n);
+    m[0].tangents = dup_array(raw, quad_t, sizeof quad_t);
+    m[0].triangle_count = 2;
+    m[0].triangles = dup_array(raw, quad_tri, sizeof quad_tri);
+    m[0].control_point_count = 3;
+    m[0].control_points = dup_array(raw, quad_cp, sizeof quad_cp);
+    mk_mat4_identity(m[0].world);
+    m[0].gltf_node = m[0].gltf_mesh = m[0].gltf_primitive = -1;
+    m[0].stacking = MK_STACKING_ADDITIVE;
+
+    static const float prop_p[] = { 0, 0, 0, 2, 0, 0, 0, 2, 0 };
+    static const uint32_t prop_tri[] = { 0, 1, 2 };
+    m[1].name = mk_arena_strdup(&raw->arena, "prop");
+    m[1].vertex_count = 3;
+    m[1].positions = dup_array(raw, prop_p, sizeof prop_p);
+    m[1].triangle_count = 1;
+    m[1].triangles = dup_array(raw, prop_tri, sizeof prop_tri);
+    mk_mat4_identity(m[1].world);
+    m[1].world[12] = 5;
+    m[1].gltf_node = 3;
+    m[1].gltf_mesh = 1;
+    m[1].gltf_primitive = 0;
+    m[1].stacking = MK_STACKING_ADDITIVE;
+
+    enum { N = 150 };
+    m[2].name = mk_arena_strdup(&raw->arena, "strip");
+    m[2].vertex_count = N;
+    m[2].positions = mk_arena_array(&raw->arena, 3 * N, sizeof(float));
+    m[2].normals = mk_arena_array(&raw->arena, 3 * N, sizeof(float));
+    m[2].triangle_count = N - 2;
+    m[2].triangles = mk_arena_array(&raw->arena, 3 * (N - 2), sizeof(uint32_t));
+    if (!m[2].positions || !m[2].normals || !m[2].triangles) { fprintf(stderr, "fixture: out of memory\n"); exit(2); }
+    for (uint32_t v = 0; v < N; v++) {
+        m[2].positions[3 * v] = (float)(v / 2);
+        m[2].positions[3 * v + 1] = (float)(v % 2);
+        m[2].normals[3 * v + 2] = 1;
+    }
+    for (uint32_t t = 0; t + 2 < N; t++) {
+        m[2].triangles[3 * t] = t;
+        m[2].triangles[3 * t + 1] = t % 2 ? t + 2 : t + 1;
+        m[2].triangles[3 * t + 2] = t % 2 ? t + 1 : t + 2;
+    }
+    mk_mat4_identity(m[2].world);
+    m[2].gltf_node = m[2].gltf_mesh = m[2].gltf_primitive = -1;
+    m[2].stacking = MK_STACKING_SEQUENTIAL;
+
+    m[3].name = mk_arena_strdup(&raw->arena, "rigid");
+    m[3].vertex_count = 3;
+    m[3].positions = dup_array(raw, prop_p, sizeof prop_p);
+    m[3].triangle_count = 1;
+    m[3].triangles = dup_array(raw, prop_tri, sizeof prop_tri);
+    mk_mat4_identity(m[3].world);
+    m[3].gltf_node = m[3].gltf_mesh = m[3].gltf_primitive = -1;
+    m[3].stacking = MK_STACKING_ADDITIVE;
+
+    mk_raw_channel *ch = add_channel(raw, 0, "brow");
+    add_target_nt(raw, ch, -0.5f, 1, (const uint32_t[]){ 0 }, (const float[]){ 0, 0, -1 },
+                  (const float[]){ 0.1f, 0, 0 }, (const float[]){ 0, 0.1f, 0 });
+    add_target_nt(raw, ch, 0.5f, 2, (const uint32_t[]){ 0, 1 }, (const float[]){ 0, 0, 0.5f, 0, 0, 0.25f },
+                  (const float[]){ 0, 0.2f, 0, 0, 0.1f, 0 }, (const float[]){ 0, 0, 0.2f, 0, 0, 0.1f });
+    add_target_nt(raw, ch, 1.0f, 3, (const uint32_t[]){ 0, 1, 3 }, (const float[]){ 0, 0, 1, 0, 0, 0.5f, 0, 0, 0.75f },
+                  (const float[]){ 0.3f, 0, 0, 0, 0.3f, 0, 0.1f, 0.1f, 0 },
+                  (const float[]){ 0, 0.3f, 0, 0, 0, 0.3f, 0, 0.1f, 0.1f });
+    ch = add_channel(raw, 0, "jaw");
+    add_target(raw, ch, 1.0f, 2, (const uint32_t[]){ 2, 3 }, (const float[]){ 0, -0.5f, 0, 0, -0.5f, 0 }, NULL);
+
+    uint32_t *all = mk_arena_array(&raw->arena, N, sizeof(uint32_t));
+    float *dense_p = mk_arena_array(&raw->arena, 3 * N, sizeof(float));
+    float *dense_n = mk_arena_array(&raw->arena, 3 * N, sizeof(float));
+    if (!all || !dense_p || !dense_n) { fprintf(stderr, "fixture: out of memory\n"); exit(2); }
+    for (uint32_t v = 0; v < N; v++) {
+        all[v] = v;
+        dense_p[3 * v + 2] = 0.01f * (float)(v % 13);
+        dense_n[3 * v] = 0.02f * (float)(v % 5);
+    }
+    ch = add_channel(raw, 2, "dense");
+    add_target(raw, ch, 1.0f, N, all, dense_p, dense_n);
+    uint32_t sparse[(N + 6) / 7];
+    float sparse_p[3 * ((N + 6) / 7)];
+    uint32_t n_sparse = 0;
+    for (uint32_t v = 3; v < N; v += 7, n_sparse++) {
+        sparse[n_sparse] = v;
+        sparse_p[3 * n_sparse] = 0.1f;
+        sparse_p[3 * n_sparse + 1] = -0.05f * (float)(v % 3);
+        sparse_p[3 * n_sparse + 2] = 0.2f;
+    }
+    ch = add_channel(raw, 2, "sparse");
+    add_target(raw, ch, 0.5f, n_sparse, sparse, sparse_p, NULL);
+    add_target(raw, ch, 1.0f, n_sparse, sparse, sparse_p, NULL);
+    ch->targets[1].positions[0] = 0.3f;
+    uint32_t span[11];
+    float span_p[33];
+    for (uint32_t k = 0; k < 11; k++) {
+        span[k] = 60 + k;
+        span_p[3 * k] = 0;
+        span_p[3 * k + 1] = 0.5f;
+        span_p[3 * k + 2] = -0.01f * (float)k;
+    }
+    ch = add_channel(raw, 2, "span");
+    add_target(raw, ch, 1.0f, 11, span, span_p, NULL);
+    ch->default_weight = 0.25f;
+    ch = add_channel(raw, 3, "lift");
+    add_target(raw, ch, 1.0f, 3, prop_tri, (const float[]){ 0, 0, 1, 0, 0, 1, 0, 0, 1 }, NULL);
+
+    mk_raw_clip *clip = mk_raw_add_clips(raw, 3);
+    clip[0].name = mk_arena_strdup(&raw->arena, "talk");
+    clip[0].start = 0;
+    clip[0].duration = 2;
+    clip[0].track_count = 3;
+    clip[0].tracks = mk_arena_array(&raw->arena, 3, sizeof(mk_raw_track));
+    clip[2].tracks = mk_arena_array(&raw->arena, 2, sizeof(mk_raw_track));
+    if (!clip[0].tracks || !clip[2].tracks) { fprintf(stderr, "fixture: out of memory\n"); exit(2); }
+    const float third = 1.0f / 3;
+    const mk_key cubic[3] = { { 0, 0, 0.5f, third, 0, third, MK_INTERP_CUBIC, 0 },
+                              { 1, 1, 0, third, -1, third, MK_INTERP_CUBIC, 0 },
+                              { 2, -0.5f, 0, third, 0.25f, third, MK_INTERP_CUBIC, 0 } };
+    const mk_key weighted[2] = { { 0, 0, 2, 0.25f, 0, 0.75f, MK_INTERP_CUBIC, 0 },
+                                 { 1.5f, 1, 0, 0.75f, -1, 0.25f, MK_INTERP_CUBIC, 0 } };
+    const mk_key step[2] = { { 0.25f, 0, 0, third, 0, third, MK_INTERP_CONSTANT_NEXT, 0 },
+                             { 0.75f, 1, 0, third, 0, third, MK_INTERP_CONSTANT_NEXT, 0 } };
+    clip[0].tracks[0] = make_track(raw, 0, 3, cubic);
+    clip[0].tracks[1] = make_track(raw, 1, 2, weighted);
+    clip[0].tracks[2] = make_track(raw, 3, 2, step);
+    clip[1].name = mk_arena_strdup(&raw->arena, "still");
+    clip[2].name = mk_arena_strdup(&raw->arena, "blink");
+    clip[2].start = 0.5f;
+    clip[2].duration = 1;
+    clip[2].track_count = 2;
+    const mk_key hold[1] = { { 0.5f, 0.75f, 0, third, 0, third, MK_INTERP_CONSTANT, 0 } };
+    const mk_key linear[2] = { { 0.5f, 0, 0, third, 0, third, MK_INTERP_LINEAR, 0 },
+                               { 1.5f, 1, 0, third, 0, third, MK_INTERP_LINEAR, 0 } };
+    clip[2].tracks[0] = make_track(raw, 4, 1, hold);
+    clip[2].tracks[1] = make_track(raw, 2, 2, linear);
 }
 
 void fixture_line(mk_raw_asset *raw, uint32_t n, uint32_t channels, uint32_t stride)

@@ -20,6 +20,25 @@ void fixture_basic(mk_raw_asset *raw);
  * `stride`-th vertex (sparse) or all (dense); deterministic values. */
 void fixture_line(mk_raw_asset *raw, uint32_t n, uint32_t channels, uint32_t stride);
 
+/* Every structure the format has, small enough to patch by hand (the corruption tests of
+ * mk_asset_open break each field of it):
+ * Mesh 0 "face": 4 vertices (the quad of fixture_basic) with normals and tangents, control
+ *   points {0, 1, 2, 2} (3 of them), additive. Channels:
+ *     0 "brow" (progressive, a negative in-between): f = -0.5 (v0), 0.5 (v0 v1), 1 (v0 v1 v3),
+ *       each with position, normal and tangent deltas;
+ *     1 "jaw": f = 1, positions only (v2 v3).
+ * Mesh 1 "prop": 3 vertices, no normals, no channels.
+ * Mesh 2 "strip": 150 vertices (3 blocks, the last of 22), normals, sequential. Channels:
+ *     2 "dense": f = 1 moves every vertex, with normal deltas (dense blocks 0 and 1);
+ *     3 "sparse": f = 0.5 and 1 move every 7th vertex (sparse entries);
+ *     4 "span": f = 1 moves vertices 60..70 (across the block 0/1 boundary), default 0.25.
+ * Mesh 3 "rigid": 3 vertices, no normals, channel 5 "lift": f = 1 moves all three.
+ * Clips: 0 "talk" (start 0, 2 s): channel 0 cubic (3 keys, weights 1/3), channel 1 weighted
+ *   cubic (2 keys, weights 0.25/0.75), channel 3 constant-next (2 keys);
+ *   1 "still" (0 s, no tracks);
+ *   2 "blink" (start 0.5, 1 s): channel 4 constant (1 key), channel 2 linear (2 keys). */
+void fixture_rich(mk_raw_asset *raw);
+
 /* Writes raw to a blob in arena (aborts the test program on failure). */
 void *fixture_blob(const mk_raw_asset *raw, mk_precision precision, mk_arena *arena, size_t *size);
 
