@@ -21,12 +21,19 @@ void mk_arena_init(mk_arena *arena, const mk_allocator *allocator)
     if (allocator) arena->allocator = *allocator;
 }
 
+/* Zeroed memory. The default allocator uses calloc: large blocks then come from fresh pages
+ * the kernel has zeroed, instead of being written twice (a memset here and the real data
+ * after it), which profiled as a tenth of an import. */
 static void *raw_alloc(mk_arena *arena, size_t size)
 {
     arena->calls++;
     if (arena->allocator.fail_after && arena->calls >= arena->allocator.fail_after) return NULL;
-    if (arena->allocator.alloc) return arena->allocator.alloc(arena->allocator.user, size);
-    return malloc(size);
+    if (arena->allocator.alloc) {
+        void *p = arena->allocator.alloc(arena->allocator.user, size);
+        if (p) memset(p, 0, size);
+        return p;
+    }
+    return calloc(1, size);
 }
 
 static void raw_free(mk_arena *arena, void *ptr)
@@ -52,9 +59,7 @@ void *mk_arena_alloc(mk_arena *arena, size_t size)
     arena->blocks = b;
     arena->bytes_live += size;
     if (arena->bytes_live > arena->bytes_peak) arena->bytes_peak = arena->bytes_live;
-    void *p = b + 1;
-    memset(p, 0, size);
-    return p;
+    return b + 1;
 }
 
 void *mk_arena_array(mk_arena *arena, size_t count, size_t size)
