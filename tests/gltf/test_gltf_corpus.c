@@ -9,19 +9,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
+#include "corpus_cases.h"
 #include "gltf_test_util.h"
 
 static void test_corpus_references(void)
 {
-    const char *corpus = check_corpus_dir();
-    char path[1024];
-    snprintf(path, sizeof path, "%s/cases.json", corpus);
     pb_manifest manifest;
-    mk_error err;
-    if (pb_manifest_read(path, &manifest, &err) != MK_OK) {
-        pb_manifest_free(&manifest);
-        SKIP("corpus not found at %s", corpus);
-    }
+    CHECK_CORPUS_MANIFEST(&manifest);
     int n = 0, frames = 0;
     double wp = 0, wn = 0;
     for (uint32_t i = 0; i < manifest.case_count; i++) {

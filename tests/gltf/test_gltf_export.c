@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include "check.h"
+#include "corpus_cases.h"
 #include "gltf_test_util.h"
 
 /* Output files carry the process id so parallel builds (plain, ASan) do not collide. */
@@ -46,15 +47,10 @@ static void check_valid(const char *path)
 
 static void test_round_trip_corpus(void)
 {
-    const char *corpus = check_corpus_dir();
     char path[4200], out[1024], side[1024], msg[512];
-    snprintf(path, sizeof path, "%s/cases.json", corpus);
     pb_manifest manifest;
     mk_error err = {0};
-    if (pb_manifest_read(path, &manifest, &err) != MK_OK) {
-        pb_manifest_free(&manifest);
-        SKIP("corpus not found at %s", corpus);
-    }
+    CHECK_CORPUS_MANIFEST(&manifest);
     int n = 0, frames = 0;
     double wp = 0, wn = 0;
     for (uint32_t i = 0; i < manifest.case_count; i++) {

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
+#include "corpus_cases.h"
 #include "blob_io.h"
 #include "conform.h"
 #include "import.h"
@@ -126,15 +127,8 @@ static void run_case(const pb_manifest *manifest, const pb_case *c, corpus_total
 
 static void test_corpus_other_modes(void)
 {
-    const char *corpus = check_corpus_dir();
-    char path[2048];
-    snprintf(path, sizeof path, "%s/cases.json", corpus);
     pb_manifest manifest;
-    mk_error err;
-    if (pb_manifest_read(path, &manifest, &err) != MK_OK) {
-        pb_manifest_free(&manifest);
-        SKIP("corpus not found at %s", corpus);
-    }
+    CHECK_CORPUS_MANIFEST(&manifest);
     corpus_totals tot;
     memset(&tot, 0, sizeof tot);
     for (uint32_t i = 0; i < manifest.case_count; i++) run_case(&manifest, &manifest.cases[i], &tot);
