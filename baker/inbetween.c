@@ -395,7 +395,7 @@ static mk_result bake_channel(mk_raw_asset *raw, uint32_t mesh_index, const char
         if (r != MK_OK) { raw->channel_count = old_count; return r; }
     }
     if (!deformer->analytic_normals && mesh->normals) {
-        mk_result r = mk_raw_compute_target_normals(raw, mesh_index, 0, err);
+        mk_result r = mk_raw_compute_target_normals(raw, mesh_index, 0, 0, err);
         if (r != MK_OK) { raw->channel_count = old_count; return r; }
     }
     if (result) {

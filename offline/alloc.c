@@ -113,6 +113,24 @@ void mk_arena_free_all(mk_arena *arena)
     arena->bytes_live = 0;
 }
 
+void mk_arena_adopt(mk_arena *into, mk_arena *from)
+{
+    mk_arena_block *b = from->blocks;
+    if (b) {
+        mk_arena_block *last = b;
+        while (last->next) last = last->next;
+        last->next = into->blocks;
+        if (into->blocks) into->blocks->prev = last;
+        into->blocks = b;
+    }
+    into->bytes_live += from->bytes_live;
+    if (into->bytes_live > into->bytes_peak) into->bytes_peak = into->bytes_live;
+    into->calls += from->calls;
+    into->failed |= from->failed;
+    from->blocks = NULL;
+    from->bytes_live = 0;
+}
+
 mk_result mk_error_set(mk_error *err, mk_result code, uint64_t offset, const char *fmt, ...)
 {
     if (!err) return code;

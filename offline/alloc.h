@@ -45,6 +45,9 @@ void mk_arena_release(mk_arena *arena, void *ptr);
 char *mk_arena_strdup(mk_arena *arena, const char *s);
 char *mk_arena_strndup(mk_arena *arena, const char *s, size_t n);
 void mk_arena_free_all(mk_arena *arena);
+/* Moves every block of `from` into `into` (both on the same allocator); `from` is left empty.
+ * Lets worker threads allocate from arenas of their own and hand the results over. */
+void mk_arena_adopt(mk_arena *into, mk_arena *from);
 
 /* Fills err with code, offset (UINT64_MAX when none) and a printf-style message; returns code.
  * err may be NULL. */

@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "mesh_groups.h"
+#include "parallel.h"
 
 typedef struct topology {
     mk_normal_groups g;        /* smoothing groups (mesh_groups.h) */
@@ -95,10 +96,9 @@ static int compare_u32(const void *a, const void *b)
 /* One target, in time proportional to what it touches: the triangles around moved vertices
  * get deformed face normals, the groups around those triangles new normals, and the
  * target's index set grows by the vertices of those groups. */
-static mk_result compute_target(mk_raw_asset *raw, const mk_raw_mesh *m, const topology *topo, mk_raw_target *t,
+static mk_result compute_target(mk_arena *arena, const mk_raw_mesh *m, const topology *topo, mk_raw_target *t,
                                 work *w, mk_error *err)
 {
-    mk_arena *arena = &raw->arena;
     for (uint32_t j = 0; j < t->count; j++) w->moved[t->indices[j]] = (int32_t)j;
     uint32_t tri_count = 0, group_count = 0, extra = 0;
     /* Triangles with a moved corner (found through the moved vertices' groups). */
@@ -187,48 +187,96 @@ static mk_result compute_target(mk_raw_asset *raw, const mk_raw_mesh *m, const t
     return MK_OK;
 }
 
-mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int force, mk_error *err)
+static mk_result alloc_work(mk_arena *arena, const mk_raw_mesh *m, const topology *topo, work *w, mk_error *err)
+{
+    w->moved = mk_arena_array(arena, m->vertex_count, sizeof(int32_t));
+    w->vert_mark = mk_arena_array(arena, m->vertex_count, 1);
+    w->extra = mk_arena_array(arena, m->vertex_count, sizeof(uint32_t));
+    w->group_slot = mk_arena_array(arena, topo->g.group_count + 1u, sizeof(int32_t));
+    w->groups = mk_arena_array(arena, topo->g.group_count + 1u, sizeof(uint32_t));
+    w->tri_slot = mk_arena_array(arena, (size_t)m->triangle_count + 1, sizeof(int32_t));
+    w->tris = mk_arena_array(arena, (size_t)m->triangle_count + 1, sizeof(uint32_t));
+    if (!w->moved || !w->vert_mark || !w->extra || !w->group_slot || !w->groups || !w->tri_slot || !w->tris)
+        return mk_error_oom(err, "computing target normals");
+    for (uint32_t v = 0; v < m->vertex_count; v++) w->moved[v] = -1;
+    for (uint32_t g = 0; g < topo->g.group_count; g++) w->group_slot[g] = -1;
+    for (uint32_t t = 0; t < m->triangle_count; t++) w->tri_slot[t] = -1;
+    return MK_OK;
+}
+
+static void release_work(mk_arena *arena, work *w)
+{
+    void *scratch[] = { w->moved, w->vert_mark, w->extra, w->group_slot, w->groups, w->tri_slot, w->tris };
+    for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
+}
+
+/* The targets of a mesh are independent: each worker thread has its own work arrays and
+ * allocates the new target arrays from an arena of its own, adopted by the raw asset after
+ * the loop. Every target's result is the same whichever thread computes it. */
+typedef struct normals_loop {
+    const mk_raw_mesh *m;
+    const topology *topo;
+    mk_raw_target **targets;
+    mk_result *results;
+    mk_error *errors;
+    work *works;
+    mk_arena *arenas;
+} normals_loop;
+
+static void normals_item(void *user, uint32_t item, uint32_t worker)
+{
+    normals_loop *l = user;
+    l->results[item] = compute_target(&l->arenas[worker], l->m, l->topo, l->targets[item], &l->works[worker],
+                                      &l->errors[item]);
+}
+
+mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads, mk_error *err)
 {
     if (mesh >= raw->mesh_count)
         return mk_error_set(err, MK_ERROR_OUT_OF_RANGE, UINT64_MAX, "compute normals: mesh %u does not exist", mesh);
     const mk_raw_mesh *m = &raw->meshes[mesh];
     if (!m->normals || m->triangle_count == 0) return MK_OK;  /* nothing to morph, or no surface */
-    int needed = 0;
+    uint32_t count = 0;
     for (uint32_t c = 0; c < raw->channel_count; c++)
         if (raw->channels[c].mesh == mesh)
             for (uint32_t k = 0; k < raw->channels[c].target_count; k++)
-                if (force || !raw->channels[c].targets[k].normals) needed = 1;
-    if (!needed) return MK_OK;
+                if (force || !raw->channels[c].targets[k].normals) count++;
+    if (!count) return MK_OK;
     mk_arena *arena = &raw->arena;
     topology topo;
-    work w;
     mk_result r = build_topology(arena, m, &topo, err);
     if (r != MK_OK) return r;
-    w.moved = mk_arena_array(arena, m->vertex_count, sizeof(int32_t));
-    w.vert_mark = mk_arena_array(arena, m->vertex_count, 1);
-    w.extra = mk_arena_array(arena, m->vertex_count, sizeof(uint32_t));
-    w.group_slot = mk_arena_array(arena, topo.g.group_count + 1u, sizeof(int32_t));
-    w.groups = mk_arena_array(arena, topo.g.group_count + 1u, sizeof(uint32_t));
-    w.tri_slot = mk_arena_array(arena, (size_t)m->triangle_count + 1, sizeof(int32_t));
-    w.tris = mk_arena_array(arena, (size_t)m->triangle_count + 1, sizeof(uint32_t));
-    if (!w.moved || !w.vert_mark || !w.extra || !w.group_slot || !w.groups || !w.tri_slot || !w.tris)
-        return mk_error_oom(err, "computing target normals");
-    for (uint32_t v = 0; v < m->vertex_count; v++) w.moved[v] = -1;
-    for (uint32_t g = 0; g < topo.g.group_count; g++) w.group_slot[g] = -1;
-    for (uint32_t t = 0; t < m->triangle_count; t++) w.tri_slot[t] = -1;
-    for (uint32_t c = 0; c < raw->channel_count; c++) {
-        if (raw->channels[c].mesh != mesh) continue;
-        for (uint32_t k = 0; k < raw->channels[c].target_count; k++) {
-            mk_raw_target *t = &raw->channels[c].targets[k];
-            if (!force && t->normals) continue;
-            r = compute_target(raw, m, &topo, t, &w, err);
-            if (r) return r;
+    uint32_t workers = mk_parallel_threads(threads, count);
+    normals_loop l = { m, &topo, NULL, NULL, NULL, NULL, NULL };
+    l.targets = mk_arena_array(arena, count, sizeof *l.targets);
+    l.results = mk_arena_array(arena, count, sizeof *l.results);
+    l.errors = mk_arena_array(arena, count, sizeof *l.errors);
+    l.works = mk_arena_array(arena, workers, sizeof *l.works);
+    l.arenas = mk_arena_array(arena, workers, sizeof *l.arenas);
+    if (!l.targets || !l.results || !l.errors || !l.works || !l.arenas) return mk_error_oom(err, "computing target normals");
+    count = 0;
+    for (uint32_t c = 0; c < raw->channel_count; c++)
+        if (raw->channels[c].mesh == mesh)
+            for (uint32_t k = 0; k < raw->channels[c].target_count; k++)
+                if (force || !raw->channels[c].targets[k].normals) l.targets[count++] = &raw->channels[c].targets[k];
+    uint32_t ready = 0;
+    for (; ready < workers && r == MK_OK; ready++) {
+        mk_arena_init(&l.arenas[ready], &arena->allocator);
+        r = alloc_work(&l.arenas[ready], m, &topo, &l.works[ready], err);
+    }
+    if (r == MK_OK) mk_parallel_for(count, workers, normals_item, &l);
+    for (uint32_t i = 0; i < count && r == MK_OK; i++)
+        if (l.results[i] != MK_OK) {  /* the first failing target in asset order, whatever the threads */
+            r = l.results[i];
+            if (err) *err = l.errors[i];
         }
+    for (uint32_t w = 0; w < ready; w++) {
+        release_work(&l.arenas[w], &l.works[w]);
+        mk_arena_adopt(arena, &l.arenas[w]);
     }
     /* Work and topology memory is only needed here: give it back (lowers the import peak). */
-    void *scratch[] = { w.moved, w.vert_mark, w.extra, w.group_slot, w.groups, w.tri_slot, w.tris, topo.g.group_of,
-                        topo.g.group_vert_first, topo.g.group_verts, topo.g.group_tri_first, topo.g.group_tris, topo.face,
-                        topo.base_normal };
+    void *scratch[] = { l.targets, l.results, l.errors, l.works, l.arenas, topo.g.group_of, topo.g.group_vert_first,
+                        topo.g.group_verts, topo.g.group_tri_first, topo.g.group_tris, topo.face, topo.base_normal };
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
-    return MK_OK;
+    return r;
 }

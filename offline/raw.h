@@ -117,7 +117,8 @@ mk_result mk_raw_validate(const mk_raw_asset *raw, mk_error *err);
  * deltas (or when `force`), from the target positions with the base triangles. Vertices with
  * the same control point and the same base normal are smoothed together (UV seams merge,
  * hard edges stay hard). Δn = N(target) - N(base), both computed the same way, so the
- * authored base normals are kept at weight 0. */
-mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int force, mk_error *err);
+ * authored base normals are kept at weight 0. Targets are computed in parallel on `threads`
+ * threads (0: one per core; the result is the same for any count). */
+mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads, mk_error *err);
 
 #endif

@@ -82,7 +82,7 @@ int main(int argc, char **argv)
         ch = &raw.channels[1];
     }
     mk_error err;
-    if (mk_raw_compute_target_normals(&raw, 0, 0, &err)) { fprintf(stderr, "%s\n", err.message); return 1; }
+    if (mk_raw_compute_target_normals(&raw, 0, 0, 0, &err)) { fprintf(stderr, "%s\n", err.message); return 1; }
 
     mk_raw_clip *clip = mk_raw_add_clips(&raw, 1);
     clip->name = "wave";

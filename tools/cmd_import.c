@@ -10,6 +10,7 @@ typedef struct import_args {
     const char *input, *output, *channels, *depfile;
     int stacking, precision, stacking_given, quiet, all_meshes, timings;
     double tolerance;
+    uint64_t threads;
 } import_args;
 
 static int run_import(void *p);
@@ -37,6 +38,10 @@ static const cli_option options[] = {
       0 },
     { "--timings", NULL, CLI_FLAG, offsetof(import_args, timings),
       "Print where the import's time and memory went, phase by phase (to standard error).", NULL, NULL, 0, 0, 0, 0 },
+    { "--threads", "N", CLI_UINT, offsetof(import_args, threads),
+      "Threads for the parts of an import that run in parallel (target normals); 0 = one per core. The blob is the "
+      "same for any count.",
+      "0", NULL, 0, 64, 0, 0 },
     { "--depfile", "PATH", CLI_STRING, offsetof(import_args, depfile),
       "Also write a depfile for build systems (make syntax, as ninja and meson read it): the blob and every file the "
       "import read (the source, the sidecar, glTF buffers).",
@@ -82,6 +87,7 @@ static int run_import(void *p)
     mk_phase_log phases;
     mk_phase_log_start(&phases);
     mk_import_options io = { .phases = a->timings ? &phases : NULL, .channels_sidecar = a->channels, .keep_plain_meshes = a->all_meshes,
+                             .threads = (uint32_t)a->threads,
                              .file_read = a->depfile ? cli_depfile_add : NULL, .file_read_user = &deps };
     if (a->stacking_given) io.stacking = a->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
     mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16,

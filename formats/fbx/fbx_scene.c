@@ -920,7 +920,7 @@ static mk_result convert_meshes(scene *s)
             for (uint32_t k = 0; k < raw->channels[c].target_count; k++)
                 if (!raw->channels[c].targets[k].normals) needs_normals = 1;
         if (needs_normals) {
-            r = mk_raw_compute_target_normals(raw, mesh_index, 0, doc->err);
+            r = mk_raw_compute_target_normals(raw, mesh_index, 0, s->options->threads, doc->err);
             mk_phase_log_mark(s->options->phases, "target normals");
             if (r != MK_OK) return r;
         }

@@ -3,26 +3,22 @@
  * a float blob and checked frame by frame with the conformance check `morphkit conform` uses
  * (playback/conform.c: the static state for "time": null, the first stack otherwise; world
  * space; per control point; case tolerance plus float32 rounding), and facts the frames do not
- * show (names, in-between order). SKIPs when the corpus is absent. */
+ * show (names, in-between order), and the same blob on any thread count. SKIPs when the corpus is absent. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
+#include "corpus_cases.h"
 #include "conform.h"
 #include "fbx_test_util.h"
 
 static void test_corpus_frames(void)
 {
-    const char *corpus = check_corpus_dir();
     char path[4200];
-    snprintf(path, sizeof path, "%s/cases.json", corpus);
     pb_manifest manifest;
     mk_error err;
-    if (pb_manifest_read(path, &manifest, &err) != MK_OK) {
-        pb_manifest_free(&manifest);
-        SKIP("corpus not found at %s", corpus);
-    }
+    CHECK_CORPUS_MANIFEST(&manifest);
     double worst = 0, worst_weight = 0;
     int cases = 0, frames = 0;
     mk_write_options wo = { .precision = MK_PRECISION_FLOAT };
@@ -92,4 +88,43 @@ static void test_corpus_structure(void)
     mk_raw_free(&raw);
 }
 
-CHECK_MAIN(CASE(test_corpus_frames), CASE(test_corpus_structure))
+/* Target normals run on worker threads: every FBX case gives the same blob bytes on 1 and on
+ * 4 threads. */
+static void test_corpus_thread_count(void)
+{
+    char path[4200];
+    pb_manifest manifest;
+    mk_error err;
+    CHECK_CORPUS_MANIFEST(&manifest);
+    int compared = 0;
+    for (uint32_t i = 0; i < manifest.case_count; i++) {
+        const pb_case *c = &manifest.cases[i];
+        if (c->gltf) continue;
+        pb_manifest_path(&manifest, c->source, path, sizeof path);
+        size_t size;
+        unsigned char *data = check_read_file(path, &size);
+        CHECK_MSG(data != NULL, "%s: cannot read %s", c->name, path);
+        if (!data) continue;
+        void *blob[2] = { NULL, NULL };
+        size_t blob_size[2] = { 0, 0 };
+        mk_raw_asset raw[2];
+        for (int k = 0; k < 2; k++) {
+            mk_import_options io = { .threads = k ? 4 : 1 };
+            mk_write_options wo = { .precision = MK_PRECISION_Q16 };
+            mk_result r = ft_import(data, size, &io, &raw[k], &err);
+            if (r == MK_OK) r = mk_write_blob(&raw[k], &wo, &raw[k].arena, &blob[k], &blob_size[k], NULL, &err);
+            CHECK_MSG(r == MK_OK, "%s: %s", c->name, err.message);
+        }
+        if (blob[0] && blob[1]) {
+            CHECK_MSG(blob_size[0] == blob_size[1] && memcmp(blob[0], blob[1], blob_size[0]) == 0,
+                      "%s: the blob differs between 1 and 4 threads", c->name);
+            compared++;
+        }
+        for (int k = 0; k < 2; k++) mk_raw_free(&raw[k]);
+        free(data);
+    }
+    CHECK(compared > 0);
+    pb_manifest_free(&manifest);
+}
+
+CHECK_MAIN(CASE(test_corpus_frames), CASE(test_corpus_structure), CASE(test_corpus_thread_count))

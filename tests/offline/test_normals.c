@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /* Target normals computed from target positions: they equal normals computed from scratch
  * on the deformed mesh (property), UV-seam duplicates smooth together, hard edges stay hard,
- * and tangents stay orthogonal to the new normals. */
+ * tangents stay orthogonal to the new normals, and any thread count gives the same bytes. */
 #include <stdlib.h>
+#include <string.h>
 #include "check.h"
 #include "fixtures.h"
 
@@ -74,7 +75,7 @@ static void test_matches_recomputed_normals(void)
     mk_raw_init(&raw, NULL);
     grid_with_seam(&raw);
     mk_error err;
-    CHECK(mk_raw_compute_target_normals(&raw, 0, 0, &err) == MK_OK);
+    CHECK(mk_raw_compute_target_normals(&raw, 0, 0, 0, &err) == MK_OK);
     const mk_raw_mesh *m = &raw.meshes[0];
     const mk_raw_target *t = &raw.channels[0].targets[0];
     CHECK(t->normals != NULL && t->tangents != NULL);
@@ -135,7 +136,7 @@ static void test_hard_edge_stays_hard(void)
     static float d[] = { 0, 0, 0.5f };
     t->name = "lift"; t->count = 1; t->indices = idx; t->positions = d;
     mk_error err;
-    CHECK(mk_raw_compute_target_normals(&raw, 0, 0, &err) == MK_OK);
+    CHECK(mk_raw_compute_target_normals(&raw, 0, 0, 0, &err) == MK_OK);
     t = &raw.channels[0].targets[0];
     for (uint32_t j = 0; j < t->count; j++) {
         double len = fabs(t->normals[3 * j]) + fabs(t->normals[3 * j + 1]) + fabs(t->normals[3 * j + 2]);
@@ -145,4 +146,76 @@ static void test_hard_edge_stays_hard(void)
     mk_raw_free(&raw);
 }
 
-CHECK_MAIN(CASE(test_matches_recomputed_normals), CASE(test_hard_edge_stays_hard))
+/* A wavy n x n grid with `targets` channels, each lifting a different disc of vertices. */
+static void wavy_grid(mk_raw_asset *raw, uint32_t n, uint32_t targets)
+{
+    mk_raw_mesh *m = mk_raw_add_meshes(raw, 1);
+    m->name = "wavy";
+    m->vertex_count = m->control_point_count = n * n;
+    m->positions = mk_arena_array(&raw->arena, 3 * (size_t)n * n, sizeof(float));
+    m->normals = mk_arena_array(&raw->arena, 3 * (size_t)n * n, sizeof(float));
+    m->control_points = mk_arena_array(&raw->arena, (size_t)n * n, sizeof(uint32_t));
+    m->triangles = mk_arena_array(&raw->arena, 6 * (size_t)(n - 1) * (n - 1), sizeof(uint32_t));
+    for (uint32_t v = 0; v < n * n; v++) {
+        float x = (float)(v % n), y = (float)(v / n);
+        m->control_points[v] = v;
+        m->positions[3 * v] = x;
+        m->positions[3 * v + 1] = y;
+        m->positions[3 * v + 2] = 0.3f * sinf(0.7f * x) * cosf(0.4f * y);
+        m->normals[3 * v + 2] = 1;
+    }
+    uint32_t t = 0;
+    for (uint32_t y = 0; y + 1 < n; y++)
+        for (uint32_t x = 0; x + 1 < n; x++) {
+            uint32_t a = y * n + x, b = a + 1, c = a + n, d = c + 1, *tri = &m->triangles[6 * t++];
+            tri[0] = a; tri[1] = b; tri[2] = d; tri[3] = a; tri[4] = d; tri[5] = c;
+        }
+    m->triangle_count = t;
+    for (uint32_t k = 0; k < targets; k++) {
+        mk_raw_channel *ch = mk_raw_add_channels(raw, 1);
+        ch->name = "lift";
+        mk_raw_target *tg = mk_raw_add_targets(raw, ch, 1);
+        tg->name = "lift";
+        float cx = (float)((k * 7) % n), cy = (float)((k * 13) % n), r = 2.0f + (float)(k % 4);
+        tg->indices = mk_arena_array(&raw->arena, (size_t)n * n, sizeof(uint32_t));
+        tg->positions = mk_arena_array(&raw->arena, 3 * (size_t)n * n, sizeof(float));
+        for (uint32_t v = 0; v < n * n; v++) {
+            float dx = (float)(v % n) - cx, dy = (float)(v / n) - cy, q = dx * dx + dy * dy;
+            if (q >= r * r) continue;
+            tg->indices[tg->count] = v;
+            tg->positions[3 * tg->count + 2] = 0.5f * (1 - q / (r * r));
+            tg->positions[3 * tg->count] = 0.1f * dx;
+            tg->count++;
+        }
+    }
+}
+
+/* Targets are computed on worker threads: the result must not depend on how many. */
+static void test_same_result_for_any_thread_count(void)
+{
+    mk_raw_asset one, many;
+    mk_raw_init(&one, NULL);
+    mk_raw_init(&many, NULL);
+    wavy_grid(&one, 48, 23);
+    wavy_grid(&many, 48, 23);
+    mk_error err;
+    CHECK(mk_raw_compute_target_normals(&one, 0, 0, 1, &err) == MK_OK);
+    CHECK(mk_raw_compute_target_normals(&many, 0, 0, 5, &err) == MK_OK);
+    uint32_t differ = 0, grew = 0;
+    for (uint32_t c = 0; c < one.channel_count; c++) {
+        const mk_raw_target *a = &one.channels[c].targets[0], *b = &many.channels[c].targets[0];
+        CHECK(a->normals != NULL && b->normals != NULL);
+        if (a->count != b->count) { differ++; continue; }
+        grew += a->count > 0;
+        differ += memcmp(a->indices, b->indices, a->count * sizeof *a->indices) != 0;
+        differ += memcmp(a->positions, b->positions, 3 * a->count * sizeof(float)) != 0;
+        differ += memcmp(a->normals, b->normals, 3 * a->count * sizeof(float)) != 0;
+    }
+    CHECK_MSG(differ == 0, "%u targets differ between 1 and 5 threads", differ);
+    CHECK(grew == one.channel_count);
+    mk_raw_free(&one);
+    mk_raw_free(&many);
+}
+
+CHECK_MAIN(CASE(test_matches_recomputed_normals), CASE(test_hard_edge_stays_hard),
+           CASE(test_same_result_for_any_thread_count))

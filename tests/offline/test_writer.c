@@ -161,7 +161,7 @@ static void test_fail_allocation_k(void)
         mk_result r = mk_read_blob(&a, &raw, &err);
         void *out = NULL;
         size_t out_size;
-        if (r == MK_OK) r = mk_raw_compute_target_normals(&raw, 0, 1, &err);
+        if (r == MK_OK) r = mk_raw_compute_target_normals(&raw, 0, 1, 0, &err);
         if (r == MK_OK) r = mk_write_blob(&raw, NULL, &raw.arena, &out, &out_size, NULL, &err);
         if (r == MK_OK) succeeded = 1;
         else {
