@@ -227,6 +227,34 @@ static void test_stacking_option(void)
 
 static const double one_point[3] = { 0, 0, 0 };
 static const int32_t one_triangle[3] = { 0, 0, ~0 };
+static const double tri_points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
+static const int32_t tri_polygon[3] = { 0, 1, ~2 };
+
+/* A mesh of one triangle (control points 0, 1, 2 of `points`) without a parent. */
+static fbxw_mesh triangle_mesh(const char *name, const double *points, const fbxw_channel *channels, uint32_t channel_count)
+{
+    fbxw_mesh mesh = { .name = name, .control_point_count = 3, .control_points = points, .polygon_vertex_count = 3,
+                       .polygon_vertex_index = tri_polygon, .channel_count = channel_count, .channels = channels,
+                       .parent = -1 };
+    return mesh;
+}
+
+/* Writes `scene` and imports it (raw is initialized either way); the write failing is
+ * reported as MK_ERROR_CORRUPT. */
+static mk_result write_import(const fbxw_scene *scene, mk_raw_asset *raw, mk_error *err)
+{
+    unsigned char *data;
+    size_t size;
+    memset(err, 0, sizeof *err);
+    if (fbxw_write(scene, &data, &size) != 0) {
+        mk_raw_init(raw, NULL);
+        snprintf(err->message, sizeof err->message, "the test FBX writer failed");
+        return MK_ERROR_CORRUPT;
+    }
+    mk_result r = ft_import(data, size, NULL, raw, err);
+    free(data);
+    return r;
+}
 
 static int import_curve(const int64_t *times, const float *values, const int32_t *flags, const float *attr, uint32_t count,
                         int binary, mk_raw_asset *raw)
@@ -236,37 +264,14 @@ static int import_curve(const int64_t *times, const float *values, const int32_t
     static const double fw[1] = { 100 };
     fbxw_shape shape = { "S", 1, idx, delta, NULL };
     fbxw_curve curve = { count, times, values, flags, attr };
-    fbxw_channel channel;
-    memset(&channel, 0, sizeof channel);
-    channel.name = "C";
-    channel.shape_count = 1;
-    channel.shapes = &shape;
-    channel.full_weight_count = 1;
-    channel.full_weights = fw;
-    channel.curve = &curve;
-    fbxw_mesh mesh;
-    memset(&mesh, 0, sizeof mesh);
-    mesh.name = "M";
+    fbxw_channel channel = { .name = "C", .shape_count = 1, .shapes = &shape, .full_weight_count = 1, .full_weights = fw,
+                             .curve = &curve };
+    fbxw_mesh mesh = triangle_mesh("M", one_point, &channel, 1);
     mesh.control_point_count = 1;
-    mesh.control_points = one_point;
-    mesh.polygon_vertex_count = 3;
     mesh.polygon_vertex_index = one_triangle;
-    mesh.channel_count = 1;
-    mesh.channels = &channel;
-    mesh.parent = -1;
-    fbxw_scene scene;
-    memset(&scene, 0, sizeof scene);
-    scene.version = 7500;
-    scene.binary = binary;
-    scene.stack_stop = FIXTURE_KTIME(4);
-    scene.mesh_count = 1;
-    scene.meshes = &mesh;
-    unsigned char *data;
-    size_t size;
-    if (fbxw_write(&scene, &data, &size)) return -1;
+    fbxw_scene scene = { .version = 7500, .binary = binary, .stack_stop = FIXTURE_KTIME(4), .mesh_count = 1, .meshes = &mesh };
     mk_error err;
-    mk_result r = ft_import(data, size, NULL, raw, &err);
-    free(data);
+    mk_result r = write_import(&scene, raw, &err);
     if (r != MK_OK) fprintf(stderr, "curve import: %s\n", err.message);
     return r == MK_OK && raw->clip_count == 1 && raw->clips[0].track_count == 1 ? 0 : -1;
 }
@@ -410,43 +415,17 @@ static void test_blender_full_weights(void)
     static const int32_t idx[2] = { 0, 1 };
     static const double delta[6] = { 0, 0, 2, 0, 0, 2 };
     static const double fw[2] = { 25, 100 };  /* per Indexes entry: Blender vertex-group weights */
-    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
-    static const int32_t tri[3] = { 0, 1, ~2 };
     for (int blender = 0; blender < 2; blender++) {
         fbxw_shape shape = { "Key", 2, idx, delta, NULL };
-        fbxw_channel channel;
-        memset(&channel, 0, sizeof channel);
-        channel.name = "Key";
-        channel.deform_percent = 100;
-        channel.deform_as_field_only = 1;
-        channel.shape_count = 1;
-        channel.shapes = &shape;
-        channel.full_weight_count = 2;
-        channel.full_weights = fw;
-        fbxw_mesh mesh;
-        memset(&mesh, 0, sizeof mesh);
-        mesh.name = "Tri";
-        mesh.control_point_count = 3;
-        mesh.control_points = points;
-        mesh.polygon_vertex_count = 3;
-        mesh.polygon_vertex_index = tri;
-        mesh.channel_count = 1;
-        mesh.channels = &channel;
-        mesh.parent = -1;
-        fbxw_scene scene;
-        memset(&scene, 0, sizeof scene);
-        scene.version = 7400;
-        scene.binary = 1;
-        scene.creator = blender ? "Blender (stable FBX IO) - 4.4.1 - 5.12.7" : "FBX SDK/FBX Plugins version 2020.1";
-        scene.mesh_count = 1;
-        scene.meshes = &mesh;
-        unsigned char *data;
-        size_t size;
-        CHECK(fbxw_write(&scene, &data, &size) == 0);
+        fbxw_channel channel = { .name = "Key", .deform_percent = 100, .deform_as_field_only = 1, .shape_count = 1,
+                                 .shapes = &shape, .full_weight_count = 2, .full_weights = fw };
+        fbxw_mesh mesh = triangle_mesh("Tri", tri_points, &channel, 1);
+        fbxw_scene scene = { .version = 7400, .binary = 1, .mesh_count = 1, .meshes = &mesh,
+                             .creator = blender ? "Blender (stable FBX IO) - 4.4.1 - 5.12.7"
+                                                : "FBX SDK/FBX Plugins version 2020.1" };
         mk_raw_asset raw;
         mk_error err;
-        CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
-        free(data);
+        CHECK(write_import(&scene, &raw, &err) == MK_OK);
         CHECK_EQ_INT(raw.channel_count, 1);
         if (raw.channel_count == 1) {
             const mk_raw_channel *ch = &raw.channels[0];
@@ -470,39 +449,13 @@ static void test_duplicate_full_weights(void)
     static const int32_t idx[1] = { 0 };
     static const double d1[3] = { 1, 0, 0 }, d2[3] = { 2, 0, 0 }, d3[3] = { 3, 0, 0 };
     static const double fw[3] = { 50, 50, 0 };  /* duplicate, then a zero full weight */
-    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
-    static const int32_t tri[3] = { 0, 1, ~2 };
     fbxw_shape shapes[3] = { { "A", 1, idx, d1, NULL }, { "B", 1, idx, d2, NULL }, { "C", 1, idx, d3, NULL } };
-    fbxw_channel channel;
-    memset(&channel, 0, sizeof channel);
-    channel.name = "Dup";
-    channel.shape_count = 3;
-    channel.shapes = shapes;
-    channel.full_weight_count = 3;
-    channel.full_weights = fw;
-    fbxw_mesh mesh;
-    memset(&mesh, 0, sizeof mesh);
-    mesh.name = "Tri";
-    mesh.control_point_count = 3;
-    mesh.control_points = points;
-    mesh.polygon_vertex_count = 3;
-    mesh.polygon_vertex_index = tri;
-    mesh.channel_count = 1;
-    mesh.channels = &channel;
-    mesh.parent = -1;
-    fbxw_scene scene;
-    memset(&scene, 0, sizeof scene);
-    scene.version = 7500;
-    scene.binary = 0;
-    scene.mesh_count = 1;
-    scene.meshes = &mesh;
-    unsigned char *data;
-    size_t size;
-    CHECK(fbxw_write(&scene, &data, &size) == 0);
+    fbxw_channel channel = { .name = "Dup", .shape_count = 3, .shapes = shapes, .full_weight_count = 3, .full_weights = fw };
+    fbxw_mesh mesh = triangle_mesh("Tri", tri_points, &channel, 1);
+    fbxw_scene scene = { .version = 7500, .binary = 0, .mesh_count = 1, .meshes = &mesh };
     mk_raw_asset raw;
     mk_error err;
-    CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
-    free(data);
+    CHECK(write_import(&scene, &raw, &err) == MK_OK);
     CHECK_EQ_INT(raw.channel_count, 1);
     if (raw.channel_count == 1) {
         CHECK_EQ_INT(raw.channels[0].target_count, 1);
@@ -521,40 +474,14 @@ static void test_tiny_full_weights(void)
     static const double d1[3] = { 1, 0, 0 }, d2[3] = { 2, 0, 0 }, d3[3] = { 3, 0, 0 }, d4[3] = { 4, 0, 0 };
     /* percent: 1e-5 % = 1e-7 (too close to 0), 50, 50 + 1e-5 % (too close to 50), 100 */
     static const double fw[4] = { 1e-5, 50, 50.00001, 100 };
-    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
-    static const int32_t tri[3] = { 0, 1, ~2 };
     fbxw_shape shapes[4] = { { "A", 1, idx, d1, NULL }, { "B", 1, idx, d2, NULL }, { "C", 1, idx, d3, NULL },
                              { "D", 1, idx, d4, NULL } };
-    fbxw_channel channel;
-    memset(&channel, 0, sizeof channel);
-    channel.name = "Tiny";
-    channel.shape_count = 4;
-    channel.shapes = shapes;
-    channel.full_weight_count = 4;
-    channel.full_weights = fw;
-    fbxw_mesh mesh;
-    memset(&mesh, 0, sizeof mesh);
-    mesh.name = "Tri";
-    mesh.control_point_count = 3;
-    mesh.control_points = points;
-    mesh.polygon_vertex_count = 3;
-    mesh.polygon_vertex_index = tri;
-    mesh.channel_count = 1;
-    mesh.channels = &channel;
-    mesh.parent = -1;
-    fbxw_scene scene;
-    memset(&scene, 0, sizeof scene);
-    scene.version = 7500;
-    scene.binary = 1;
-    scene.mesh_count = 1;
-    scene.meshes = &mesh;
-    unsigned char *data;
-    size_t size;
-    CHECK(fbxw_write(&scene, &data, &size) == 0);
+    fbxw_channel channel = { .name = "Tiny", .shape_count = 4, .shapes = shapes, .full_weight_count = 4, .full_weights = fw };
+    fbxw_mesh mesh = triangle_mesh("Tri", tri_points, &channel, 1);
+    fbxw_scene scene = { .version = 7500, .binary = 1, .mesh_count = 1, .meshes = &mesh };
     mk_raw_asset raw;
     mk_error err;
-    CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
-    free(data);
+    CHECK(write_import(&scene, &raw, &err) == MK_OK);
     CHECK_MSG(mk_raw_validate(&raw, &err) == MK_OK, "%s", err.message);
     CHECK_EQ_INT(raw.channel_count, 1);
     if (raw.channel_count == 1) {
@@ -578,7 +505,6 @@ static void test_tiny_full_weights(void)
 static void test_rotation_order(void)
 {
     static const double points[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
-    static const int32_t tri[3] = { 0, 1, ~2 };
     struct { double r[3], pre[3]; int order; double expect[3]; } cases[] = {
         { { 90, 0, 90 }, { 0, 0, 0 }, 0, { 1, 1, 0 } },
         { { 90, 0, 90 }, { 0, 0, 0 }, 5, { 1, 0, 1 } },
@@ -587,31 +513,15 @@ static void test_rotation_order(void)
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
         for (int binary = 0; binary < 2; binary++) {
-            fbxw_mesh mesh;
-            memset(&mesh, 0, sizeof mesh);
-            mesh.name = "Tri";
-            mesh.control_point_count = 3;
-            mesh.control_points = points;
-            mesh.polygon_vertex_count = 3;
-            mesh.polygon_vertex_index = tri;
+            fbxw_mesh mesh = triangle_mesh("Tri", points, NULL, 0);
             mesh.translation[0] = 1;
             memcpy(mesh.rotation, cases[c].r, sizeof mesh.rotation);
             memcpy(mesh.pre_rotation, cases[c].pre, sizeof mesh.pre_rotation);
             mesh.rotation_order = cases[c].order;
-            mesh.parent = -1;
-            fbxw_scene scene;
-            memset(&scene, 0, sizeof scene);
-            scene.version = 7400;
-            scene.binary = binary;
-            scene.mesh_count = 1;
-            scene.meshes = &mesh;
-            unsigned char *data;
-            size_t size;
-            CHECK(fbxw_write(&scene, &data, &size) == 0);
+            fbxw_scene scene = { .version = 7400, .binary = binary, .mesh_count = 1, .meshes = &mesh };
             mk_raw_asset raw;
             mk_error err;
-            CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
-            free(data);
+            CHECK(write_import(&scene, &raw, &err) == MK_OK);
             float *p = NULL;
             uint32_t n = 0;
             CHECK(raw.mesh_count == 1 && ft_eval_control_points(&raw, 0, -1, 0, NULL, 1, &p, &n) == 0);
@@ -671,35 +581,16 @@ static void test_legacy_61_ascii(void)
  * and 3 with Rrs (Maya segment scale compensate: the parent's scale does not scale the child). */
 static void test_inherit_type(void)
 {
-    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
-    static const int32_t tri[3] = { 0, 1, ~2 };
     for (int ignore = 0; ignore < 2; ignore++) {
-        fbxw_mesh meshes[2];
-        memset(meshes, 0, sizeof meshes);
-        for (int m = 0; m < 2; m++) {
-            meshes[m].name = m ? "Child" : "Parent";
-            meshes[m].control_point_count = 3;
-            meshes[m].control_points = points;
-            meshes[m].polygon_vertex_count = 3;
-            meshes[m].polygon_vertex_index = tri;
-            meshes[m].parent = m ? 0 : -1;
-        }
+        fbxw_mesh meshes[2] = { triangle_mesh("Parent", tri_points, NULL, 0), triangle_mesh("Child", tri_points, NULL, 0) };
+        meshes[1].parent = 0;
         meshes[0].scaling[0] = meshes[0].scaling[1] = meshes[0].scaling[2] = 2;
         meshes[1].translation[0] = 1;
         meshes[1].ignore_parent_scale = ignore;
-        fbxw_scene scene;
-        memset(&scene, 0, sizeof scene);
-        scene.version = 7500;
-        scene.binary = 1;
-        scene.mesh_count = 2;
-        scene.meshes = meshes;
-        unsigned char *data;
-        size_t size;
-        CHECK(fbxw_write(&scene, &data, &size) == 0);
+        fbxw_scene scene = { .version = 7500, .binary = 1, .mesh_count = 2, .meshes = meshes };
         mk_raw_asset raw;
         mk_error err;
-        CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
-        free(data);
+        CHECK(write_import(&scene, &raw, &err) == MK_OK);
         int32_t child = ft_find_mesh(&raw, "Child");
         float *p = NULL;
         uint32_t n = 0;
@@ -728,53 +619,25 @@ static int has_warning(const mk_raw_asset *raw, const char *a, const char *b)
  * without blend shapes): Prop is skipped with a warning naming it, Tri and Plain import. */
 static void test_empty_mesh_skipped(void)
 {
-    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
-    static const int32_t tri[3] = { 0, 1, ~2 };
     static const int32_t idx[1] = { 2 };
     static const double delta[3] = { 0, 0, 1 };
     static const double fw[1] = { 100 };
     fbxw_shape shape = { "Up", 1, idx, delta, NULL };
-    fbxw_channel channels[2];
-    memset(channels, 0, sizeof channels);
-    channels[0].name = "Up";
-    channels[0].deform_percent = 50;
-    channels[0].shape_count = 1;
-    channels[0].shapes = &shape;
-    channels[0].full_weight_count = 1;
-    channels[0].full_weights = fw;
+    fbxw_channel channels[2] = { { .name = "Up", .deform_percent = 50, .shape_count = 1, .shapes = &shape,
+                                   .full_weight_count = 1, .full_weights = fw } };
     channels[1] = channels[0];
     channels[1].name = "PropUp";
     for (int variant = 0; variant < 4; variant++) {
         int binary = variant & 1, prop_has_channel = variant >> 1;
-        fbxw_mesh meshes[3];
-        memset(meshes, 0, sizeof meshes);
-        meshes[0].name = "Prop";    /* no control points, no polygons */
-        meshes[0].parent = -1;
+        fbxw_mesh meshes[3] = { { .name = "Prop", .parent = -1 },   /* no control points, no polygons */
+                                triangle_mesh("Tri", tri_points, &channels[0], 1),
+                                triangle_mesh("Plain", tri_points, NULL, 0) };
         meshes[0].channel_count = prop_has_channel ? 1 : 0;
         meshes[0].channels = &channels[1];
-        for (int m = 1; m < 3; m++) {
-            meshes[m].name = m == 1 ? "Tri" : "Plain";
-            meshes[m].control_point_count = 3;
-            meshes[m].control_points = points;
-            meshes[m].polygon_vertex_count = 3;
-            meshes[m].polygon_vertex_index = tri;
-            meshes[m].parent = -1;
-        }
-        meshes[1].channel_count = 1;
-        meshes[1].channels = &channels[0];
-        fbxw_scene scene;
-        memset(&scene, 0, sizeof scene);
-        scene.version = binary ? 7500 : 7400;
-        scene.binary = binary;
-        scene.mesh_count = 3;
-        scene.meshes = meshes;
-        unsigned char *data;
-        size_t size;
-        CHECK(fbxw_write(&scene, &data, &size) == 0);
+        fbxw_scene scene = { .version = binary ? 7500 : 7400, .binary = binary, .mesh_count = 3, .meshes = meshes };
         mk_raw_asset raw;
         mk_error err;
-        mk_result r = ft_import(data, size, NULL, &raw, &err);
-        free(data);
+        mk_result r = write_import(&scene, &raw, &err);
         CHECK_MSG(r == MK_OK, "variant %d: %s", variant, err.message);
         if (r == MK_OK) {
             CHECK_EQ_INT(raw.mesh_count, 2);
@@ -969,23 +832,10 @@ static void test_binary_not_finite(void)
     double points[3 * 30];
     for (int i = 0; i < 90; i++) points[i] = (double)(i % 7);
     points[4] = NAN;   /* control point 1, y */
-    static const int32_t tri[3] = { 0, 1, ~2 };
     for (int compress = 0; compress < 2; compress++) {
-        fbxw_mesh mesh;
-        memset(&mesh, 0, sizeof mesh);
-        mesh.name = "M";
+        fbxw_mesh mesh = triangle_mesh("M", points, NULL, 0);
         mesh.control_point_count = 30;   /* 90 doubles: compressed when asked */
-        mesh.control_points = points;
-        mesh.polygon_vertex_count = 3;
-        mesh.polygon_vertex_index = tri;
-        mesh.parent = -1;
-        fbxw_scene scene;
-        memset(&scene, 0, sizeof scene);
-        scene.version = 7500;
-        scene.binary = 1;
-        scene.compress = compress;
-        scene.mesh_count = 1;
-        scene.meshes = &mesh;
+        fbxw_scene scene = { .version = 7500, .binary = 1, .compress = compress, .mesh_count = 1, .meshes = &mesh };
         unsigned char *data;
         size_t size;
         CHECK(fbxw_write(&scene, &data, &size) == 0);
