@@ -467,13 +467,36 @@ static void connect(out *o, const char *type, int64_t src, int64_t dst, const ch
     end(o, 0);
 }
 
+/* An object's node and values: `node` (Geometry, Model, Deformer...) with the id, "class::name"
+ * and the subclass; `nested` as values_end takes it. */
+static void object_begin(out *o, const char *node, int64_t id, const char *cls, const char *name, const char *subclass,
+                         int nested)
+{
+    begin(o, node);
+    v_i64(o, id, 'L');
+    v_name(o, cls, name);
+    v_str(o, subclass);
+    values_end(o, nested);
+}
+
+/* A by-polygon-vertex, direct layer element (normals, UVs) of `count` values. */
+static void layer_element(out *o, const char *node, int64_t version, const char *name, const char *array,
+                          const double *values, size_t count)
+{
+    begin(o, node);
+    v_i64(o, 0, 'I');
+    values_end(o, 1);
+    leaf_i64(o, "Version", version, 'I');
+    leaf_str(o, "Name", name);
+    leaf_str(o, "MappingInformationType", "ByPolygonVertex");
+    leaf_str(o, "ReferenceInformationType", "Direct");
+    leaf_array_as(o, array, 'f', values, count);
+    end(o, 1);
+}
+
 static void write_curve(out *o, int64_t id, const fbxw_curve *c, double default_value)
 {
-    begin(o, "AnimationCurve");
-    v_i64(o, id, 'L');
-    v_name(o, "AnimCurve", "");
-    v_str(o, "");
-    values_end(o, 1);
+    object_begin(o, "AnimationCurve", id, "AnimCurve", "", "", 1);
     leaf_f64(o, "Default", default_value);
     leaf_i64(o, "KeyVer", 4009, 'I');
     leaf_array(o, "KeyTime", 'l', c->times, c->key_count, 0);
@@ -564,42 +587,20 @@ static void write_scene(out *o, const fbxw_scene *sc)
         const fbxw_mesh *mesh = &sc->meshes[m];
         model_id[m] = new_id(&g);
         geom_id[m] = new_id(&g);
-        begin(o, "Geometry");
-        v_i64(o, geom_id[m], 'L');
-        v_name(o, "Geometry", "");
-        v_str(o, "Mesh");
-        values_end(o, 1);
+        object_begin(o, "Geometry", geom_id[m], "Geometry", "", "Mesh", 1);
         leaf_array(o, "Vertices", 'd', mesh->control_points, 3 * (size_t)mesh->control_point_count, 0);
         leaf_array(o, "PolygonVertexIndex", 'i', mesh->polygon_vertex_index, mesh->polygon_vertex_count, 0);
         leaf_i64(o, "GeometryVersion", 124, 'I');
-        if (mesh->normals) {
-            begin(o, "LayerElementNormal"); v_i64(o, 0, 'I'); values_end(o, 1);
-            leaf_i64(o, "Version", 102, 'I');
-            leaf_str(o, "Name", "");
-            leaf_str(o, "MappingInformationType", "ByPolygonVertex");
-            leaf_str(o, "ReferenceInformationType", "Direct");
-            leaf_array_as(o, "Normals", 'f', mesh->normals, 3 * (size_t)mesh->polygon_vertex_count);
-            end(o, 1);
-        }
-        if (mesh->uvs) {
-            begin(o, "LayerElementUV"); v_i64(o, 0, 'I'); values_end(o, 1);
-            leaf_i64(o, "Version", 101, 'I');
-            leaf_str(o, "Name", "map1");
-            leaf_str(o, "MappingInformationType", "ByPolygonVertex");
-            leaf_str(o, "ReferenceInformationType", "Direct");
-            leaf_array_as(o, "UV", 'f', mesh->uvs, 2 * (size_t)mesh->polygon_vertex_count);
-            end(o, 1);
-        }
+        if (mesh->normals)
+            layer_element(o, "LayerElementNormal", 102, "", "Normals", mesh->normals, 3 * (size_t)mesh->polygon_vertex_count);
+        if (mesh->uvs)
+            layer_element(o, "LayerElementUV", 101, "map1", "UV", mesh->uvs, 2 * (size_t)mesh->polygon_vertex_count);
         begin(o, "Layer"); v_i64(o, 0, 'I'); values_end(o, 1);
         leaf_i64(o, "Version", 100, 'I');
         end(o, 1);
         end(o, 1);
 
-        begin(o, "Model");
-        v_i64(o, model_id[m], 'L');
-        v_name(o, "Model", mesh->name);
-        v_str(o, "Mesh");
-        values_end(o, 1);
+        object_begin(o, "Model", model_id[m], "Model", mesh->name, "Mesh", 1);
         leaf_i64(o, "Version", 232, 'I');
         begin(o, "Properties70");
         values_end(o, 1);
@@ -635,22 +636,14 @@ static void write_scene(out *o, const fbxw_scene *sc)
 
         if (mesh->channel_count) {
             deformer_id[m] = new_id(&g);
-            begin(o, "Deformer");
-            v_i64(o, deformer_id[m], 'L');
-            v_name(o, "Deformer", mesh->name);
-            v_str(o, "BlendShape");
-            values_end(o, 1);
+            object_begin(o, "Deformer", deformer_id[m], "Deformer", mesh->name, "BlendShape", 1);
             leaf_i64(o, "Version", 100, 'I');
             end(o, 1);
         }
         for (uint32_t c = 0; c < mesh->channel_count; c++, ci++) {
             const fbxw_channel *ch = &mesh->channels[c];
             channel_id[ci] = new_id(&g);
-            begin(o, "Deformer");
-            v_i64(o, channel_id[ci], 'L');
-            v_name(o, "SubDeformer", ch->name);
-            v_str(o, "BlendShapeChannel");
-            values_end(o, 1);
+            object_begin(o, "Deformer", channel_id[ci], "SubDeformer", ch->name, "BlendShapeChannel", 1);
             leaf_i64(o, "Version", 100, 'I');
             if (!ch->deform_as_field_only) {
                 begin(o, "Properties70");
@@ -664,11 +657,7 @@ static void write_scene(out *o, const fbxw_scene *sc)
             for (uint32_t k = 0; k < ch->shape_count; k++, si++) {
                 const fbxw_shape *sh = &ch->shapes[k];
                 shape_id[si] = new_id(&g);
-                begin(o, "Geometry");
-                v_i64(o, shape_id[si], 'L');
-                v_name(o, "Geometry", sh->name);
-                v_str(o, "Shape");
-                values_end(o, 1);
+                object_begin(o, "Geometry", shape_id[si], "Geometry", sh->name, "Shape", 1);
                 leaf_i64(o, "Version", 100, 'I');
                 if (o->binary && o->type_mix) {
                     int64_t *wide = malloc(((size_t)sh->count + 1) * sizeof *wide);
@@ -690,11 +679,7 @@ static void write_scene(out *o, const fbxw_scene *sc)
                 animated = 1;
                 node_id[ci] = new_id(&g);
                 curve_id[ci] = new_id(&g);
-                begin(o, "AnimationCurveNode");
-                v_i64(o, node_id[ci], 'L');
-                v_name(o, "AnimCurveNode", "DeformPercent");
-                v_str(o, "");
-                values_end(o, 1);
+                object_begin(o, "AnimationCurveNode", node_id[ci], "AnimCurveNode", "DeformPercent", "", 1);
                 begin(o, "Properties70");
                 values_end(o, 1);
                 prop_begin(o, "d|DeformPercent", "Number", "", "A"); v_f64(o, ch->deform_percent); prop_end(o);
@@ -705,22 +690,14 @@ static void write_scene(out *o, const fbxw_scene *sc)
         }
     }
     if (animated) {
-        begin(o, "AnimationStack");
-        v_i64(o, stack_id, 'L');
-        v_name(o, "AnimStack", "Take 001");
-        v_str(o, "");
-        values_end(o, 1);
+        object_begin(o, "AnimationStack", stack_id, "AnimStack", "Take 001", "", 1);
         begin(o, "Properties70");
         values_end(o, 1);
         prop_begin(o, "LocalStart", "KTime", "Time", ""); v_i64(o, sc->stack_start, 'L'); prop_end(o);
         prop_begin(o, "LocalStop", "KTime", "Time", ""); v_i64(o, sc->stack_stop, 'L'); prop_end(o);
         end(o, 1);
         end(o, 1);
-        begin(o, "AnimationLayer");
-        v_i64(o, layer_id, 'L');
-        v_name(o, "AnimLayer", "BaseLayer");
-        v_str(o, "");
-        values_end(o, 0);
+        object_begin(o, "AnimationLayer", layer_id, "AnimLayer", "BaseLayer", "", 0);
         end(o, 0);
     }
     end(o, 1);
