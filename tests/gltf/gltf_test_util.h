@@ -37,6 +37,9 @@ void gt_to_world(const gt_model *m, uint32_t mesh, const float *local, uint32_t 
 void gt_check_case(const pb_manifest *manifest, const pb_case *c, gt_model *loaded, double *worst_pos,
                    double *worst_normal_deg, int *frames_done);
 
+/* n bytes as base64 (for data: URIs), malloc'ed; NULL when out of memory. */
+char *gt_base64(const unsigned char *in, size_t n);
+
 /* cJSON of a whole file (NULL when missing or malformed). */
 cJSON *gt_read_json(const char *path);
 

@@ -18,32 +18,17 @@
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
+#include "gltf_test_util.h"
 #include "gltf_accessor.h"
 #include "gltf_import.h"
 
 /* ---- documents ---- */
 
-static char *base64(const unsigned char *in, size_t n)
-{
-    static const char t[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    char *out = malloc(4 * (n / 3 + 1) + 1);
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
-        out[o++] = t[v >> 18 & 63];
-        out[o++] = t[v >> 12 & 63];
-        out[o++] = i + 1 < n ? t[v >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? t[v & 63] : '=';
-    }
-    out[o] = 0;
-    return out;
-}
-
 /* A glTF document: one buffer holding bin[0..n) as a data: URI, then `rest` (more top-level
  * members, starting with a comma: bufferViews, accessors, meshes...). */
 static char *gltf_text(const void *bin, size_t n, const char *rest)
 {
-    char *b64 = base64(bin, n);
+    char *b64 = gt_base64(bin, n);
     size_t len = strlen(b64) + strlen(rest) + 256;
     char *json = malloc(len);
     snprintf(json, len,

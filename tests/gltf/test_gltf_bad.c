@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include "check.h"
+#include "gltf_test_util.h"
 #include "gltf_import.h"
 #include "import.h"
 
@@ -43,20 +44,6 @@ static void fixture_default(fixture *f)
     f->interp = "LINEAR";
 }
 
-static void base64(const unsigned char *in, size_t n, char *out)
-{
-    static const char t[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
-        out[o++] = t[v >> 18 & 63];
-        out[o++] = t[v >> 12 & 63];
-        out[o++] = i + 1 < n ? t[v >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? t[v & 63] : '=';
-    }
-    out[o] = 0;
-}
-
 /* Layout: positions 0..36, target 36..72, indices 72..78 (+2 pad), times 80..80+4K, values after. */
 static char *fixture_json(const fixture *f)
 {
@@ -69,8 +56,7 @@ static char *fixture_json(const fixture *f)
     size_t vo = 80 + 4 * (size_t)f->keys;
     memcpy(bin + vo, f->values, 4 * (size_t)f->values_count);
     size_t total = vo + 4 * (size_t)f->values_count;
-    char b64[400];
-    base64(bin, total, b64);
+    char *b64 = gt_base64(bin, total);
     char *json = malloc(8192);
     snprintf(json, 8192,
         "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
@@ -87,7 +73,8 @@ static char *fixture_json(const fixture *f)
         "{\"bufferView\":2,\"byteOffset\":%d,\"componentType\":5126,\"count\":%d,\"type\":\"SCALAR\"}],"
         "\"animations\":[{\"name\":\"bounce\",\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"weights\"}}],"
         "\"samplers\":[{\"input\":3,\"output\":4,\"interpolation\":\"%s\"}]}]}",
-        total, b64, total - 80, f->keys, 4 * f->keys, f->values_count, f->interp);
+        total, b64 ? b64 : "", total - 80, f->keys, 4 * f->keys, f->values_count, f->interp);
+    free(b64);
     return json;
 }
 

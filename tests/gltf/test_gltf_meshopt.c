@@ -17,6 +17,7 @@
 #include <string.h>
 #include <meshoptimizer.h>
 #include "check.h"
+#include "gltf_test_util.h"
 #include "gltf_accessor.h"
 #include "gltf_import.h"
 #include "gltf_meshopt.h"
@@ -157,22 +158,6 @@ static void test_exponential(void)
 
 /* ---- the importer uses the filter ---- */
 
-static char *base64(const unsigned char *in, size_t n)
-{
-    static const char t[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    char *out = malloc(4 * (n / 3 + 1) + 1);
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
-        out[o++] = t[v >> 18 & 63];
-        out[o++] = t[v >> 12 & 63];
-        out[o++] = i + 1 < n ? t[v >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? t[v & 63] : '=';
-    }
-    out[o] = 0;
-    return out;
-}
-
 /* A triangle whose base NORMAL is a meshopt ATTRIBUTES view with the OCTAHEDRAL filter (the
  * stream encoded here with libmeshoptimizer's encoder): the raw normals are the hand-computed
  * filter outputs / 127. */
@@ -189,7 +174,7 @@ static void test_import_filtered_normals(void)
     if (48 + bound > sizeof bin) return;
     size_t clen = meshopt_encodeVertexBuffer(bin + 48, bound, oct, 3, 4);
     CHECK(clen > 0);
-    char *b64 = base64(bin, 48 + clen);
+    char *b64 = gt_base64(bin, 48 + clen);
     char *json = malloc(strlen(b64) + 4096);
     sprintf(json,
             "{\"asset\":{\"version\":\"2.0\"},"
