@@ -9,27 +9,9 @@ usage: test_cli_safety.py MORPHKIT MAKE_EXAMPLE   (corpus checks skip without th
 import base64, hashlib, json, os, stat, struct, subprocess, sys, tempfile, threading
 
 mk, make_example = sys.argv[1], sys.argv[2]
-root = os.environ.get("MORPHKIT_SOURCE_ROOT", os.path.join(os.path.dirname(__file__), "..", ".."))
-corpus = os.environ.get("MORPHKIT_CORPUS", os.path.join(root, "..", "shared", "corpus"))
-have_corpus = os.path.isfile(os.path.join(corpus, "cases.json"))
-work = tempfile.mkdtemp(prefix="mk_cli_safety_")
-passed = failed = skipped = 0
+from cli_check import check, corpus, finish, have_corpus, root, scratch, skip
 
-
-def check(name, cond, detail=""):
-    global passed, failed
-    if cond:
-        passed += 1
-        print("ok   " + name)
-    else:
-        failed += 1
-        print("FAIL " + name + ("\n     " + detail.replace("\n", "\n     ") if detail else ""))
-
-
-def skip(name, why):
-    global skipped
-    skipped += 1
-    print("skip " + name + ": " + why)
+work = scratch("mk_cli_safety_")
 
 
 def run(*args, stdin=None):
@@ -297,5 +279,4 @@ if os.path.exists("/usr/bin/script"):
 else:
     skip("progress on a terminal", "script(1) not found")
 
-print("%d passed, %d failed, %d skipped" % (passed, failed, skipped))
-sys.exit(1 if failed else 0)
+finish()

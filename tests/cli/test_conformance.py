@@ -11,20 +11,9 @@ usage: test_conformance.py MORPHKIT GOLDEN_CHECK MAKE_EXAMPLE"""
 import base64, json, math, os, random, shutil, struct, subprocess, sys, tempfile
 
 mk, golden_check, make_example = sys.argv[1], sys.argv[2], sys.argv[3]
-root = os.environ.get("MORPHKIT_SOURCE_ROOT", os.path.join(os.path.dirname(__file__), "..", ".."))
-corpus = os.environ.get("MORPHKIT_CORPUS", os.path.join(root, "..", "shared", "corpus"))
-work = tempfile.mkdtemp(prefix="mk_conformance_")
-passed = failed = skipped = 0
+from cli_check import check, corpus, finish, have_corpus, scratch, skip
 
-
-def check(name, cond, detail=""):
-    global passed, failed
-    if cond:
-        passed += 1
-        print("ok   " + name)
-    else:
-        failed += 1
-        print("FAIL " + name + ("\n     " + detail.replace("\n", "\n     ")[-1500:] if detail else ""))
+work = scratch("mk_conformance_")
 
 
 def run(*args):
@@ -53,15 +42,14 @@ sources = []
 ex = os.path.join(work, "example.morph")
 subprocess.run([make_example, ex], check=True, capture_output=True)
 sources.append(("example", ex))
-if os.path.isfile(os.path.join(corpus, "cases.json")):
+if have_corpus:
     seen = set()
     for case in json.load(open(os.path.join(corpus, "cases.json")))["cases"]:
         if case["source"] not in seen:
             seen.add(case["source"])
             sources.append((case["name"], os.path.join(corpus, case["source"])))
 else:
-    skipped += 1
-    print("skip corpus sources: corpus not found")
+    skip("corpus sources", "corpus not found")
 for i, (name, src) in enumerate(sources):
     out = os.path.join(work, "golden_%d" % i)
     modes = ["--stacking", "sequential", "--normals", "slerp"] if i % 3 == 1 else []
@@ -176,5 +164,4 @@ rc, o, e = run(mk, "conform", bad_manifest)
 check("a broken field is refused naming the case and the field", rc == 1 and "cases[0] 'x'.reference" in e and "space" in e, e)
 
 shutil.rmtree(work, ignore_errors=True)
-print("%d passed, %d failed, %d skipped" % (passed, failed, skipped))
-sys.exit(1 if failed else 0)
+finish()
