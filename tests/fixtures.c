@@ -1,4 +1,5 @@
 /* SPDX-License-Identifier: MIT */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -290,4 +291,65 @@ void *fixture_blob(const mk_raw_asset *raw, mk_precision precision, mk_arena *ar
         exit(2);
     }
     return blob;
+}
+
+void fixture_wavy_grid(mk_raw_asset *raw, uint32_t n, uint32_t targets)
+{
+    mk_raw_mesh *m = mk_raw_add_meshes(raw, 1);
+    m->name = "wavy";
+    m->vertex_count = m->control_point_count = n * n;
+    m->positions = mk_arena_array(&raw->arena, 3 * (size_t)n * n, sizeof(float));
+    m->normals = mk_arena_array(&raw->arena, 3 * (size_t)n * n, sizeof(float));
+    m->control_points = mk_arena_array(&raw->arena, (size_t)n * n, sizeof(uint32_t));
+    m->triangles = mk_arena_array(&raw->arena, 6 * (size_t)(n - 1) * (n - 1), sizeof(uint32_t));
+    for (uint32_t v = 0; v < n * n; v++) {
+        float x = (float)(v % n), y = (float)(v / n);
+        m->control_points[v] = v;
+        m->positions[3 * v] = x;
+        m->positions[3 * v + 1] = y;
+        m->positions[3 * v + 2] = 0.3f * sinf(0.7f * x) * cosf(0.4f * y);
+        m->normals[3 * v + 2] = 1;
+    }
+    uint32_t t = 0;
+    for (uint32_t y = 0; y + 1 < n; y++)
+        for (uint32_t x = 0; x + 1 < n; x++) {
+            uint32_t a = y * n + x, b = a + 1, c = a + n, d = c + 1, *tri = &m->triangles[6 * t++];
+            tri[0] = a; tri[1] = b; tri[2] = d; tri[3] = a; tri[4] = d; tri[5] = c;
+        }
+    m->triangle_count = 2 * t;
+    for (uint32_t k = 0; k < targets; k++) {
+        mk_raw_channel *ch = mk_raw_add_channels(raw, 1);
+        ch->name = "lift";
+        mk_raw_target *tg = mk_raw_add_targets(raw, ch, 1);
+        tg->name = "lift";
+        float cx = (float)((k * 7) % n), cy = (float)((k * 13) % n), r = 2.0f + (float)(k % 4);
+        tg->indices = mk_arena_array(&raw->arena, (size_t)n * n, sizeof(uint32_t));
+        tg->positions = mk_arena_array(&raw->arena, 3 * (size_t)n * n, sizeof(float));
+        for (uint32_t v = 0; v < n * n; v++) {
+            float dx = (float)(v % n) - cx, dy = (float)(v / n) - cy, q = dx * dx + dy * dy;
+            if (q >= r * r) continue;
+            tg->indices[tg->count] = v;
+            tg->positions[3 * tg->count + 2] = 0.5f * (1 - q / (r * r));
+            tg->positions[3 * tg->count] = 0.1f * dx;
+            tg->count++;
+        }
+    }
+}
+
+void fixture_brute_normal(const mk_raw_mesh *m, const float *pos, uint32_t cp, double out[3])
+{
+    double s[3] = { 0, 0, 0 };
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *tri = &m->triangles[3 * t];
+        int touches = 0;
+        for (int c = 0; c < 3; c++) touches |= (m->control_points ? m->control_points[tri[c]] : tri[c]) == cp;
+        if (!touches) continue;
+        const float *a = &pos[3 * tri[0]], *b = &pos[3 * tri[1]], *c = &pos[3 * tri[2]];
+        double e1[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] }, e2[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+        s[0] += e1[1] * e2[2] - e1[2] * e2[1];
+        s[1] += e1[2] * e2[0] - e1[0] * e2[2];
+        s[2] += e1[0] * e2[1] - e1[1] * e2[0];
+    }
+    double l = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    for (int d = 0; d < 3; d++) out[d] = s[d] / l;
 }

@@ -39,6 +39,17 @@ void fixture_line(mk_raw_asset *raw, uint32_t n, uint32_t channels, uint32_t str
  *   2 "blink" (start 0.5, 1 s): channel 4 constant (1 key), channel 2 linear (2 keys). */
 void fixture_rich(mk_raw_asset *raw);
 
+/* Mesh 0 "wavy": an n x n grid (spacing 1, height 0.3 sin(0.7 x) cos(0.4 y), base normals
+ * +z, one control point per vertex, 2 (n-1)^2 triangles) and `targets` single-target
+ * channels "lift", target k lifting a disc of radius 2 + k % 4 around (7k % n, 13k % n) by up
+ * to 0.5 (and pushing it outwards by 0.1 x the distance). */
+void fixture_wavy_grid(mk_raw_asset *raw, uint32_t n, uint32_t targets);
+
+/* Brute force: the normalized sum of the area-weighted normals (cross products) of every
+ * triangle touching control point cp (the vertex itself without control points), at
+ * positions pos (3 floats per render vertex). */
+void fixture_brute_normal(const mk_raw_mesh *m, const float *pos, uint32_t cp, double out[3]);
+
 /* Writes raw to a blob in arena (aborts the test program on failure). */
 void *fixture_blob(const mk_raw_asset *raw, mk_precision precision, mk_arena *arena, size_t *size);
 

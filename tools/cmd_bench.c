@@ -26,6 +26,7 @@
 #include "cli.h"
 #include "frame.h"
 #include "naive.h"
+#include "normal_quality.h"
 #include "synthetic.h"
 #include "timing.h"
 
@@ -73,7 +74,9 @@ const cli_verb cli_verb_bench = {
                    "prints it with ratios "
                    "against baselines measured in the same run: the memory-copy bound for the bytes a frame touches, "
                    "and a naive dense "
-                   "loop. Without FILE a synthetic asset is built (--vertices, --channels, --active, --density).",
+                   "loop. With FILE it also measures how far the evaluated normals are from the evaluated surface, per "
+                   "normal mode (docs/semantics.md, Normal quality). Without FILE a synthetic asset is built (--vertices, "
+                   "--channels, --active, --density).",
     .positional = "FILE",
     .positional_help = "An asset to play instead of the synthetic one (its first clip).",
     .positional_offset = offsetof(bench_args, file),
@@ -83,6 +86,35 @@ const cli_verb cli_verb_bench = {
     .args_size = sizeof(bench_args),
     .run = run_bench,
 };
+
+static const char *const quality_names[PB_QUALITY_MODES] = { "nlerp", "slerp", "base" };
+static const char *const quality_labels[PB_QUALITY_MODES] = { "nlerp", "slerp", "base normals kept" };
+
+/* Normal quality (playback/normal_quality.h) over up to 20 of the frames, evenly spread. */
+static mk_result measure_normals(const pb_asset *l, const float *weights, uint32_t frames,
+                                 pb_normal_stats out[PB_QUALITY_MODES], mk_error *err)
+{
+    const mk_asset *a = &l->asset;
+    mk_raw_asset read;
+    mk_raw_init(&read, NULL);
+    const mk_raw_asset *raw = &l->raw;
+    mk_result r = MK_OK;
+    if (l->raw.mesh_count == 0) {  /* a .morph input: its meshes read back */
+        r = mk_read_blob(a, &read, err);
+        raw = &read;
+    }
+    pb_normal_quality q;
+    memset(&q, 0, sizeof q);
+    uint32_t measured = frames < 20 ? frames : 20;
+    for (uint32_t k = 0; k < measured && r == MK_OK; k++) {
+        uint32_t f = measured > 1 ? (uint32_t)((uint64_t)k * (frames - 1) / (measured - 1)) : 0;
+        r = pb_normal_quality_add(&q, a, raw, weights + (size_t)f * a->channel_count, MK_STACKING_ASSET, err);
+    }
+    for (int m = 0; m < PB_QUALITY_MODES; m++) out[m] = pb_normal_quality_stats(&q, m);
+    pb_normal_quality_free(&q);
+    mk_raw_free(&read);
+    return r;
+}
 
 static int run_bench(void *p)
 {
@@ -213,12 +245,30 @@ static int run_bench(void *p)
     double diff = 0;
     cli_progress_update(&progress, "naive baseline", -1);
     double naive_ns = bench_naive_frames(&l, weights, frames < 20 ? frames : 20, &diff);
+    /* Normal quality (a file's normals are meant to match its surface; the synthetic asset's
+     * normal deltas are made up): up to 20 of the frames, evenly spread. */
+    pb_normal_stats quality[PB_QUALITY_MODES];
+    memset(quality, 0, sizeof quality);
+    if (file && !profile) {
+        cli_progress_update(&progress, "normal quality", -1);
+        if (measure_normals(&l, weights, frames, quality, &err) != MK_OK) {
+            fprintf(stderr, "morphkit bench: normal quality not measured: %s\n", err.message);
+            memset(quality, 0, sizeof quality);
+        }
+    }
 
     if (args->json) {
         printf("{\"ns_per_frame\": %.0f, \"ns_per_frame_positions\": %.0f, \"bytes_per_frame\": %.0f, "
                "\"bound_ns\": %.0f, \"ratio_to_bound\": %.3f, \"naive_ns\": %.0f, \"speedup_vs_naive\": %.2f, "
-               "\"sequential_over_additive\": %.3f}\n",
+               "\"sequential_over_additive\": %.3f",
                ns, ns_positions, bytes, bound_ns, bound_ns / ns, naive_ns, naive_ns / ns, ns_sequential / ns);
+        if (quality[0].count) {
+            printf(", \"normals_measured\": %zu", quality[0].count);
+            for (int k = 0; k < PB_QUALITY_MODES; k++)
+                printf(", \"normals_%s_mean_deg\": %.4f, \"normals_%s_p99_deg\": %.4f, \"normals_%s_max_deg\": %.4f",
+                       quality_names[k], quality[k].mean, quality_names[k], quality[k].p99, quality_names[k], quality[k].max);
+        }
+        printf("}\n");
     } else {
         uint32_t vertices = 0;
         for (uint32_t mi = 0; mi < a->mesh_count; mi++) {
@@ -238,6 +288,12 @@ static int run_bench(void *p)
         printf("naive_ns                 %12.0f  (dense float loop; max |difference| %.3g)\n", naive_ns, diff);
         printf("speedup_vs_naive         %12.2f\n", naive_ns / ns);
         printf("sequential_over_additive %12.3f\n", ns_sequential / ns);
+        if (quality[0].count) {
+            printf("normal error vs the evaluated surface (degrees over %zu moved vertex-frames: mean / p99 / max):\n",
+                   quality[0].count);
+            for (int k = 0; k < PB_QUALITY_MODES; k++)
+                printf("  %-22s %8.3f / %8.3f / %8.3f\n", quality_labels[k], quality[k].mean, quality[k].p99, quality[k].max);
+        }
         if (ns_one > 0) {
             printf("thread_scaling           %12.2f  (1 thread %.0f ns, %u threads %.0f ns; passes alternating)\n",
                    ns_one / ns, ns_one, thread_count, ns);

@@ -1,0 +1,49 @@
+/* SPDX-License-Identifier: MIT */
+/* How far evaluated normals are from the normals of the evaluated surface (docs/semantics.md,
+ * "Normal quality"). The reference of a vertex whose one-ring moved is
+ *     normalize(B + N(P) - N(P0)),
+ * B its authored base normal, N(P) the normal morphkit's importer computes for a surface
+ * (smoothing groups, area-weighted face normals) at the evaluated positions P, N(P0) the same
+ * at rest: the rule target normals are made with, applied to the combined shape. A single
+ * target at a full weight therefore has no error under nlerp; combinations and in-betweens
+ * show how far each normal mode is from the surface. Vertices whose one-ring did not move are
+ * not measured. */
+#ifndef MK_PB_NORMAL_QUALITY_H
+#define MK_PB_NORMAL_QUALITY_H
+
+#include "asset.h"
+#include "mesh_groups.h"
+
+/* The modes measured: the runtime's two, and base normals left as they are. */
+enum { PB_QUALITY_NLERP, PB_QUALITY_SLERP, PB_QUALITY_BASE, PB_QUALITY_MODES };
+
+/* Angles (degrees) collected over frames, per mode. */
+typedef struct pb_normal_quality {
+    double *angles[PB_QUALITY_MODES];
+    size_t count, capacity;            /* the same count for every mode */
+    uint32_t frames;
+} pb_normal_quality;
+
+typedef struct pb_normal_stats {
+    size_t count;                      /* vertex-frames measured */
+    double mean, p99, max;             /* degrees */
+} pb_normal_stats;
+
+/* Adds the moved vertices of every mesh with normals and triangles of `asset` (opened from
+ * `raw`, which holds its meshes in the same order: an import, or mk_read_blob of the blob)
+ * for asset-wide `weights`, evaluated with `stacking` (0 = the blob's). */
+mk_result pb_normal_quality_add(pb_normal_quality *q, const mk_asset *asset, const mk_raw_asset *raw,
+                                const float *weights, mk_stacking stacking, mk_error *err);
+
+/* Mean, 99th percentile and largest angle of one mode (zeros when nothing was measured). */
+pb_normal_stats pb_normal_quality_stats(const pb_normal_quality *q, int mode);
+
+void pb_normal_quality_free(pb_normal_quality *q);
+
+/* Reference normals (3 doubles per vertex) of mesh m at positions (3 floats per vertex), for
+ * the vertices whose one-ring moved (moved[v] = 1; the others get 0 and keep no reference).
+ * Returns the count of moved vertices, or -1 when out of memory. */
+long pb_reference_normals(const mk_raw_mesh *m, const mk_normal_groups *groups, const double *rest_normals,
+                          const float *positions, double *reference, unsigned char *moved, mk_arena *arena);
+
+#endif
