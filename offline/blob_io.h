@@ -22,6 +22,9 @@ typedef struct mk_write_options {
     uint32_t dense_threshold;
     /* Phases of the write (quantize, lay out blocks, assemble); may be NULL. */
     mk_phase_log *phases;
+    /* Threads for quantizing and laying out targets; 0 = one per core. The blob is the same
+     * for any count (nothing is allocated on the worker threads). */
+    uint32_t threads;
 } mk_write_options;
 
 typedef struct mk_write_report {

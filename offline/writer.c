@@ -18,6 +18,7 @@
 #include <string.h>
 #include "blob_io.h"
 #include "format.h"
+#include "parallel.h"
 
 typedef struct bytes {
     mk_arena *arena;
@@ -112,34 +113,44 @@ static float mesh_diagonal(const mk_raw_mesh *m)
 typedef struct target_plan {
     uint32_t flags;
     float position_scale, normal_scale, tangent_scale;
+    double tolerance;                  /* the mesh's */
+    double error[3];                   /* largest quantization error: positions, normals, tangents */
 } target_plan;
 
-static target_plan plan_target(const mk_raw_target *t, mk_precision precision, double tolerance,
-                               mk_write_report *report)
+/* Decides a target's storage: int16 with per-attribute scales when the positions' error stays
+ * within the tolerance, float32 otherwise (or when asked). */
+static void plan_target(const mk_raw_target *t, mk_precision precision, target_plan *p)
 {
-    target_plan p = { 0, 0, 0, 0 };
-    if (t->normals) p.flags |= MK_TARGET_HAS_NORMALS;
-    if (t->tangents) p.flags |= MK_TARGET_HAS_TANGENTS;
-    if (precision == MK_PRECISION_FLOAT) { report->float_targets++; return p; }
+    p->flags = (t->normals ? MK_TARGET_HAS_NORMALS : 0u) | (t->tangents ? MK_TARGET_HAS_TANGENTS : 0u);
+    if (precision == MK_PRECISION_FLOAT) return;
     size_t n = 3 * (size_t)t->count;
     float ps = quant_scale(max_abs(t->positions, n));
     double pe = quant_error(t->positions, n, ps);
-    if (pe > tolerance) { report->float_targets++; return p; }
-    p.flags |= MK_TARGET_QUANTIZED;
-    p.position_scale = ps;
-    if (pe > report->max_position_error) report->max_position_error = pe;
+    if (pe > p->tolerance) return;
+    p->flags |= MK_TARGET_QUANTIZED;
+    p->position_scale = ps;
+    p->error[0] = pe;
     if (t->normals) {
-        p.normal_scale = quant_scale(max_abs(t->normals, n));
-        double ne = quant_error(t->normals, n, p.normal_scale);
-        if (ne > report->max_normal_error) report->max_normal_error = ne;
+        p->normal_scale = quant_scale(max_abs(t->normals, n));
+        p->error[1] = quant_error(t->normals, n, p->normal_scale);
     }
     if (t->tangents) {
-        p.tangent_scale = quant_scale(max_abs(t->tangents, n));
-        double te = quant_error(t->tangents, n, p.tangent_scale);
-        if (te > report->max_tangent_error) report->max_tangent_error = te;
+        p->tangent_scale = quant_scale(max_abs(t->tangents, n));
+        p->error[2] = quant_error(t->tangents, n, p->tangent_scale);
     }
-    report->quantized_targets++;
-    return p;
+}
+
+typedef struct plan_loop {
+    const mk_raw_target **targets;
+    target_plan *plans;
+    mk_precision precision;
+} plan_loop;
+
+static void plan_item(void *user, uint32_t item, uint32_t worker)
+{
+    plan_loop *l = user;
+    (void)worker;
+    plan_target(l->targets[item], l->precision, &l->plans[item]);
 }
 
 /* Writes one attribute's xyz triples for the vertices of `mask` in block `block`, in bit order.
@@ -163,6 +174,96 @@ static void put_triples(uint8_t *dst, const mk_raw_target *t, const float *src, 
     }
 }
 
+/* One target's share of a mesh's block data. */
+typedef struct target_layout {
+    const mk_raw_target *t;
+    uint64_t entry_count, data_size;   /* counted first: blocks touched, bytes (entries 16-aligned) */
+    uint64_t first_entry, base;        /* then placed: its first entry, its data's offset */
+    uint64_t cursor;                   /* the entry merge's position */
+} target_layout;
+
+typedef struct layout_loop {
+    const mk_raw_mesh *m;
+    const target_plan *plans;
+    uint32_t dense_threshold;
+    target_layout *targets;
+    uint32_t *entry_block;             /* per entry, target-major */
+    uint64_t *entry_mask, *entry_data; /* the entry's vertices; its data's offset in the target data */
+    uint8_t *data;                     /* the mesh's target data */
+} layout_loop;
+
+/* Calls fn(user, block, mask) for each block a target touches, in block order; the mask has
+ * the moved vertices, or all the block's vertices when it is dense. */
+static void target_blocks(const layout_loop *l, const mk_raw_target *tg,
+                          void (*fn)(void *user, uint32_t block, uint32_t first, uint64_t mask), void *user)
+{
+    const uint32_t vertex_count = l->m->vertex_count;
+    for (uint32_t first = 0; first < tg->count;) {
+        uint32_t block = tg->indices[first] / MK_BLOCK_SIZE, start = block * MK_BLOCK_SIZE;
+        uint32_t in_block = vertex_count - start < MK_BLOCK_SIZE ? vertex_count - start : MK_BLOCK_SIZE;
+        uint64_t mask = 0;
+        uint32_t end = first;
+        while (end < tg->count && tg->indices[end] < start + in_block) mask |= 1ull << (tg->indices[end++] - start);
+        if (mk_popcount64(mask) >= l->dense_threshold) mask = in_block == 64 ? ~0ull : ((1ull << in_block) - 1);
+        fn(user, block, first, mask);
+        first = end;
+    }
+}
+
+typedef struct layout_item {
+    const layout_loop *l;
+    target_layout *tl;
+    uint32_t index;
+} layout_item;
+
+static void count_block(void *user, uint32_t block, uint32_t first, uint64_t mask)
+{
+    layout_item *it = user;
+    (void)block; (void)first;
+    uint64_t size = mk_entry_data_size(it->l->plans[it->index].flags, mk_popcount64(mask));
+    it->tl->data_size = pad16((size_t)it->tl->data_size) + size;
+    it->tl->entry_count++;
+}
+
+static void layout_count(void *user, uint32_t item, uint32_t worker)
+{
+    layout_loop *l = user;
+    (void)worker;
+    layout_item it = { l, &l->targets[item], item };
+    target_blocks(l, it.tl->t, count_block, &it);
+}
+
+static void write_block(void *user, uint32_t block, uint32_t first, uint64_t mask)
+{
+    layout_item *it = user;
+    const layout_loop *l = it->l;
+    target_layout *tl = it->tl;
+    const mk_raw_target *tg = tl->t;
+    const target_plan *p = &l->plans[it->index];
+    uint64_t e = tl->cursor++;
+    uint64_t at = pad16((size_t)tl->data_size), size = mk_entry_data_size(p->flags, mk_popcount64(mask));
+    tl->data_size = at + size;
+    l->entry_block[e] = block;
+    l->entry_mask[e] = mask;
+    l->entry_data[e] = tl->base + at;
+    int q = (p->flags & MK_TARGET_QUANTIZED) != 0;
+    size_t attr = (size_t)size / (1u + (tg->normals ? 1u : 0u) + (tg->tangents ? 1u : 0u));
+    uint8_t *dst = l->data + tl->base + at;
+    put_triples(dst, tg, tg->positions, first, mask, block, q, p->position_scale);
+    if (tg->normals) put_triples(dst += attr, tg, tg->normals, first, mask, block, q, p->normal_scale);
+    if (tg->tangents) put_triples(dst + attr, tg, tg->tangents, first, mask, block, q, p->tangent_scale);
+}
+
+static void layout_write(void *user, uint32_t item, uint32_t worker)
+{
+    layout_loop *l = user;
+    (void)worker;
+    layout_item it = { l, &l->targets[item], item };
+    it.tl->cursor = it.tl->first_entry;
+    it.tl->data_size = 0;
+    target_blocks(l, it.tl->t, write_block, &it);
+}
+
 typedef struct mesh_out {
     uint64_t positions, normals, tangents, triangles, control_points, block_entries, entries, target_data;
     uint64_t entry_count, target_data_size;
@@ -170,8 +271,8 @@ typedef struct mesh_out {
 
 /* Appends one mesh's arrays to data; offsets are relative to the data section. */
 static mk_result write_mesh_data(const mk_raw_asset *raw, uint32_t mi, uint32_t first_channel, uint32_t channel_count,
-                                 const target_plan *plans, uint32_t dense_threshold, bytes *data, mesh_out *out,
-                                 mk_write_report *report, mk_error *err)
+                                 const target_plan *plans, uint32_t dense_threshold, uint32_t threads, bytes *data,
+                                 mesh_out *out, mk_write_report *report, mk_error *err)
 {
     const mk_raw_mesh *m = &raw->meshes[mi];
     mk_arena *arena = data->arena;
@@ -185,97 +286,66 @@ static mk_result write_mesh_data(const mk_raw_asset *raw, uint32_t mi, uint32_t 
     uint32_t *cp = (uint32_t *)(void *)(data->data + out->control_points);
     for (uint32_t v = 0; v < m->vertex_count; v++) cp[v] = m->control_points ? m->control_points[v] : v;
 
-    /* Targets of the mesh in blob order, with a cursor each into its sorted indices. */
-    uint32_t target_count = 0;
-    for (uint32_t c = first_channel; c < first_channel + channel_count; c++) target_count += raw->channels[c].target_count;
-    const mk_raw_target **targets = mk_arena_array(arena, target_count + 1, sizeof *targets);
-    uint32_t *cursor = mk_arena_array(arena, target_count + 1, sizeof *cursor);
-    uint32_t blocks = (m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
-    uint32_t *block_first = mk_arena_array(arena, (size_t)blocks + 1, sizeof *block_first);
     /* Delta data is laid out target-major (all blocks of target 0, then target 1, ...) while
      * the entries stay block-major: a frame then reads each active target as one sequential
      * stream, which the hardware prefetcher and the TLB handle well, and never touches the
-     * pages of inactive targets. Each target's data goes to its own buffer first; entry data
-     * offsets are rebased once the buffers are concatenated. */
-    bytes *per_target = mk_arena_array(arena, target_count + 1, sizeof *per_target);
-    bytes entries = { arena, NULL, 0, 0, 0 }, offsets = { arena, NULL, 0, 0, 0 }; /* offsets: per entry, in its target's buffer */
-    if (!targets || !cursor || !block_first || !per_target) return mk_error_oom(err, "planning blocks");
-    for (uint32_t t = 0; t < target_count; t++) per_target[t].arena = arena;
+     * pages of inactive targets. Targets are independent: their sizes are counted, then their
+     * data written straight into the final buffer, both on worker threads (no allocation
+     * there); the entries are merged block by block afterwards. */
+    uint32_t target_count = 0;
+    for (uint32_t c = first_channel; c < first_channel + channel_count; c++) target_count += raw->channels[c].target_count;
+    uint32_t blocks = (m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
+    layout_loop l = { m, plans, dense_threshold, NULL, NULL, NULL, NULL, NULL };
+    l.targets = mk_arena_array(arena, target_count + 1, sizeof *l.targets);
+    uint32_t *block_first = mk_arena_array(arena, (size_t)blocks + 1, sizeof *block_first);
+    if (!l.targets || !block_first) return mk_error_oom(err, "planning blocks");
     uint32_t k = 0;
     for (uint32_t c = first_channel; c < first_channel + channel_count; c++)
-        for (uint32_t j = 0; j < raw->channels[c].target_count; j++) targets[k++] = &raw->channels[c].targets[j];
-
-    uint64_t entry_count = 0;
-    for (uint32_t b = 0; b < blocks; b++) {
-        block_first[b] = (uint32_t)entry_count;
-        uint32_t start = b * MK_BLOCK_SIZE;
-        uint32_t in_block = m->vertex_count - start < MK_BLOCK_SIZE ? m->vertex_count - start : MK_BLOCK_SIZE;
-        uint64_t all = in_block == 64 ? ~0ull : ((1ull << in_block) - 1);
-        for (uint32_t t = 0; t < target_count; t++) {
-            const mk_raw_target *tg = targets[t];
-            uint32_t first = cursor[t], end = first;
-            uint64_t mask = 0;
-            while (end < tg->count && tg->indices[end] < start + in_block) mask |= 1ull << (tg->indices[end++] - start);
-            cursor[t] = end;
-            if (!mask) continue;
-            uint32_t moved = mk_popcount64(mask);
-            if (moved >= dense_threshold) mask = all;
-            uint32_t count = mk_popcount64(mask);
-            const target_plan *p = &plans[t];
-            int q = (p->flags & MK_TARGET_QUANTIZED) != 0;
-            size_t size = (size_t)mk_entry_data_size(p->flags, count);
-            bytes *dst_buf = &per_target[t];
-            size_t at = bytes_put(dst_buf, NULL, size);
-            if (dst_buf->failed) return mk_error_oom(err, "writing target data");
-            size_t attr = size / (1u + (tg->normals ? 1u : 0u) + (tg->tangents ? 1u : 0u));
-            uint8_t *dst = dst_buf->data + at;
-            put_triples(dst, tg, tg->positions, first, mask, b, q, p->position_scale);
-            if (tg->normals) put_triples(dst += attr, tg, tg->normals, first, mask, b, q, p->normal_scale);
-            if (tg->tangents) put_triples(dst + attr, tg, tg->tangents, first, mask, b, q, p->tangent_scale);
-            /* data is filled in once the target buffers are concatenated (below). */
-            mk_blob_entry e = { t, 0, mask };
-            size_t e_at = entries.size;
-            uint64_t local = at;
-            if (!bytes_reserve(&entries, sizeof e) || !bytes_reserve(&offsets, sizeof local))
-                return mk_error_oom(err, "writing entries");
-            memcpy(entries.data + e_at, &e, sizeof e);
-            entries.size += sizeof e;
-            memcpy(offsets.data + offsets.size, &local, sizeof local);
-            offsets.size += sizeof local;
-            if (++entry_count > UINT32_MAX)
-                return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: more than 2^32 block entries", mi);
-        }
+        for (uint32_t j = 0; j < raw->channels[c].target_count; j++) l.targets[k++].t = &raw->channels[c].targets[j];
+    mk_parallel_for(target_count, threads, layout_count, &l);
+    uint64_t entry_count = 0, total = 0;
+    for (uint32_t t = 0; t < target_count; t++) {
+        l.targets[t].first_entry = entry_count;
+        l.targets[t].base = total;
+        entry_count += l.targets[t].entry_count;
+        total += pad16(l.targets[t].data_size);
     }
-    block_first[blocks] = (uint32_t)entry_count;
-    /* Concatenate the per-target buffers and rebase the entries. */
-    uint64_t *base = mk_arena_array(arena, target_count + 1, sizeof *base);
-    if (!base) return mk_error_oom(err, "writing target data");
-    uint64_t total = 0;
-    for (uint32_t t = 0; t < target_count; t++) { base[t] = total; total += pad16(per_target[t].size); }
+    if (entry_count > UINT32_MAX)
+        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: more than 2^32 block entries", mi);
     if (total / MK_ALIGN > UINT32_MAX)
         return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: target data exceeds 64 GiB", mi);
-    mk_blob_entry *all_entries = (mk_blob_entry *)(void *)entries.data;
-    const uint64_t *local_offsets = (const uint64_t *)(void *)offsets.data;
-    for (uint64_t e = 0; e < entry_count; e++)
-        all_entries[e].data = (uint32_t)((base[all_entries[e].target] + local_offsets[e]) / MK_ALIGN);
-    out->block_entries = bytes_put(data, block_first, 4u * ((size_t)blocks + 1));
-    out->entries = bytes_put(data, entries.data, entries.size);
+    /* Per target entry (target-major): its block, mask and data offset. */
+    l.entry_block = mk_arena_array(arena, entry_count + 1, sizeof *l.entry_block);
+    l.entry_mask = mk_arena_array(arena, entry_count + 1, sizeof *l.entry_mask);
+    l.entry_data = mk_arena_array(arena, entry_count + 1, sizeof *l.entry_data);
+    if (!l.entry_block || !l.entry_mask || !l.entry_data) return mk_error_oom(err, "planning blocks");
+    out->block_entries = bytes_put(data, NULL, 4u * ((size_t)blocks + 1));
+    out->entries = bytes_put(data, NULL, (size_t)entry_count * sizeof(mk_blob_entry));
     out->entry_count = entry_count;
     out->target_data = bytes_put(data, NULL, (size_t)total);
     out->target_data_size = total;
     if (data->failed) return mk_error_oom(err, "writing block data");
-    for (uint32_t t = 0; t < target_count; t++) {
-        if (per_target[t].size) memcpy(data->data + out->target_data + base[t], per_target[t].data, per_target[t].size);
-        mk_arena_release(arena, per_target[t].data);
+    l.data = data->data + out->target_data;
+    mk_parallel_for(target_count, threads, layout_write, &l);
+    /* Entries block-major, targets in blob order within a block. */
+    mk_blob_entry *entries = (mk_blob_entry *)(void *)(data->data + out->entries);
+    uint64_t e = 0;
+    for (uint32_t t = 0; t < target_count; t++) l.targets[t].cursor = l.targets[t].first_entry;
+    for (uint32_t b = 0; b < blocks; b++) {
+        block_first[b] = (uint32_t)e;
+        for (uint32_t t = 0; t < target_count; t++) {
+            target_layout *tl = &l.targets[t];
+            if (tl->cursor == tl->first_entry + tl->entry_count || l.entry_block[tl->cursor] != b) continue;
+            mk_blob_entry be = { t, (uint32_t)(l.entry_data[tl->cursor] / MK_ALIGN), l.entry_mask[tl->cursor] };
+            entries[e++] = be;
+            tl->cursor++;
+        }
     }
-    report->target_bytes += entries.size + total;
-    mk_arena_release(arena, entries.data);
-    mk_arena_release(arena, offsets.data);
-    mk_arena_release(arena, per_target);
-    mk_arena_release(arena, base);
-    mk_arena_release(arena, targets);
-    mk_arena_release(arena, cursor);
-    mk_arena_release(arena, block_first);
+    block_first[blocks] = (uint32_t)e;
+    memcpy(data->data + out->block_entries, block_first, 4u * ((size_t)blocks + 1));
+    report->target_bytes += entry_count * sizeof(mk_blob_entry) + total;
+    void *scratch[] = { l.targets, block_first, l.entry_block, l.entry_mask, l.entry_data };
+    for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
     return MK_OK;
 }
 
@@ -313,12 +383,35 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
         return mk_error_oom(err, "writing the blob tables");
     put_string(&strings, "");
 
-    /* Channels and targets, with per-target precision decided per mesh tolerance. */
+    /* Per-target precision under each mesh's tolerance, decided on worker threads. */
+    const mk_raw_target **all_targets = mk_arena_array(arena, target_count + 1, sizeof *all_targets);
+    if (!all_targets) return mk_error_oom(err, "writing the blob tables");
+    for (uint32_t mi = 0, c = 0, k = 0; mi < raw->mesh_count; mi++) {
+        double tolerance = opt.tolerance > 0 ? opt.tolerance : 1e-4 * mesh_diagonal(&raw->meshes[mi]);
+        if (tolerance > report.tolerance_used) report.tolerance_used = tolerance;
+        for (; c < raw->channel_count && raw->channels[c].mesh == mi; c++)
+            for (uint32_t j = 0; j < raw->channels[c].target_count; j++, k++) {
+                all_targets[k] = &raw->channels[c].targets[j];
+                memset(&plans[k], 0, sizeof plans[k]);
+                plans[k].tolerance = tolerance;
+            }
+    }
+    plan_loop pl = { all_targets, plans, opt.precision };
+    mk_parallel_for(target_count, opt.threads, plan_item, &pl);
+    mk_arena_release(arena, all_targets);
+    for (uint32_t k = 0; k < target_count; k++) {
+        if (!(plans[k].flags & MK_TARGET_QUANTIZED)) { report.float_targets++; continue; }
+        report.quantized_targets++;
+        if (plans[k].error[0] > report.max_position_error) report.max_position_error = plans[k].error[0];
+        if (plans[k].error[1] > report.max_normal_error) report.max_normal_error = plans[k].error[1];
+        if (plans[k].error[2] > report.max_tangent_error) report.max_tangent_error = plans[k].error[2];
+    }
+    mk_phase_log_mark(opt.phases, "quantize");
+
+    /* Channels and targets. */
     uint32_t t_index = 0;
     for (uint32_t mi = 0, c = 0; mi < raw->mesh_count; mi++) {
         const mk_raw_mesh *m = &raw->meshes[mi];
-        double tolerance = opt.tolerance > 0 ? opt.tolerance : 1e-4 * mesh_diagonal(m);
-        if (tolerance > report.tolerance_used) report.tolerance_used = tolerance;
         mk_blob_mesh *bm = &meshes[mi];
         bm->name = put_string(&strings, m->name);
         bm->first_channel = c;
@@ -334,7 +427,6 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
             bc->default_weight = ch->default_weight;
             for (uint32_t k = 0; k < ch->target_count; k++, t_index++) {
                 const mk_raw_target *t = &ch->targets[k];
-                plans[t_index] = plan_target(t, opt.precision, tolerance, &report);
                 mk_blob_target *bt = &targets[t_index];
                 bt->name = put_string(&strings, t->name);
                 bt->channel = c;
@@ -350,7 +442,7 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
         bm->target_count = t_index - bm->first_target;
         mk_phase_log_mark(opt.phases, "quantize");
         r = write_mesh_data(raw, mi, bm->first_channel, bm->channel_count, &plans[bm->first_target],
-                            opt.dense_threshold, &data, &mesh_data[mi], &report, err);
+                            opt.dense_threshold, opt.threads, &data, &mesh_data[mi], &report, err);
         mk_phase_log_mark(opt.phases, "lay out blocks");
         if (r) return r;
         bm->vertex_count = m->vertex_count;

@@ -39,8 +39,8 @@ static const cli_option options[] = {
     { "--timings", NULL, CLI_FLAG, offsetof(import_args, timings),
       "Print where the import's time and memory went, phase by phase (to standard error).", NULL, NULL, 0, 0, 0, 0 },
     { "--threads", "N", CLI_UINT, offsetof(import_args, threads),
-      "Threads for the parts of an import that run in parallel (target normals); 0 = one per core. The blob is the "
-      "same for any count.",
+      "Threads for the parts of an import that run in parallel (target normals, quantization, block layout); 0 = "
+      "one per core. The blob is the same for any count.",
       "0", NULL, 0, 64, 0, 0 },
     { "--depfile", "PATH", CLI_STRING, offsetof(import_args, depfile),
       "Also write a depfile for build systems (make syntax, as ninja and meson read it): the blob and every file the "
@@ -91,7 +91,8 @@ static int run_import(void *p)
                              .file_read = a->depfile ? cli_depfile_add : NULL, .file_read_user = &deps };
     if (a->stacking_given) io.stacking = a->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
     mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16,
-                            .tolerance = (float)a->tolerance, .phases = io.phases };
+                            .tolerance = (float)a->tolerance, .phases = io.phases,
+                            .threads = (uint32_t)a->threads };
     /* Progress only for inputs big enough to take a while. */
     struct stat st;
     cli_progress progress;

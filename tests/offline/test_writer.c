@@ -8,21 +8,29 @@
 #include "check.h"
 #include "fixtures.h"
 
+/* The same model gives the same bytes, whatever the thread count (targets are quantized and
+ * laid out on worker threads). */
 static void test_deterministic(void)
 {
-    for (int p = 0; p < 2; p++) {
-        mk_raw_asset a, b;
-        mk_raw_init(&a, NULL);
-        mk_raw_init(&b, NULL);
-        fixture_line(&a, 700, 9, 2);
-        fixture_line(&b, 700, 9, 2);
-        size_t sa, sb;
-        void *ba = fixture_blob(&a, (mk_precision)p, &a.arena, &sa);
-        void *bb = fixture_blob(&b, (mk_precision)p, &b.arena, &sb);
-        CHECK(sa == sb && memcmp(ba, bb, sa) == 0);
-        mk_raw_free(&a);
-        mk_raw_free(&b);
-    }
+    for (int p = 0; p < 2; p++)
+        for (int fixture = 0; fixture < 3; fixture++) {
+            mk_raw_asset raw[3];
+            void *blob[3];
+            size_t size[3];
+            for (int k = 0; k < 3; k++) {
+                mk_raw_init(&raw[k], NULL);
+                if (fixture == 0) fixture_line(&raw[k], 700, 9, 2);
+                else if (fixture == 1) fixture_rich(&raw[k]);
+                else fixture_wavy_grid(&raw[k], 40, 17);
+                mk_write_options wo = { .precision = (mk_precision)p, .threads = k == 0 ? 1u : k == 1 ? 1u : 5u };
+                mk_error err;
+                CHECK(mk_write_blob(&raw[k], &wo, &raw[k].arena, &blob[k], &size[k], NULL, &err) == MK_OK);
+            }
+            for (int k = 1; k < 3; k++)
+                CHECK_MSG(size[0] == size[k] && memcmp(blob[0], blob[k], size[0]) == 0,
+                          "fixture %d, precision %d: run %d (%s) differs", fixture, p, k, k == 1 ? "1 thread" : "5 threads");
+            for (int k = 0; k < 3; k++) mk_raw_free(&raw[k]);
+        }
 }
 
 static void test_round_trip_float(void)
