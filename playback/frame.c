@@ -48,6 +48,38 @@ mk_result pb_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weight
     return r;
 }
 
+mk_result pb_surface_normals(const mk_asset *asset, uint32_t mesh, const float *positions, float *normals, mk_error *err)
+{
+    size_t size = mk_surface_topology_size(asset, mesh), scratch_size = mk_surface_scratch_size(asset, mesh);
+    void *topology = size ? aligned_alloc(16, (size + 15) & ~(size_t)15) : NULL;
+    void *scratch = size ? aligned_alloc(16, (scratch_size + 15) & ~(size_t)15) : NULL;
+    if (size && (!topology || !scratch)) {
+        free(topology);
+        free(scratch);
+        return mk_error_oom(err, "surface topology");
+    }
+    mk_result r = mk_surface_topology_build(asset, mesh, topology, size, err);
+    mk_mesh_info m;
+    mk_mesh_get(asset, mesh, &m);
+    mk_surface_job job = {
+        .asset = asset,
+        .mesh = mesh,
+        .topology = topology,
+        .topology_size = size,
+        .positions = positions,
+        .positions_size = (size_t)m.vertex_count * 12,
+        .vertex_count = MK_VERTICES_TO_END,
+        .normals = normals,
+        .normals_size = (size_t)m.vertex_count * 12,
+        .scratch = scratch,
+        .scratch_size = scratch_size,
+    };
+    if (r == MK_OK) r = mk_surface_run(&job, err);
+    free(topology);
+    free(scratch);
+    return r;
+}
+
 void pb_channel_span(const mk_asset *asset, uint32_t channel, float w, int32_t *ia, float *ca, int32_t *ib, float *cb)
 {
     mk_channel_info ch;

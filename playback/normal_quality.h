@@ -14,8 +14,9 @@
 #include "asset.h"
 #include "mesh_groups.h"
 
-/* The modes measured: the runtime's two, and base normals left as they are. */
-enum { PB_QUALITY_NLERP, PB_QUALITY_SLERP, PB_QUALITY_BASE, PB_QUALITY_MODES };
+/* The modes measured: the runtime's nlerp and slerp, its surface normals (mk_surface_run), and
+ * base normals left as they are. */
+enum { PB_QUALITY_NLERP, PB_QUALITY_SLERP, PB_QUALITY_SURFACE, PB_QUALITY_BASE, PB_QUALITY_MODES };
 
 /* Angles (degrees) collected over frames, per mode. */
 typedef struct pb_normal_quality {

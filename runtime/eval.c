@@ -27,8 +27,9 @@
 #endif
 #include "format.h"
 #include "morphkit.h"
-#include "determinism.h"
 #include "error.h"
+#include "span.h"
+#include "determinism.h"
 
 /* ---- channel spans ---- */
 
@@ -101,15 +102,6 @@ size_t mk_eval_scratch_size(const mk_asset *asset, uint32_t mesh)
 
 /* ---- validation ---- */
 
-static int span_ok(const void *p, size_t stride, size_t size, uint32_t count, size_t elem)
-{
-    if ((uintptr_t)p % 4 || stride % 4 || stride < elem) return 0;
-    if (count == 0) return 1;
-    return (count - 1) <= (SIZE_MAX - elem) / stride && size >= stride * (count - 1) + elem;
-}
-
-static size_t stride_or(size_t stride, size_t fallback) { return stride ? stride : fallback; }
-
 static uint32_t job_vertex_count(const mk_eval_job *job)
 {
     const mk_blob_mesh *m = &job->asset->meshes[job->mesh];
@@ -143,18 +135,18 @@ mk_result mk_eval_validate(const mk_eval_job *job, mk_error *err)
         return mk_error_fail(err, MK_ERROR_BUFFER_TOO_SMALL, MK_NO_OFFSET, "eval job: scratch is smaller than mk_eval_scratch_size()");
     uint32_t n = job_vertex_count(job);
     if (!job->positions) return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: positions output is NULL");
-    if (!span_ok(job->positions, stride_or(job->positions_stride, 12), job->positions_size, n, 12))
+    if (!mk_span_ok(job->positions, mk_stride_or(job->positions_stride, 12), job->positions_size, n, 12))
         return mk_error_fail(err, MK_ERROR_BUFFER_TOO_SMALL, MK_NO_OFFSET, "eval job: positions span is too small or misaligned");
     if (job->normals) {
         if (!(m->flags & MK_MESH_HAS_NORMALS))
             return mk_error_fail(err, MK_ERROR_UNSUPPORTED, MK_NO_OFFSET, "eval job: normals requested but the mesh has no normals");
-        if (!span_ok(job->normals, stride_or(job->normals_stride, 12), job->normals_size, n, 12))
+        if (!mk_span_ok(job->normals, mk_stride_or(job->normals_stride, 12), job->normals_size, n, 12))
             return mk_error_fail(err, MK_ERROR_BUFFER_TOO_SMALL, MK_NO_OFFSET, "eval job: normals span is too small or misaligned");
     }
     if (job->tangents) {
         if (!(m->flags & MK_MESH_HAS_TANGENTS))
             return mk_error_fail(err, MK_ERROR_UNSUPPORTED, MK_NO_OFFSET, "eval job: tangents requested but the mesh has no tangents");
-        if (!span_ok(job->tangents, stride_or(job->tangents_stride, 16), job->tangents_size, n, 16))
+        if (!mk_span_ok(job->tangents, mk_stride_or(job->tangents_stride, 16), job->tangents_size, n, 16))
             return mk_error_fail(err, MK_ERROR_BUFFER_TOO_SMALL, MK_NO_OFFSET, "eval job: tangents span is too small or misaligned");
     }
     return MK_OK;
@@ -433,8 +425,8 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
     const uint32_t *block_first = (const uint32_t *)(a->data + m->block_entries);
     const mk_blob_entry *entries = (const mk_blob_entry *)(a->data + m->entries);
     const uint8_t *data = a->data + m->target_data;
-    const size_t ps = stride_or(job->positions_stride, 12), ns = stride_or(job->normals_stride, 12),
-                 ts = stride_or(job->tangents_stride, 16);
+    const size_t ps = mk_stride_or(job->positions_stride, 12), ns = mk_stride_or(job->normals_stride, 12),
+                 ts = mk_stride_or(job->tangents_stride, 16);
 
     const int stream = job_streams(job);
     block_acc acc_p, acc_n, acc_t, slerp_a, slerp_b;

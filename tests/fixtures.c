@@ -336,13 +336,19 @@ void fixture_wavy_grid(mk_raw_asset *raw, uint32_t n, uint32_t targets)
     }
 }
 
-void fixture_brute_normal(const mk_raw_mesh *m, const float *pos, uint32_t cp, double out[3])
+void fixture_brute_normal(const mk_raw_mesh *m, const float *pos, uint32_t v, int split_by_normal, double out[3])
 {
     double s[3] = { 0, 0, 0 };
+    const uint32_t key = m->control_points ? m->control_points[v] : v;
     for (uint32_t t = 0; t < m->triangle_count; t++) {
         const uint32_t *tri = &m->triangles[3 * t];
         int touches = 0;
-        for (int c = 0; c < 3; c++) touches |= (m->control_points ? m->control_points[tri[c]] : tri[c]) == cp;
+        for (int c = 0; c < 3; c++) {
+            int same = (m->control_points ? m->control_points[tri[c]] : tri[c]) == key;
+            if (same && split_by_normal)
+                for (int d = 0; d < 3; d++) same &= fabsf(m->normals[3 * tri[c] + (uint32_t)d] - m->normals[3 * v + (uint32_t)d]) <= 1e-5f;
+            touches |= same;
+        }
         if (!touches) continue;
         const float *a = &pos[3 * tri[0]], *b = &pos[3 * tri[1]], *c = &pos[3 * tri[2]];
         double e1[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] }, e2[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };

@@ -46,9 +46,10 @@ void fixture_rich(mk_raw_asset *raw);
 void fixture_wavy_grid(mk_raw_asset *raw, uint32_t n, uint32_t targets);
 
 /* Brute force: the normalized sum of the area-weighted normals (cross products) of every
- * triangle touching control point cp (the vertex itself without control points), at
- * positions pos (3 floats per render vertex). */
-void fixture_brute_normal(const mk_raw_mesh *m, const float *pos, uint32_t cp, double out[3]);
+ * triangle with a corner in v's group, at positions pos (3 floats per render vertex). The
+ * group: the vertices with v's control point (v alone without control points), and, with
+ * split_by_normal, v's base normal within 1e-5 per component. */
+void fixture_brute_normal(const mk_raw_mesh *m, const float *pos, uint32_t v, int split_by_normal, double out[3]);
 
 /* Writes raw to a blob in arena (aborts the test program on failure). */
 void *fixture_blob(const mk_raw_asset *raw, mk_precision precision, mk_arena *arena, size_t *size);

@@ -27,6 +27,7 @@
 #include "frame.h"
 #include "naive.h"
 #include "normal_quality.h"
+#include "surface.h"
 #include "synthetic.h"
 #include "timing.h"
 
@@ -87,8 +88,8 @@ const cli_verb cli_verb_bench = {
     .run = run_bench,
 };
 
-static const char *const quality_names[PB_QUALITY_MODES] = { "nlerp", "slerp", "base" };
-static const char *const quality_labels[PB_QUALITY_MODES] = { "nlerp", "slerp", "base normals kept" };
+static const char *const quality_names[PB_QUALITY_MODES] = { "nlerp", "slerp", "surface", "base" };
+static const char *const quality_labels[PB_QUALITY_MODES] = { "nlerp", "slerp", "surface", "base normals kept" };
 
 /* Normal quality (playback/normal_quality.h) over up to 20 of the frames, evenly spread. */
 static mk_result measure_normals(const pb_asset *l, const float *weights, uint32_t frames,
@@ -249,7 +250,10 @@ static int run_bench(void *p)
      * normal deltas are made up): up to 20 of the frames, evenly spread. */
     pb_normal_stats quality[PB_QUALITY_MODES];
     memset(quality, 0, sizeof quality);
+    double ns_surface_nlerp = 0, ns_surface = 0;
     if (file && !profile) {
+        cli_progress_update(&progress, "surface normals", -1);
+        bench_surface_frames(&l, weights, frames < 20 ? frames : 20, &ns_surface_nlerp, &ns_surface);
         cli_progress_update(&progress, "normal quality", -1);
         if (measure_normals(&l, weights, frames, quality, &err) != MK_OK) {
             fprintf(stderr, "morphkit bench: normal quality not measured: %s\n", err.message);
@@ -268,6 +272,9 @@ static int run_bench(void *p)
                 printf(", \"normals_%s_mean_deg\": %.4f, \"normals_%s_p99_deg\": %.4f, \"normals_%s_max_deg\": %.4f",
                        quality_names[k], quality[k].mean, quality_names[k], quality[k].p99, quality_names[k], quality[k].max);
         }
+        if (ns_surface > 0)
+            printf(", \"ns_per_frame_surface\": %.0f, \"surface_over_nlerp\": %.3f", ns_surface,
+                   ns_surface / ns_surface_nlerp);
         printf("}\n");
     } else {
         uint32_t vertices = 0;
@@ -288,11 +295,15 @@ static int run_bench(void *p)
         printf("naive_ns                 %12.0f  (dense float loop; max |difference| %.3g)\n", naive_ns, diff);
         printf("speedup_vs_naive         %12.2f\n", naive_ns / ns);
         printf("sequential_over_additive %12.3f\n", ns_sequential / ns);
+        if (ns_surface > 0)
+            printf("surface_over_nlerp       %12.3f  (positions + surface normals %.0f ns, positions + nlerp %.0f ns; "
+                   "one thread, alternating)\n",
+                   ns_surface / ns_surface_nlerp, ns_surface, ns_surface_nlerp);
         if (quality[0].count) {
             printf("normal error vs the evaluated surface (degrees over %zu moved vertex-frames: mean / p99 / max):\n",
                    quality[0].count);
             for (int k = 0; k < PB_QUALITY_MODES; k++)
-                printf("  %-22s %8.3f / %8.3f / %8.3f\n", quality_labels[k], quality[k].mean, quality[k].p99, quality[k].max);
+                printf("  %-22s %9.4f / %9.4f / %9.4f\n", quality_labels[k], quality[k].mean, quality[k].p99, quality[k].max);
         }
         if (ns_one > 0) {
             printf("thread_scaling           %12.2f  (1 thread %.0f ns, %u threads %.0f ns; passes alternating)\n",

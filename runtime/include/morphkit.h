@@ -255,6 +255,55 @@ mk_result mk_eval_run(const mk_eval_job *job, mk_error *err);
  * budgeting memory bandwidth; it uses the job's scratch. */
 uint64_t mk_eval_traffic(const mk_eval_job *job);
 
+/* ---- Surface normals ---- */
+
+/* Normals of the evaluated surface (docs/semantics.md, "Surface normals"): for every vertex
+ * whose smoothing group has a triangle with a moved corner, n = normalize(B + N(P) - N(P0)),
+ * N the normalized sum of the group's area-weighted face normals at the evaluated positions P
+ * and at rest P0, B the stored base normal; every other vertex keeps B as stored. The exact
+ * counterpart of nlerp/slerp where shapes combine, at the cost of one pass over the triangles
+ * around moved vertices. Smoothing groups are the importer's: vertices with the same control
+ * point and the same base normal (within 1e-5 per component), so UV seams stay smooth and hard
+ * edges hard.
+ *
+ * Two steps an engine runs per frame: evaluate the positions of the whole mesh (mk_eval_run,
+ * any split into ranges), then this job over any ranges, reading those positions (a vertex's
+ * normal needs the positions around it). It allocates nothing: the mesh's topology is built
+ * once into caller memory (mk_surface_topology_size bytes, 16-byte aligned) by
+ * mk_surface_topology_build, and read-only afterwards (share it between threads). Every
+ * vertex's result is the same whichever range computes it. */
+
+/* Bytes of a mesh's surface topology; 0 when the mesh has no normals or no triangles (or the
+ * mesh index is invalid). */
+size_t mk_surface_topology_size(const mk_asset *asset, uint32_t mesh);
+mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *topology, size_t size, mk_error *err);
+
+typedef struct mk_surface_job {
+    const mk_asset *asset;
+    uint32_t mesh;
+    const void *topology;         /* built by mk_surface_topology_build for this mesh */
+    size_t topology_size;
+    const float *positions;       /* evaluated positions of the whole mesh, from vertex 0 */
+    size_t positions_stride;      /* bytes between vertices; 0 means 12 */
+    size_t positions_size;        /* bytes available at positions */
+    uint32_t first_vertex;        /* output range, as in mk_eval_job */
+    uint32_t vertex_count;        /* 0: none; MK_VERTICES_TO_END: the rest of the mesh */
+    float *normals;               /* output (addresses first_vertex): 3 floats per vertex */
+    size_t normals_stride, normals_size;
+    float *tangents;              /* optional output: the base tangent re-orthogonalized against
+                                   * the new normal, w copied from the base; base where unmoved */
+    size_t tangents_stride, tangents_size;
+    void *scratch;                /* mk_surface_scratch_size() bytes, 16-byte aligned, one per
+                                   * thread (no initialization needed) */
+    size_t scratch_size;
+} mk_surface_job;
+
+/* Scratch bytes of a surface job on this mesh (0 when it has no topology). */
+size_t mk_surface_scratch_size(const mk_asset *asset, uint32_t mesh);
+
+mk_result mk_surface_validate(const mk_surface_job *job, mk_error *err);
+mk_result mk_surface_run(const mk_surface_job *job, mk_error *err);
+
 /* ---- Clip sampling job ---- */
 
 /* Time in, one weight per asset channel out. Channels the clip does not animate get their

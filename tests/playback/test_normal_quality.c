@@ -33,7 +33,7 @@ static void test_reference_is_the_recomputed_surface(void)
     mk_normal_groups g;
     mk_error err;
     CHECK(mk_normal_groups_build(m, MK_GROUP_BY_CONTROL_POINT, &raw.arena, &g, &err) == MK_OK);
-    for (uint32_t v = 0; v < n; v++) fixture_brute_normal(m, m->positions, v, &rest[3 * v]);
+    for (uint32_t v = 0; v < n; v++) fixture_brute_normal(m, m->positions, v, 0, &rest[3 * v]);
     long count = pb_reference_normals(m, &g, rest, p, ref, moved, &raw.arena);
     long expected = 0;
     uint32_t wrong_flag = 0;
@@ -43,7 +43,7 @@ static void test_reference_is_the_recomputed_surface(void)
         wrong_flag += moved[v] != expect_moved[v];
         if (!moved[v]) continue;
         double np[3], r[3], len = 0, dot = 0;
-        fixture_brute_normal(m, p, v, np);
+        fixture_brute_normal(m, p, v, 0, np);
         for (int d = 0; d < 3; d++) { r[d] = m->normals[3 * v + (uint32_t)d] + np[d] - rest[3 * v + (uint32_t)d]; len += r[d] * r[d]; }
         for (int d = 0; d < 3; d++) dot += r[d] / sqrt(len) * ref[3 * v + (uint32_t)d];
         double angle = acos(fmin(1.0, dot)) * 180 / 3.14159265358979;

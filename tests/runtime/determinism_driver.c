@@ -2,7 +2,7 @@
 /* Prints one hash of everything the runtime computes for the given blobs: every clip sampled at
  * 17 times, and 8 weight sets per mesh (weights in [-1.5, 2.5], crossing in-betweens) evaluated
  * with both stackings and both normal modes, positions, normals and tangents, over the whole
- * mesh and a range starting mid-block. The flag-matrix test builds this and the runtime with
+ * mesh and a range starting mid-block, and surface normals and tangents from those positions. The flag-matrix test builds this and the runtime with
  * many compilers and flags and expects the same hash from every build.
  * usage: determinism_driver BLOB...   (runtime only: libc and morphkit.h) */
 #include <stdint.h>
@@ -63,6 +63,14 @@ int main(int argc, char **argv)
             float *out = calloc(n * 10 + 4, sizeof(float));
             size_t scratch_size = mk_eval_scratch_size(&a, mi);
             void *scratch = aligned_alloc(16, (scratch_size + 31) / 16 * 16);
+            size_t topology_size = mk_surface_topology_size(&a, mi);
+            void *topology = topology_size ? aligned_alloc(16, (topology_size + 15) / 16 * 16) : NULL;
+            size_t surface_scratch_size = mk_surface_scratch_size(&a, mi);
+            void *surface_scratch = topology_size ? aligned_alloc(16, (surface_scratch_size + 15) / 16 * 16) : NULL;
+            if (topology && mk_surface_topology_build(&a, mi, topology, topology_size, &err) != MK_OK) {
+                fprintf(stderr, "%s\n", err.message);
+                return 1;
+            }
             for (int set = 0; set < 8; set++) {
                 for (uint32_t c = 0; c < m.channel_count; c++) {
                     rng ^= rng << 13; rng ^= rng >> 7; rng ^= rng << 17;
@@ -85,10 +93,33 @@ int main(int argc, char **argv)
                         memset(out, 0, 40 * n);
                         if (mk_eval_run(&j, &err) != MK_OK) { fprintf(stderr, "%s\n", err.message); return 1; }
                         h = fnv(h, out, 40 * (n - first));
+                        /* Surface normals (and tangents) from the whole mesh's positions, two ranges. */
+                        if (range == 0 && topology) {
+                            float *sn = calloc(n * 7 + 4, sizeof(float));
+                            for (int part = 0; part < 2; part++) {
+                                uint32_t from = part ? (uint32_t)(n / 3) | 1u : 0;
+                                if (from >= n) continue;
+                                mk_surface_job sj = {
+                                    .asset = &a, .mesh = mi, .topology = topology, .topology_size = topology_size,
+                                    .positions = out, .positions_stride = 40, .positions_size = 40 * n,
+                                    .first_vertex = from, .vertex_count = part ? MK_VERTICES_TO_END : (uint32_t)(n / 3) | 1u,
+                                    .normals = sn + 3 * (size_t)from, .normals_size = 12 * (n - from),
+                                    .tangents = m.has_tangents ? sn + 3 * n + 4 * (size_t)from : NULL,
+                                    .tangents_size = 16 * (n - from),
+                                    .scratch = surface_scratch, .scratch_size = surface_scratch_size,
+                                };
+                                if (sj.vertex_count != MK_VERTICES_TO_END && sj.vertex_count > n) sj.vertex_count = (uint32_t)n;
+                                if (mk_surface_run(&sj, &err) != MK_OK) { fprintf(stderr, "%s\n", err.message); return 1; }
+                            }
+                            h = fnv(h, sn, 28 * n);
+                            free(sn);
+                        }
                     }
             }
             free(out);
             free(scratch);
+            free(topology);
+            free(surface_scratch);
         }
         free(w);
         free(blob);

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The runtime never allocates: open, sample and evaluate (every mode) under a malloc hook
+/* The runtime never allocates: open, sample, evaluate (every mode) and surface normals under a malloc hook
  * that counts calls. The hook replaces the allocator for this test program only; under
  * AddressSanitizer (which owns malloc) the case reports itself skipped, and the symbol check
  * (check_runtime_symbols.sh) covers that the runtime references no allocator at all. */
@@ -42,7 +42,7 @@ static void test_runtime_allocates_nothing(void)
     size_t size;
     void *blob = fixture_blob(&raw, MK_PRECISION_Q16, &raw.arena, &size);
     static float w[5], p[64], n[64], t[64];
-    static _Alignas(16) unsigned char scratch[1024];
+    static _Alignas(16) unsigned char scratch[1024], topology[2048], surface_scratch[1024];
     mk_asset a;
     mk_error err;
     uint32_t cursors[2] = { 0, 0 };
@@ -58,8 +58,16 @@ static void test_runtime_allocates_nothing(void)
                           .scratch = scratch, .scratch_size = sizeof scratch, .positions = p, .positions_size = sizeof p,
                           .normals = n, .normals_size = sizeof n, .tangents = t, .tangents_size = sizeof t };
         ok &= mk_eval_run(&j, &err) == MK_OK;
+        mk_surface_job sj = { .asset = &a, .mesh = 0, .topology = topology, .topology_size = sizeof topology,
+                              .positions = p, .positions_size = sizeof p, .vertex_count = MK_VERTICES_TO_END,
+                              .normals = n, .normals_size = sizeof n, .tangents = t, .tangents_size = sizeof t,
+                              .scratch = surface_scratch, .scratch_size = sizeof surface_scratch };
+        ok &= (frame == 0 ? mk_surface_topology_build(&a, 0, topology, sizeof topology, &err) : MK_OK) == MK_OK;
+        ok &= mk_surface_run(&sj, &err) == MK_OK;
         j.weights = NULL;                      /* error paths must not allocate either */
         ok &= mk_eval_run(&j, &err) != MK_OK;
+        sj.topology_size = 8;
+        ok &= mk_surface_run(&sj, &err) != MK_OK;
     }
     counting = 0;
     CHECK(ok);
