@@ -34,20 +34,27 @@ static mk_raw_channel *add_channel(mk_raw_asset *raw, uint32_t mesh, const char 
     return ch;
 }
 
+/* The unit quad (0,0,0) (1,0,0) (0,1,0) (1,1,0): normals +z, tangents +x (w 1; the last
+ * vertex's w is last_w), two triangles. */
+static void fill_quad(mk_raw_asset *raw, mk_raw_mesh *m, const char *name, float last_w)
+{
+    static const float p[] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0 };
+    static const float n[] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1 };
+    static const uint32_t tri[] = { 0, 1, 3, 0, 3, 2 };
+    float t[] = { 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, last_w };
+    m->name = mk_arena_strdup(&raw->arena, name);
+    m->vertex_count = 4;
+    m->positions = dup_array(raw, p, sizeof p);
+    m->normals = dup_array(raw, n, sizeof n);
+    m->tangents = dup_array(raw, t, sizeof t);
+    m->triangle_count = 2;
+    m->triangles = dup_array(raw, tri, sizeof tri);
+}
+
 void fixture_basic(mk_raw_asset *raw)
 {
     mk_raw_mesh *m = mk_raw_add_meshes(raw, 2);
-    static const float quad_p[] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0 };
-    static const float quad_n[] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1 };
-    static const float quad_t[] = { 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1 };
-    static const uint32_t quad_tri[] = { 0, 1, 3, 0, 3, 2 };
-    m[0].name = mk_arena_strdup(&raw->arena, "quad");
-    m[0].vertex_count = 4;
-    m[0].positions = dup_array(raw, quad_p, sizeof quad_p);
-    m[0].normals = dup_array(raw, quad_n, sizeof quad_n);
-    m[0].tangents = dup_array(raw, quad_t, sizeof quad_t);
-    m[0].triangle_count = 2;
-    m[0].triangles = dup_array(raw, quad_tri, sizeof quad_tri);
+    fill_quad(raw, &m[0], "quad", 1);
     static const float tri_p[] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
     static const uint32_t tri_i[] = { 0, 1, 2 };
     m = &raw->meshes[1];
@@ -106,17 +113,8 @@ static mk_raw_track make_track(mk_raw_asset *raw, uint32_t channel, uint32_t key
 void fixture_rich(mk_raw_asset *raw)
 {
     mk_raw_mesh *m = mk_raw_add_meshes(raw, 4);
-    static const float quad_p[] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0 };
-    static const float quad_n[] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1 };
-    static const float quad_t[] = { 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, -1 };
-    static const uint32_t quad_tri[] = { 0, 1, 3, 0, 3, 2 }, quad_cp[] = { 0, 1, 2, 2 };
-    m[0].name = mk_arena_strdup(&raw->arena, "face");
-    m[0].vertex_count = 4;
-    m[0].positions = dup_array(raw, quad_p, sizeof quad_p);
-    m[0].normals = dup_array(raw, quad_n, sizeof quad_n);
-    m[0].tangents = dup_array(raw, quad_t, sizeof quad_t);
-    m[0].triangle_count = 2;
-    m[0].triangles = dup_array(raw, quad_tri, sizeof quad_tri);
+    static const uint32_t quad_cp[] = { 0, 1, 2, 2 };
+    fill_quad(raw, &m[0], "face", -1);
     m[0].control_point_count = 3;
     m[0].control_points = dup_array(raw, quad_cp, sizeof quad_cp);
     mk_mat4_identity(m[0].world);
