@@ -143,6 +143,18 @@ static mk_result finish(fbx_doc *doc, mk_raw_asset *raw, const char *path, const
     return MK_OK;
 }
 
+
+/* Stores a key's tangents; the next key's left tangent becomes the current one. */
+static void put_tangents(dkey *key, double *slope_left, double *weight_left, double right_slope, double right_weight,
+                         double next_slope_left, double next_weight_left)
+{
+    key->left_slope = *slope_left;
+    key->left_weight = *weight_left;
+    key->right_slope = right_slope;
+    key->right_weight = right_weight;
+    *slope_left = next_slope_left;
+    *weight_left = next_weight_left;
+}
 mk_result fbx_convert_curve(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *curve, double ticks_per_second,
                             double scale, mk_key **out_keys, uint32_t *out_count)
 {
@@ -261,12 +273,7 @@ mk_result fbx_convert_curve(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *cur
             right_weight = next_weight_left = THIRD;
             right_slope = next_slope_left = next_t > t ? (next_v - v) / (next_t - t) : 0.0;
         }
-        key->left_slope = slope_left;
-        key->left_weight = weight_left;
-        key->right_slope = right_slope;
-        key->right_weight = right_weight;
-        slope_left = next_slope_left;
-        weight_left = next_weight_left;
+        put_tangents(key, &slope_left, &weight_left, right_slope, right_weight, next_slope_left, next_weight_left);
         prev_time = t;
     }
     r = finish(doc, raw, path, k, n, scale, out_keys, out_count);
@@ -413,12 +420,7 @@ mk_result fbx_convert_legacy_curve(fbx_doc *doc, mk_raw_asset *raw, const fbx_no
             right_slope = next_slope_left = next_t > t ? (next_v - v) / (next_t - t) : 0.0;
         key->time = t;
         key->value = v;
-        key->left_slope = slope_left;
-        key->left_weight = weight_left;
-        key->right_slope = right_slope;
-        key->right_weight = right_weight;
-        slope_left = next_slope_left;
-        weight_left = next_weight_left;
+        put_tangents(key, &slope_left, &weight_left, right_slope, right_weight, next_slope_left, next_weight_left);
         prev_time = t;
     }
 #undef NEED
