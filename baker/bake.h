@@ -32,6 +32,12 @@ typedef struct mk_bake_channel_report {
     double factor_seconds;     /* Laplacian/ARAP: analyze + factorize wall time */
     double solve_seconds;      /* Laplacian/ARAP: total time of all triangular solves */
     uint32_t solves;           /* Laplacian/ARAP: solves (each one with 3 right-hand sides) */
+    uint32_t iterations;       /* ARAP: local/global iterations over all evaluations */
+    uint32_t max_iterations;   /* ARAP: most iterations one evaluation took */
+    uint32_t unconverged;      /* ARAP: evaluations stopped by the iteration cap */
+    double energy;             /* ARAP: energy of the last evaluation (amplitude 1 unless the
+                                * in-between search evaluated later weights last) */
+    double start_energy;       /* ARAP: energy of that evaluation's initial guess */
     double seconds;            /* whole channel, wall time */
 } mk_bake_channel_report;
 

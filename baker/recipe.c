@@ -36,7 +36,8 @@ static const char *const op_fields[][12] = {
     [OP_BEND] = { "axis", "center", "range", "angle", "direction", NULL },
     [OP_CAGE] = { "cage", "deformed_cage", NULL },
     [OP_LAPLACIAN] = { "weights", "constraints", "soft_weight", "anchors", "handles", NULL },
-    [OP_ARAP] = { "weights", "constraints", "soft_weight", "anchors", "handles", "iterations", NULL },
+    [OP_ARAP] = { "weights", "constraints", "soft_weight", "anchors", "handles", "iterations",
+                  "convergence", "acceleration", NULL },
 };
 
 /* Everything parsed for one channel before baking. */
@@ -517,8 +518,19 @@ static mk_result parse_edit(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch
     mk_result r = get_number(ctx, ch, path, "soft_weight", &e->soft_weight, 0);
     if (r != MK_OK) return r;
     if (!(e->soft_weight > 0)) return field_error(ctx, path, "soft_weight", "must be > 0%s", NULL);
-    e->iterations = 10;
+    e->iterations = untrusted(ctx) ? 50 : 1000;
     if ((r = get_uint(ctx, ch, path, "iterations", &e->iterations, 1, untrusted(ctx) ? 50 : 10000)) != MK_OK) return r;
+    e->convergence = 1e-6;
+    if ((r = get_number(ctx, ch, path, "convergence", &e->convergence, 0)) != MK_OK) return r;
+    if (!(e->convergence >= 0 && e->convergence < 1))
+        return field_error(ctx, path, "convergence", "must be in [0, 1) (0: run all iterations)%s", NULL);
+    if (e->convergence == 0) e->convergence = -1;  /* the C API's "all iterations" */
+    const cJSON *acc = cJSON_GetObjectItemCaseSensitive(ch, "acceleration");
+    if (acc) {
+        if (cJSON_IsString(acc) && !strcmp(acc->valuestring, "anderson")) e->acceleration = MK_ARAP_ANDERSON;
+        else if (cJSON_IsString(acc) && !strcmp(acc->valuestring, "none")) e->acceleration = MK_ARAP_PLAIN;
+        else return field_error(ctx, path, "acceleration", "must be \"anderson\" or \"none\"%s", NULL);
+    }
 
     unsigned char *mark = mk_arena_array(ctx->scratch, mesh->vertex_count ? mesh->vertex_count : 1, 1);
     if (!mark) return mk_error_oom(ctx->err, "selection");
@@ -737,6 +749,11 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
         cr.factor_seconds = st.factor_seconds;
         cr.solve_seconds = st.solve_seconds;
         cr.solves = st.solves;
+        cr.iterations = st.iterations;
+        cr.max_iterations = st.max_iterations;
+        cr.unconverged = st.unconverged;
+        cr.energy = st.energy;
+        cr.start_energy = st.start_energy;
         mk_surface_edit_destroy(edit);
     }
     if (binding) mk_cage_unbind(binding);

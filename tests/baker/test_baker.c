@@ -537,6 +537,22 @@ static void laplacian_translation_of_everything_is_exact(void)
     mk_raw_free(&raw);
 }
 
+/* Largest distance of pos from the tube moved by the rigid motion of the ARAP rigidity tests
+ * (50 degrees about (1, 1, 0.5) through (0, 0, 1.5), then (0.3, -0.2, 0.5)), / diagonal. */
+static double rigid_deviation(const mk_raw_mesh *m, const double *pos)
+{
+    double axis[3] = { 1, 1, 0.5 }, R[9], worst = 0;
+    vec3_normalize(axis);
+    mat3_rotation(R, axis, 50 * PI / 180);
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        double d[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] - 1.5 }, q[3];
+        mat3_mul_vec(q, R, d);
+        double expect[3] = { q[0] + 0.3, q[1] - 0.2, q[2] + 1.5 + 0.5 };
+        for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(pos[3 * v + c] - expect[c]));
+    }
+    return worst / diag_of(m);
+}
+
 static double arap_rigid_error(int iterations)
 {
     mk_raw_asset raw;
@@ -549,6 +565,7 @@ static double arap_rigid_error(int iterations)
     snprintf(recipe, sizeof recipe,
         "{\"mesh\": \"tube\", \"channels\": ["
         " {\"name\": \"rigid\", \"op\": \"arap\", \"inbetweens\": 1, \"iterations\": %d,"
+        "  \"convergence\": 0, \"acceleration\": \"none\","
         "  \"handles\": ["
         "   {\"min\": [-2, -2, -1], \"max\": [2, 2, 0.01], \"translate\": [0.3, -0.2, 0.5],"
         "    \"rotate\": {\"axis\": [1, 1, 0.5], \"degrees\": 50, \"pivot\": [0, 0, 1.5]}},"
@@ -560,19 +577,9 @@ static double arap_rigid_error(int iterations)
     double worst = 1e9;
     if (r == MK_OK) {
         m = &raw.meshes[0];
-        double axis[3] = { 1, 1, 0.5 }, R[9];
-        vec3_normalize(axis);
-        mat3_rotation(R, axis, 50 * PI / 180);
         double *pos = malloc(3 * m->vertex_count * sizeof(double));
         last_target_positions(m, &raw.channels[0], pos);
-        worst = 0;
-        for (uint32_t v = 0; v < m->vertex_count; v++) {
-            double d[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] - 1.5 }, q[3];
-            mat3_mul_vec(q, R, d);
-            double expect[3] = { q[0] + 0.3, q[1] - 0.2, q[2] + 1.5 + 0.5 };
-            for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(pos[3 * v + c] - expect[c]));
-        }
-        worst /= diag_of(m);
+        worst = rigid_deviation(m, pos);
         free(pos);
     }
     mk_raw_free(&raw);
@@ -589,6 +596,118 @@ static void arap_rigid_handles_without_anchors_move_rigidly(void)
     CHECK(e10 < e0);
     CHECK(e300 < e10);
     CHECK_MSG(e300 < 1e-5, "ARAP deviates from the rigid motion by %g x diagonal", e300);
+}
+
+typedef struct energy_log { double energy[2048]; uint32_t count; } energy_log;
+
+static void log_energy(void *user, uint32_t iteration, double energy)
+{
+    energy_log *l = user;
+    CHECK_EQ_INT(iteration, l->count);
+    if (l->count < 2048) l->energy[l->count++] = energy;
+}
+
+/* 1 when every logged energy is at most the one before (to rounding, 1e-12 relative). */
+static int energies_decrease(const energy_log *l)
+{
+    for (uint32_t k = 1; k < l->count; k++)
+        if (!(l->energy[k] <= l->energy[k - 1] * (1 + 1e-12))) {
+            fprintf(stderr, "energy rises at iteration %u: %.17g -> %.17g\n", k, l->energy[k - 1], l->energy[k]);
+            return 0;
+        }
+    return 1;
+}
+
+/* Surface edit of m at amplitude 1 into pos, with its stats; 0 (after a failed check) on error. */
+static int edit_at_full_amplitude(const mk_raw_mesh *m, const mk_edit_params *p, double *pos, mk_solver_stats *st)
+{
+    mk_surface_edit *e = NULL;
+    mk_error err;
+    mk_result r = mk_surface_edit_create(m, p, NULL, &e, &err);
+    CHECK_MSG(r == MK_OK, "create: %s", err.message);
+    if (r != MK_OK) return 0;
+    r = mk_surface_edit_eval(e, 1, pos, NULL, NULL, NULL, &err);
+    CHECK_MSG(r == MK_OK, "eval: %s", err.message);
+    mk_surface_edit_stats(e, st);
+    mk_surface_edit_destroy(e);
+    return r == MK_OK;
+}
+
+static void arap_converges_to_the_rigid_optimum_with_falling_energy(void)
+{
+    /* Handles at both ends of a tube moved by one rigid motion, nothing anchored: the rigidly
+     * moved tube has zero energy, so it is the optimum, and with the default convergence test
+     * both iterations (plain and Anderson-accelerated) must stop there, their energy falling at
+     * every iteration. */
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_raw_mesh *m = fixture_cylinder(&raw, "tube", 1, 3, 24, 12);
+    uint32_t *bottom = malloc(m->vertex_count * sizeof(uint32_t)), *top = malloc(m->vertex_count * sizeof(uint32_t));
+    uint32_t nb = 0, nt = 0;
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        float z = m->positions[3 * (size_t)v + 2];
+        if (z < 0.01f) bottom[nb++] = v;
+        else if (z > 2.99f) top[nt++] = v;
+    }
+    double angle = 50 * PI / 180;
+    mk_edit_handle h[2] = { { nb, bottom, { 0.3, -0.2, 0.5 }, { 1, 1, 0.5 }, angle, { 0, 0, 1.5 } },
+                            { nt, top, { 0.3, -0.2, 0.5 }, { 1, 1, 0.5 }, angle, { 0, 0, 1.5 } } };
+    double *pos = malloc(3 * m->vertex_count * sizeof(double));
+    for (int acc = 0; acc < 2; acc++) {
+        energy_log log = { .count = 0 };
+        mk_edit_params p = { .method = MK_EDIT_ARAP, .handle_count = 2, .handles = h,
+                             .acceleration = (mk_arap_acceleration)acc, .iteration_done = log_energy, .user = &log };
+        mk_solver_stats st;
+        if (!edit_at_full_amplitude(m, &p, pos, &st)) continue;
+        double worst = rigid_deviation(m, pos);
+        fprintf(stderr, "ARAP rigid optimum (%s): %u iterations, energy %.3g -> %.3g, deviation %.3g x diagonal\n",
+                acc ? "plain" : "anderson", st.iterations, st.start_energy, st.energy, worst);
+        CHECK(log.count == st.iterations + 1);
+        CHECK(energies_decrease(&log));
+        CHECK_EQ_INT(st.unconverged, 0);
+        CHECK(st.start_energy > 1e-3);
+        CHECK_MSG(st.energy < 1e-10 * st.start_energy, "energy %g of %g left", st.energy, st.start_energy);
+        CHECK_MSG(worst < 1e-6, "deviation %g x diagonal from the rigid motion", worst);
+        if (acc == 0) CHECK_MSG(st.iterations < 100, "Anderson took %u iterations", st.iterations);
+    }
+    free(pos); free(bottom); free(top);
+    mk_raw_free(&raw);
+}
+
+static void arap_anderson_lowers_energy_faster_than_plain(void)
+{
+    /* A bent sphere (no known optimum): both iterations lower the energy at every step; with
+     * the same number of iterations the accelerated one ends at least as low, and converged
+     * runs of both agree on the energy to 1e-3. */
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_raw_mesh *m = fixture_icosphere(&raw, "ico", 1, 3);
+    uint32_t *anchors = malloc(m->vertex_count * sizeof(uint32_t)), *handle = malloc(m->vertex_count * sizeof(uint32_t));
+    uint32_t na = fixture_select_z(m, -2, -0.5f, anchors), nh = fixture_select_z(m, 0.8f, 2, handle);
+    mk_edit_handle h = { nh, handle, { 0.3, 0, 0.2 }, { 1, 0, 0 }, 0.6, { 0, 0, 0.9 } };
+    double energy[2][2];
+    double *pos = malloc(3 * m->vertex_count * sizeof(double));
+    for (int acc = 0; acc < 2; acc++)
+        for (int run = 0; run < 2; run++) {
+            energy_log log = { .count = 0 };
+            mk_edit_params p = { .method = MK_EDIT_ARAP, .anchor_count = na, .anchors = anchors,
+                                 .handle_count = 1, .handles = &h, .acceleration = (mk_arap_acceleration)acc,
+                                 .iterations = run ? 2000 : 20, .convergence = run ? 1e-12 : -1,
+                                 .iteration_done = log_energy, .user = &log };
+            mk_solver_stats st;
+            if (!edit_at_full_amplitude(m, &p, pos, &st)) continue;
+            energy[acc][run] = st.energy;
+            CHECK(energies_decrease(&log));
+            CHECK(log.count >= 2 && log.energy[log.count - 1] < log.energy[0]);
+            if (!run) CHECK_EQ_INT(st.iterations, 20);
+        }
+    fprintf(stderr, "ARAP bent sphere energy: 20 iterations plain %.6f, anderson %.6f; converged %.6f, %.6f\n",
+            energy[1][0], energy[0][0], energy[1][1], energy[0][1]);
+    CHECK(energy[0][0] <= energy[1][0]);
+    CHECK(fabs(energy[0][1] - energy[1][1]) <= 1e-3 * energy[1][1]);
+    CHECK(energy[0][1] <= energy[0][0] && energy[1][1] <= energy[1][0]);
+    free(pos); free(anchors); free(handle);
+    mk_raw_free(&raw);
 }
 
 static void component_without_constraint_is_rejected(void)
@@ -749,6 +868,12 @@ static void bad_recipes_name_the_field(void)
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd\", \"origin\": [0, 0, 0],"
                        " \"axes\": [[1, 0, 0], [0, 1, 0], [1, 1, 0]]}]}", "degenerate");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd\", \"dims\": [1, 4, 4]}]}", "channels[0].dims");
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"convergence\": -0.1,"
+                       " \"handles\": [{\"indices\": [0]}]}]}", "channels[0].convergence: must be in [0, 1)");
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"convergence\": 1e999,"
+                       " \"handles\": [{\"indices\": [0]}]}]}", "channels[0].convergence");
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"acceleration\": \"fast\","
+                       " \"handles\": [{\"indices\": [0]}]}]}", "channels[0].acceleration");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"twist\", \"angle\": 1e999}]}", "channels[0].angle");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"twist\", \"angle\": NaN}]}", "JSON");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"twist\"}]}", "channels[0].angle: missing");
@@ -964,6 +1089,8 @@ CHECK_MAIN(CASE(identity_deformations_give_zero_deltas),
            CASE(laplacian_kills_constants),
            CASE(laplacian_translation_of_everything_is_exact),
            CASE(arap_rigid_handles_without_anchors_move_rigidly),
+           CASE(arap_converges_to_the_rigid_optimum_with_falling_energy),
+           CASE(arap_anderson_lowers_energy_faster_than_plain),
            CASE(component_without_constraint_is_rejected),
            CASE(twist_180_auto_inbetweens_play_back_within_tolerance),
            CASE(fixed_inbetweens_and_linear_ops),
