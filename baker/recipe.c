@@ -16,15 +16,16 @@
 #include "barr.h"
 #include "cage_mvc.h"
 #include "ffd.h"
+#include "ffd_travel.h"
 #include "inbetween.h"
 #include "surface_edit.h"
 #include "obj.h"
 
 #define PI 3.14159265358979323846
 
-typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP } op_kind;
+typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP, OP_FFD_TRAVEL } op_kind;
 
-static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap" };
+static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap", "ffd_travel" };
 
 /* Fields accepted by every op, and per op. */
 static const char *const common_fields[] = { "name", "op", "mesh", "inbetweens", "tolerance",
@@ -38,6 +39,7 @@ static const char *const op_fields[][12] = {
     [OP_LAPLACIAN] = { "weights", "constraints", "soft_weight", "anchors", "handles", NULL },
     [OP_ARAP] = { "weights", "constraints", "soft_weight", "anchors", "handles", "iterations",
                   "convergence", "acceleration", NULL },
+    [OP_FFD_TRAVEL] = { "dims", "basis", "origin", "axes", "padding", "moves", "travel", "duration", NULL },
 };
 
 /* Everything parsed for one channel before baking. */
@@ -54,6 +56,8 @@ typedef struct channel_plan {
     mk_cage cage;
     mk_edit_params edit;
     mk_edit_handle *handles;
+    mk_ffd_travel travel;
+    double clip_duration;         /* ffd_travel: seconds of the clip playing 0 -> 1; 0 = no clip */
 } channel_plan;
 
 typedef struct recipe_ctx {
@@ -331,7 +335,9 @@ static mk_result parse_index_range(recipe_ctx *ctx, const cJSON *mv, const char 
     return MK_OK;
 }
 
-static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+/* bounds: the box the default lattice encloses (min, max), NULL = the mesh's bounding box. */
+static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path,
+                           const double (*bounds)[3])
 {
     const mk_raw_mesh *mesh = &ctx->raw->meshes[plan->mesh];
     mk_ffd_lattice *f = &plan->ffd;
@@ -372,6 +378,12 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
         if (r != MK_OK) return r;
         if (padding < 0) return field_error(ctx, path, "padding", "must be >= 0%s", NULL);
         bake_bounds(mesh, bmin, bmax, &diag);
+        if (bounds) {
+            double d[3];
+            for (int c = 0; c < 3; c++) { bmin[c] = bounds[0][c]; bmax[c] = bounds[1][c]; }
+            vec3_sub(d, bmax, bmin);
+            diag = vec3_length(d);
+        }
         double pad = padding * diag;
         for (int a = 0; a < 3; a++) {
             f->origin[a] = bmin[a] - pad;
@@ -582,6 +594,69 @@ static mk_result parse_edit(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch
     return MK_OK;
 }
 
+/* ffd_travel: the travel (a rigid motion), a lattice around the swept mesh, the clip. */
+static mk_result parse_ffd_travel(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    static const char *const travel_fields[] = { "translate", "rotate", NULL };
+    const mk_raw_mesh *mesh = &ctx->raw->meshes[plan->mesh];
+    mk_ffd_travel *t = &plan->travel;
+    memset(t, 0, sizeof *t);
+    char tpath[96];
+    snprintf(tpath, sizeof tpath, "%s.travel", path);
+    const cJSON *travel = cJSON_GetObjectItemCaseSensitive(ch, "travel");
+    if (!travel) return field_error(ctx, path, "travel", "missing (translate and/or rotate: the mesh's path through the lattice)%s", NULL);
+    if (!cJSON_IsObject(travel)) return field_error(ctx, path, "travel", "must be an object {translate, rotate}%s", NULL);
+    mk_result r = check_fields(ctx, travel, tpath, travel_fields, NULL);
+    if (r != MK_OK) return r;
+    double bmin[3], bmax[3], diag, centre[3];
+    bake_bounds(mesh, bmin, bmax, &diag);
+    for (int c = 0; c < 3; c++) centre[c] = 0.5 * (bmin[c] + bmax[c]);
+    if (get_vec3(ctx, travel, tpath, "translate", t->translate) < 0) return ctx->err->code;
+    if ((r = parse_rotate(ctx, travel, tpath, t->axis, &t->angle, t->pivot, centre)) != MK_OK) return r;
+    if (vec3_length(t->translate) == 0 && t->angle == 0)
+        return field_error(ctx, tpath, "", "moves nothing: give a nonzero translate or rotate%s", NULL);
+    plan->clip_duration = 0;
+    if ((r = get_number(ctx, ch, path, "duration", &plan->clip_duration, 0)) != MK_OK) return r;
+    if (cJSON_HasObjectItem(ch, "duration") && !(plan->clip_duration > 0))
+        return field_error(ctx, path, "duration", "must be > 0 seconds%s", NULL);
+    /* Default lattice: around the mesh at 17 points of its travel. */
+    double bounds[2][3];
+    for (int c = 0; c < 3; c++) { bounds[0][c] = bmin[c]; bounds[1][c] = bmax[c]; }
+    for (int k = 1; k <= 16; k++) {
+        double R[9];
+        mat3_rotation(R, t->axis, k / 16.0 * t->angle);
+        for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+            const float *p = mesh->positions + 3 * (size_t)v;
+            double d[3] = { p[0] - t->pivot[0], p[1] - t->pivot[1], p[2] - t->pivot[2] }, q[3];
+            mat3_mul_vec(q, R, d);
+            for (int c = 0; c < 3; c++) {
+                q[c] += t->pivot[c] + k / 16.0 * t->translate[c];
+                if (q[c] < bounds[0][c]) bounds[0][c] = q[c];
+                if (q[c] > bounds[1][c]) bounds[1][c] = q[c];
+            }
+        }
+    }
+    if ((r = parse_ffd(ctx, plan, ch, path, (const double (*)[3])bounds)) != MK_OK) return r;
+    t->lattice = &plan->ffd;
+    /* The channel's weight 0 is the rest mesh: the lattice may not move the start pose. */
+    double worst = 0;
+    uint32_t worst_v = 0;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        const float *p = mesh->positions + 3 * (size_t)v;
+        double pd[3] = { p[0], p[1], p[2] }, q[3], J[9], d[3];
+        mk_ffd_travel_map(t, 0, pd, q, J);
+        vec3_sub(d, q, pd);
+        if (vec3_length(d) > worst) { worst = vec3_length(d); worst_v = v; }
+    }
+    if (worst > 1e-6 * diag) {
+        char msg[200];
+        snprintf(msg, sizeof msg, "the deformed lattice moves the mesh before it travels (vertex %u by %.3g x diagonal): "
+                 "keep the control points around the start pose at rest", worst_v, worst / diag);
+        return field_error(ctx, path, "moves", "%s", msg);
+    }
+    return MK_OK;
+}
+
 /* ---- recipe ---- */
 
 static mk_result resolve_mesh(recipe_ctx *ctx, const cJSON *item, const char *path, uint32_t *mesh)
@@ -639,12 +714,12 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     snprintf(path, sizeof path, "channels[%d]", index);
     if (!cJSON_IsObject(ch)) return field_error(ctx, path, "", "must be an object%s", NULL);
     const cJSON *op = cJSON_GetObjectItemCaseSensitive(ch, "op");
-    if (!op) return field_error(ctx, path, "op", "missing (ffd, taper, twist, bend, cage, laplacian or arap)%s", NULL);
+    if (!op) return field_error(ctx, path, "op", "missing (ffd, ffd_travel, taper, twist, bend, cage, laplacian or arap)%s", NULL);
     if (!cJSON_IsString(op)) return field_error(ctx, path, "op", "must be a string%s", NULL);
     int k = -1;
     for (int i = 0; i < (int)(sizeof op_names / sizeof op_names[0]); i++)
         if (!strcmp(op_names[i], op->valuestring)) k = i;
-    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, taper, twist, bend, cage, laplacian or arap)", op->valuestring);
+    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, ffd_travel, taper, twist, bend, cage, laplacian or arap)", op->valuestring);
     plan->op = (op_kind)k;
     mk_result r = check_fields(ctx, ch, path, common_fields, op_fields[k]);
     if (r != MK_OK) return r;
@@ -662,9 +737,10 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     if (name) snprintf(plan->name, sizeof plan->name, "%s", name->valuestring);
     else snprintf(plan->name, sizeof plan->name, "%s%d", op_names[k], index);
 
-    /* Twist, bend, Laplacian (with rotations) and ARAP are nonlinear in the amplitude: they
+    /* Twist, bend, Laplacian (with rotations), ARAP and FFD travel are nonlinear in the amplitude: they
      * default to adaptive in-betweens; FFD, taper and cage are linear: one target is exact. */
-    int nonlinear = plan->op == OP_TWIST || plan->op == OP_BEND || plan->op == OP_LAPLACIAN || plan->op == OP_ARAP;
+    int nonlinear = plan->op == OP_TWIST || plan->op == OP_BEND || plan->op == OP_LAPLACIAN || plan->op == OP_ARAP ||
+                    plan->op == OP_FFD_TRAVEL;
     plan->inbetween.count = nonlinear ? 0 : 1;
     const cJSON *ib = cJSON_GetObjectItemCaseSensitive(ch, "inbetweens");
     if (ib) {
@@ -687,7 +763,8 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
 
     switch (plan->op) {
     case OP_TAPER: case OP_TWIST: case OP_BEND: r = parse_barr(ctx, plan, ch, path); break;
-    case OP_FFD: r = parse_ffd(ctx, plan, ch, path); break;
+    case OP_FFD: r = parse_ffd(ctx, plan, ch, path, NULL); break;
+    case OP_FFD_TRAVEL: r = parse_ffd_travel(ctx, plan, ch, path); break;
     case OP_CAGE: r = parse_cage(ctx, plan, ch, path); break;
     case OP_LAPLACIAN: case OP_ARAP: r = parse_edit(ctx, plan, ch, path); break;
     }
@@ -697,6 +774,35 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     plan->origin = mk_arena_strdup(ctx->scratch, json);
     cJSON_free(json);
     if (!plan->origin) return mk_error_oom(ctx->err, "recipe origin");
+    return MK_OK;
+}
+
+/* A clip named like the channel that plays its weight linearly from 0 to 1 over the duration. */
+static mk_result add_travel_clip(recipe_ctx *ctx, const channel_plan *plan, uint32_t channel)
+{
+    mk_raw_asset *raw = ctx->raw;
+    mk_raw_track *track = mk_arena_array(&raw->arena, 1, sizeof *track);
+    mk_key *keys = mk_arena_array(&raw->arena, 2, sizeof *keys);
+    char *name = mk_arena_strdup(&raw->arena, plan->name);
+    mk_raw_clip *clip = track && keys && name ? mk_raw_add_clips(raw, 1) : NULL;
+    if (!clip) return mk_error_oom(ctx->err, "travel clip");
+    keys[0].time = 0;
+    keys[0].value = 0;
+    keys[1].time = (float)plan->clip_duration;
+    keys[1].value = 1;
+    for (int k = 0; k < 2; k++) {
+        keys[k].interp = MK_INTERP_LINEAR;
+        keys[k].left_weight = keys[k].right_weight = 1.0f / 3;
+        keys[k].left_slope = keys[k].right_slope = (float)(1 / plan->clip_duration);
+    }
+    track->channel = channel;
+    track->key_count = 2;
+    track->keys = keys;
+    clip->name = name;
+    clip->start = 0;
+    clip->duration = (float)plan->clip_duration;
+    clip->track_count = 1;
+    clip->tracks = track;
     return MK_OK;
 }
 
@@ -722,6 +828,10 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
         break;
     case OP_FFD:
         pw.map = mk_ffd_map; pw.user = &plan->ffd;
+        deformer.eval = bake_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
+        break;
+    case OP_FFD_TRAVEL:
+        pw.map = mk_ffd_travel_map; pw.user = &plan->travel;
         deformer.eval = bake_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
         break;
     case OP_CAGE:
@@ -759,6 +869,7 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
     if (binding) mk_cage_unbind(binding);
     if (r != MK_OK) return mk_error_set(ctx->err, inner.code, inner.offset, "%s (%s): %s", path, op_names[plan->op], inner.message);
     raw->channels[raw->channel_count - 1].default_weight = plan->default_weight;
+    if (plan->clip_duration > 0 && (r = add_travel_clip(ctx, plan, raw->channel_count - 1)) != MK_OK) return r;
     if (res.inverted_vertices)
         mk_raw_warn(raw, "channel \"%s\": %u vertices where the deformation folds (det J <= 0); "
                     "their normals come from the deformed surface", plan->name, res.inverted_vertices);
@@ -831,11 +942,13 @@ mk_result mk_bake_recipe(mk_raw_asset *raw, const char *recipe_json, size_t reci
     if (!err) ctx.err = &local_err;
     uint32_t old_channels = raw->channel_count;
     uint32_t old_warnings = raw->warning_count;
+    uint32_t old_clips = raw->clip_count;
     mk_result r = run_recipe(&ctx, recipe_json, recipe_size, report);
     if (r == MK_OK) r = mk_raw_group_channels(raw, ctx.err);
     if (r != MK_OK) {
         raw->channel_count = old_channels;
         raw->warning_count = old_warnings;  /* drop warnings of the abandoned bake */
+        raw->clip_count = old_clips;        /* and travel clips */
         memset(report, 0, sizeof *report);
     }
     mk_arena_free_all(&scratch);

@@ -14,6 +14,7 @@
 #include "cage_mvc.h"
 #include "check.h"
 #include "ffd.h"
+#include "ffd_travel.h"
 #include "fixtures.h"
 #include "inbetween.h"
 #include "surface_edit.h"
@@ -743,6 +744,51 @@ static void component_without_constraint_is_rejected(void)
 
 /* ---- adaptive in-betweens through the real runtime ---- */
 
+/* Writes raw as a float blob (into raw's arena) and opens it; 0 (after a failed check) on error. */
+static int write_and_open(mk_raw_asset *raw, mk_asset *asset)
+{
+    mk_write_options wo = { .precision = MK_PRECISION_FLOAT };
+    void *blob = NULL;
+    size_t size = 0;
+    mk_error err;
+    mk_result r = mk_write_blob(raw, &wo, &raw->arena, &blob, &size, NULL, &err);
+    CHECK_MSG(r == MK_OK, "write: %s", err.message);
+    if (r == MK_OK) r = mk_asset_open(blob, size, asset, &err);
+    CHECK_MSG(r == MK_OK, "open: %s", err.message);
+    return r == MK_OK;
+}
+
+/* Largest distance (mesh units) between the runtime's playback of mesh 0 with channel
+ * `channel` of `channel_count` at weight w (the others at 0) and truth(w, p), over w = k/100. */
+static double playback_error(const mk_asset *asset, const mk_raw_mesh *m, uint32_t channel, uint32_t channel_count,
+                             bake_point_map truth, const void *user)
+{
+    size_t scratch_size = mk_eval_scratch_size(asset, 0);
+    void *scratch = scratch_size ? aligned_alloc(16, (scratch_size + 15) / 16 * 16) : NULL;
+    float *out = malloc(3 * m->vertex_count * sizeof(float)), weights[16] = { 0 };
+    double worst = 0;
+    for (int step = 0; step <= 100 && channel_count <= 16; step++) {
+        weights[channel] = (float)step / 100;
+        mk_eval_job job = { .asset = asset, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = weights,
+                            .weight_count = channel_count, .scratch = scratch, .scratch_size = scratch_size,
+                            .positions = out, .positions_size = 3 * m->vertex_count * sizeof(float) };
+        mk_error err;
+        mk_result r = mk_eval_run(&job, &err);
+        CHECK_MSG(r == MK_OK, "eval: %s", err.message);
+        if (r != MK_OK) { worst = INFINITY; break; }
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, q[3], J[9];
+            truth(user, (double)step / 100, p, q, J);
+            double e2 = 0;
+            for (int c = 0; c < 3; c++) e2 += (out[3 * v + c] - q[c]) * (out[3 * v + c] - q[c]);
+            worst = fmax(worst, sqrt(e2));
+        }
+    }
+    free(out);
+    free(scratch);
+    return worst;
+}
+
 static void twist_180_auto_inbetweens_play_back_within_tolerance(void)
 {
     mk_raw_asset raw;
@@ -765,15 +811,8 @@ static void twist_180_auto_inbetweens_play_back_within_tolerance(void)
     /* The origin holds the channel's recipe. */
     CHECK(raw.channels[0].origin && strstr(raw.channels[0].origin, "\"twist\"") != NULL);
 
-    mk_write_options wo = { .precision = MK_PRECISION_FLOAT };
-    void *blob = NULL;
-    size_t size = 0;
-    r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, NULL, &err);
-    CHECK_MSG(r == MK_OK, "write: %s", err.message);
     mk_asset asset;
-    if (r == MK_OK) r = mk_asset_open(blob, size, &asset, &err);
-    CHECK_MSG(r == MK_OK, "open: %s", err.message);
-    if (r != MK_OK) { mk_raw_free(&raw); return; }
+    if (!write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
     mk_channel_info ci;
     CHECK(mk_channel_get(&asset, 0, &ci) && ci.target_count == targets);
     CHECK(ci.origin && strstr(ci.origin, "twist"));
@@ -784,34 +823,148 @@ static void twist_180_auto_inbetweens_play_back_within_tolerance(void)
     for (int c = 0; c < 3; c++) tw.center[c] = 0.5 * (lo[c] + hi[c]);
     tw.range[0] = lo[2]; tw.range[1] = hi[2];
     CHECK(mk_barr_prepare(&tw, &err) == MK_OK);
-    size_t scratch_size = mk_eval_scratch_size(&asset, 0);
-    void *scratch = scratch_size ? aligned_alloc(16, (scratch_size + 15) / 16 * 16) : NULL;
-    float *out = malloc(3 * m->vertex_count * sizeof(float));
-    double worst = 0;
-    for (int step = 0; step <= 100; step++) {
-        float w = (float)step / 100;
-        mk_eval_job job = { .asset = &asset, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = &w, .weight_count = 1,
-                            .scratch = scratch, .scratch_size = scratch_size,
-                            .positions = out, .positions_size = 3 * m->vertex_count * sizeof(float) };
-        r = mk_eval_run(&job, &err);
-        CHECK_MSG(r == MK_OK, "eval: %s", err.message);
-        if (r != MK_OK) break;
-        for (uint32_t v = 0; v < m->vertex_count; v++) {
-            double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, q[3], J[9];
-            mk_barr_map(&tw, (double)step / 100, p, q, J);
-            double e2 = 0;
-            for (int c = 0; c < 3; c++) e2 += (out[3 * v + c] - q[c]) * (out[3 * v + c] - q[c]);
-            worst = fmax(worst, sqrt(e2));
-        }
-    }
+    double worst = playback_error(&asset, m, 0, 1, mk_barr_map, &tw);
     fprintf(stderr, "twist playback through the runtime: max error %.3g x diagonal over 101 weights\n",
             worst / d);
     CHECK_MSG(worst <= 0.001 * d, "playback error %g > 0.001 x diagonal %g", worst, 0.001 * d);
     /* a single target would be far off: linear blending of a 180 degree rotation collapses
      * the tube through its axis at w = 0.5 */
     CHECK(targets >= 8);
-    free(out);
-    free(scratch);
+    mk_raw_free(&raw);
+}
+
+/* ---- ffd_travel ---- */
+
+typedef struct rigid_travel { double translate[3], axis[3], angle; } rigid_travel;
+
+/* pivot at the origin */
+static void rigid_travel_map(const void *user, double a, const double p[3], double q[3], double J[9])
+{
+    const rigid_travel *t = user;
+    double R[9];
+    mat3_rotation(R, t->axis, a * t->angle);
+    mat3_mul_vec(q, R, p);
+    for (int c = 0; c < 3; c++) q[c] += a * t->translate[c];
+    memcpy(J, R, sizeof R);
+}
+
+/* A cylinder fixture (see fixture_cylinder) in a fresh raw with the recipe baked on it; NULL
+ * (after a failed check, raw freed) if the bake fails. */
+static mk_raw_mesh *baked_cylinder(mk_raw_asset *raw, const char *name, float radius, float height,
+                                   uint32_t segments, uint32_t rings, const char *recipe)
+{
+    mk_raw_init(raw, NULL);
+    fixture_cylinder(raw, name, radius, height, segments, rings);
+    mk_error err;
+    mk_result r = bake(raw, recipe, &err);
+    CHECK_MSG(r == MK_OK, "bake: %s", err.message);
+    if (r != MK_OK) { mk_raw_free(raw); return NULL; }
+    return &raw->meshes[0];
+}
+
+static void ffd_travel_through_an_unmoved_lattice_is_the_rigid_travel(void)
+{
+    const char *recipe =
+        "{\"mesh\": \"tube\", \"channels\": ["
+        " {\"name\": \"slide\", \"op\": \"ffd_travel\", \"dims\": [3, 3, 3], \"duration\": 2,"
+        "  \"travel\": {\"translate\": [1.5, 0, 0.5]}},"
+        " {\"name\": \"spin\", \"op\": \"ffd_travel\", \"basis\": \"bspline\","
+        "  \"travel\": {\"translate\": [0, 0, 1], \"rotate\": {\"axis\": [0, 0, 1], \"degrees\": 90, \"pivot\": [0, 0, 0]}}}"
+        "]}";
+    mk_raw_asset raw;
+    const mk_raw_mesh *m = baked_cylinder(&raw, "tube", 1, 4, 16, 8, recipe);
+    if (!m) return;
+    /* A pure translation is linear in the weight: one target, every delta the translation. */
+    const mk_raw_channel *slide = find_channel(&raw, "slide"), *spin = find_channel(&raw, "spin");
+    CHECK(slide && spin);
+    if (!slide || !spin) { mk_raw_free(&raw); return; }
+    CHECK_EQ_INT(slide->target_count, 1);
+    CHECK_EQ_INT(slide->targets[0].count, m->vertex_count);
+    double worst = 0;
+    for (uint32_t k = 0; k < slide->targets[0].count; k++) {
+        const float *d = slide->targets[0].positions + 3 * (size_t)k;
+        worst = fmax(worst, fabs(d[0] - 1.5) + fabs(d[1]) + fabs(d[2] - 0.5));
+    }
+    CHECK_MSG(worst < 1e-6, "slide delta off the translation by %g", worst);
+    CHECK(spin->target_count > 1);
+    /* The clip plays slide's weight 0 -> 1 over 2 s. */
+    CHECK_EQ_INT(raw.clip_count, 1);
+    if (raw.clip_count == 1) {
+        const mk_raw_clip *clip = &raw.clips[0];
+        CHECK(!strcmp(clip->name, "slide") && clip->duration == 2 && clip->track_count == 1);
+        CHECK(&raw.channels[clip->tracks[0].channel] == slide);
+        CHECK(clip->tracks[0].key_count == 2 && clip->tracks[0].keys[1].value == 1 && clip->tracks[0].keys[1].time == 2);
+    }
+    mk_asset asset;
+    if (!write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
+    rigid_travel spin_truth = { { 0, 0, 1 }, { 0, 0, 1 }, PI / 2 };
+    double e = playback_error(&asset, m, (uint32_t)(spin - raw.channels), 2, rigid_travel_map, &spin_truth);
+    fprintf(stderr, "ffd_travel spin through an unmoved lattice: %u targets, playback error %.3g x diagonal\n",
+            spin->target_count, e / diag_of(m));
+    CHECK_MSG(e <= 0.001 * diag_of(m) + 1e-5, "playback error %g x diagonal", e / diag_of(m));
+    mk_raw_free(&raw);
+}
+
+/* The bent lattice of the next test: x in [0.2, 2.2], y in [-1, 1], z in [-1, 2], 3 x 2 x 2
+ * Bernstein points, the middle layer moved by (0, 0.3, 0): inside, y gains 0.3 * 2 s (1 - s)
+ * (the degree-2 Bernstein weight of the middle layer), s = (x - 0.2) / 2; outside nothing. The
+ * mesh travels by (1.2, 0, 0). */
+static void bent_lattice_truth(const void *user, double a, const double p[3], double q[3], double J[9])
+{
+    (void)user; (void)J;
+    q[0] = p[0] + 1.2 * a; q[1] = p[1]; q[2] = p[2];
+    double s = (q[0] - 0.2) / 2;
+    if (s >= 0 && s <= 1) q[1] += 0.3 * 2 * s * (1 - s);
+}
+
+static void ffd_travel_through_a_bent_lattice_follows_the_bernstein_formula(void)
+{
+    const char *recipe = "{\"mesh\": \"rod\", \"channels\": [{\"name\": \"wave\", \"op\": \"ffd_travel\","
+        " \"dims\": [3, 2, 2], \"tolerance\": 0.002, \"origin\": [0.2, -1, -1], \"axes\": [[2, 0, 0], [0, 2, 0], [0, 0, 3]],"
+        " \"moves\": [{\"i\": 1, \"translate\": [0, 0.3, 0]}], \"travel\": {\"translate\": [1.2, 0, 0]}}]}";
+    mk_raw_asset raw;
+    const mk_raw_mesh *m = baked_cylinder(&raw, "rod", 0.1f, 0.2f, 12, 2, recipe);
+    if (!m) return;
+    mk_error err;
+    /* The map itself, exactly. */
+    double lattice_displacements[12 * 3] = { 0 };
+    for (int k = 0; k < 12; k++) if (k % 3 == 1) lattice_displacements[3 * k + 1] = 0.3;
+    mk_ffd_lattice f = { .basis = MK_FFD_BERNSTEIN, .dims = { 3, 2, 2 }, .origin = { 0.2, -1, -1 },
+                         .axes = { { 2, 0, 0 }, { 0, 2, 0 }, { 0, 0, 3 } }, .displacements = lattice_displacements };
+    CHECK(mk_ffd_prepare(&f, &err) == MK_OK);
+    mk_ffd_travel t = { .lattice = &f, .translate = { 1.2, 0, 0 }, .axis = { 0, 0, 1 } };
+    double worst_map = 0;
+    for (int step = 0; step <= 20; step++)
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, q[3], e[3], J[9];
+            mk_ffd_travel_map(&t, step / 20.0, p, q, J);
+            bent_lattice_truth(NULL, step / 20.0, p, e, J);
+            for (int c = 0; c < 3; c++) worst_map = fmax(worst_map, fabs(q[c] - e[c]));
+        }
+    CHECK_MSG(worst_map < 1e-12, "ffd_travel map off the formula by %g", worst_map);
+    /* Its Jacobian (J_ffd R, for the normals) against central differences, with a turn. */
+    mk_ffd_travel turning = { .lattice = &f, .translate = { 1.2, 0, 0 }, .axis = { 0.6, 0, 0.8 }, .angle = 0.7 };
+    double worst_jacobian = 0;
+    for (uint32_t v = 0; v < m->vertex_count; v += 5) {
+        double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, q[3], J[9], Jd[9];
+        mk_ffd_travel_map(&turning, 0.5, p, q, J);
+        for (int c = 0; c < 3; c++) {
+            double pp[3] = { p[0], p[1], p[2] }, pm[3] = { p[0], p[1], p[2] }, qp[3], qm[3];
+            pp[c] += 1e-6; pm[c] -= 1e-6;
+            mk_ffd_travel_map(&turning, 0.5, pp, qp, Jd);
+            mk_ffd_travel_map(&turning, 0.5, pm, qm, Jd);
+            for (int r = 0; r < 3; r++) worst_jacobian = fmax(worst_jacobian, fabs((qp[r] - qm[r]) / 2e-6 - J[3 * r + c]));
+        }
+    }
+    CHECK_MSG(worst_jacobian < 1e-6, "ffd_travel Jacobian off the finite differences by %g", worst_jacobian);
+    const mk_raw_channel *ch = &raw.channels[0];
+    mk_asset asset;
+    if (!write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
+    double d = diag_of(m), e = playback_error(&asset, m, 0, 1, bent_lattice_truth, NULL);
+    fprintf(stderr, "ffd_travel through a bent lattice: %u targets, playback error %.3g x diagonal\n",
+            ch->target_count, e / d);
+    CHECK(ch->target_count > 2);
+    CHECK_MSG(e <= 0.002 * d + 1e-5, "playback error %g x diagonal", e / d);
     mk_raw_free(&raw);
 }
 
@@ -868,6 +1021,21 @@ static void bad_recipes_name_the_field(void)
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd\", \"origin\": [0, 0, 0],"
                        " \"axes\": [[1, 0, 0], [0, 1, 0], [1, 1, 0]]}]}", "degenerate");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd\", \"dims\": [1, 4, 4]}]}", "channels[0].dims");
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\"}]}", "channels[0].travel: missing");
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {}}]}",
+                 "channels[0].travel: moves nothing");
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0, 1e999]}}]}",
+                 "channels[0].travel.translate");
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0]}}]}",
+                 "channels[0].travel.translate");
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"shift\": [1, 0, 0]}}]}",
+                 "channels[0].travel.shift: unknown field");
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"duration\": 0,"
+                       " \"travel\": {\"translate\": [1, 0, 0]}}]}", "channels[0].duration");
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0, 0]},"
+                       " \"moves\": [{\"j\": 1, \"translate\": [0, 0.2, 0]}]}]}", "moves the mesh before it travels");
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0, 0]},"
+                       " \"origin\": [0, 0, 0], \"axes\": [[1, 0, 0], [2, 0, 0], [0, 0, 1]]}]}", "degenerate");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"convergence\": -0.1,"
                        " \"handles\": [{\"indices\": [0]}]}]}", "channels[0].convergence: must be in [0, 1)");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"convergence\": 1e999,"
@@ -949,7 +1117,8 @@ static void record_channels(void *user, const mk_bake_channel_report *c)
  * y from 0 to 2), including the cage OBJ files that resolve against the recipe directory. */
 static void sample_recipes_bake(void)
 {
-    static const char *const names[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json" };
+    static const char *const names[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json",
+                                         "ffd_travel.json" };
     const char *root = getenv("MORPHKIT_SOURCE_ROOT");
     if (!root) root = MK_SOURCE_ROOT;
     char dir[4096];
@@ -1094,5 +1263,7 @@ CHECK_MAIN(CASE(identity_deformations_give_zero_deltas),
            CASE(component_without_constraint_is_rejected),
            CASE(twist_180_auto_inbetweens_play_back_within_tolerance),
            CASE(fixed_inbetweens_and_linear_ops),
+           CASE(ffd_travel_through_an_unmoved_lattice_is_the_rigid_travel),
+           CASE(ffd_travel_through_a_bent_lattice_follows_the_bernstein_formula),
            CASE(bad_recipes_name_the_field),
            CASE(bake_keeps_existing_channels))
