@@ -23,9 +23,9 @@
 
 #define PI 3.14159265358979323846
 
-typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP, OP_FFD_TRAVEL } op_kind;
+typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP, OP_FFD_TRAVEL, OP_FFD_KEYS } op_kind;
 
-static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap", "ffd_travel" };
+static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap", "ffd_travel", "ffd_keys" };
 
 /* Fields accepted by every op, and per op. */
 static const char *const common_fields[] = { "name", "op", "mesh", "inbetweens", "tolerance",
@@ -40,6 +40,7 @@ static const char *const op_fields[][12] = {
     [OP_ARAP] = { "weights", "constraints", "soft_weight", "anchors", "handles", "iterations",
                   "convergence", "acceleration", NULL },
     [OP_FFD_TRAVEL] = { "dims", "basis", "origin", "axes", "padding", "moves", "travel", "duration", NULL },
+    [OP_FFD_KEYS] = { "dims", "basis", "origin", "axes", "padding", "keys", NULL },
 };
 
 /* Everything parsed for one channel before baking. */
@@ -58,6 +59,9 @@ typedef struct channel_plan {
     mk_edit_handle *handles;
     mk_ffd_travel travel;
     double clip_duration;         /* ffd_travel: seconds of the clip playing 0 -> 1; 0 = no clip */
+    uint32_t key_count;           /* ffd_keys: lattice keys, their times and displacements */
+    double *key_times;
+    double **key_displacements;
 } channel_plan;
 
 typedef struct recipe_ctx {
@@ -335,6 +339,9 @@ static mk_result parse_index_range(recipe_ctx *ctx, const cJSON *mv, const char 
     return MK_OK;
 }
 
+static mk_result parse_ffd_moves(recipe_ctx *ctx, const mk_ffd_lattice *f, const cJSON *obj, const char *path,
+                                 double *current, double *displacements);
+
 /* bounds: the box the default lattice encloses (min, max), NULL = the mesh's bounding box. */
 static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path,
                            const double (*bounds)[3])
@@ -402,7 +409,20 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
     mk_error inner;
     if (mk_ffd_prepare(f, &inner) != MK_OK)
         return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
-    const cJSON *moves = cJSON_GetObjectItemCaseSensitive(ch, "moves");
+    mk_result r = parse_ffd_moves(ctx, f, ch, path, current, plan->ffd_displacements);
+    if (r != MK_OK) return r;
+    f->displacements = plan->ffd_displacements;
+    if (mk_ffd_prepare(f, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
+    return MK_OK;
+}
+
+/* The "moves" of obj (at path) applied to the control points `current` (rest positions on
+ * entry, moved on return); displacements gets moved - rest. f is prepared. */
+static mk_result parse_ffd_moves(recipe_ctx *ctx, const mk_ffd_lattice *f, const cJSON *obj, const char *path,
+                                 double *current, double *displacements)
+{
+    const cJSON *moves = cJSON_GetObjectItemCaseSensitive(obj, "moves");
     if (moves && !cJSON_IsArray(moves))
         return field_error(ctx, path, "moves", "must be an array of moves%s", NULL);
     int m = 0;
@@ -455,11 +475,8 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
                 size_t q = 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k));
                 double rest[3];
                 mk_ffd_control_point(f, i, j, k, rest);
-                for (int c = 0; c < 3; c++) plan->ffd_displacements[q + c] = current[q + c] - rest[c];
+                for (int c = 0; c < 3; c++) displacements[q + c] = current[q + c] - rest[c];
             }
-    f->displacements = plan->ffd_displacements;
-    if (mk_ffd_prepare(f, &inner) != MK_OK)
-        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
     return MK_OK;
 }
 
@@ -657,6 +674,47 @@ static mk_result parse_ffd_travel(recipe_ctx *ctx, channel_plan *plan, const cJS
     return MK_OK;
 }
 
+/* ffd_keys: the lattice, then per key its time and its own moves from the rest lattice. */
+static mk_result parse_ffd_keys(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    static const char *const key_fields[] = { "time", "moves", NULL };
+    mk_result r = parse_ffd(ctx, plan, ch, path, NULL);
+    if (r != MK_OK) return r;
+    if (strlen(plan->name) + 8 >= sizeof plan->name)
+        return field_error(ctx, path, "name", "must be under 120 bytes for ffd_keys (channels are named NAME.keyK)%s", NULL);
+    const cJSON *keys = cJSON_GetObjectItemCaseSensitive(ch, "keys");
+    if (!keys) return field_error(ctx, path, "keys", "missing (an array of {time, moves})%s", NULL);
+    int count = cJSON_IsArray(keys) ? cJSON_GetArraySize(keys) : 0;
+    if (count < 1 || count > (untrusted(ctx) ? 32 : 256))
+        return field_error(ctx, path, "keys", "must be an array of 1..256 keys {time, moves} (32 when untrusted)%s", NULL);
+    const mk_ffd_lattice *f = &plan->ffd;
+    size_t points = (size_t)f->dims[0] * f->dims[1] * f->dims[2];
+    plan->key_count = (uint32_t)count;
+    plan->key_times = mk_arena_array(ctx->scratch, (size_t)count, sizeof(double));
+    plan->key_displacements = mk_arena_array(ctx->scratch, (size_t)count, sizeof(double *));
+    double *current = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+    if (!plan->key_times || !plan->key_displacements || !current) return mk_error_oom(ctx->err, "lattice keys");
+    int k = 0;
+    for (const cJSON *key = keys->child; key; key = key->next, k++) {
+        char kpath[96];
+        snprintf(kpath, sizeof kpath, "%s.keys[%d]", path, k);
+        if (!cJSON_IsObject(key)) return field_error(ctx, kpath, "", "must be an object {time, moves}%s", NULL);
+        if ((r = check_fields(ctx, key, kpath, key_fields, NULL)) != MK_OK) return r;
+        if ((r = get_number(ctx, key, kpath, "time", &plan->key_times[k], 1)) != MK_OK) return r;
+        if (plan->key_times[k] < 0) return field_error(ctx, kpath, "time", "must be >= 0 seconds%s", NULL);
+        if (k > 0 && !(plan->key_times[k] > plan->key_times[k - 1]))
+            return field_error(ctx, kpath, "time", "must be later than the previous key's%s", NULL);
+        plan->key_displacements[k] = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+        if (!plan->key_displacements[k]) return mk_error_oom(ctx->err, "lattice keys");
+        for (uint32_t kk = 0; kk < f->dims[2]; kk++)
+            for (uint32_t j = 0; j < f->dims[1]; j++)
+                for (uint32_t i = 0; i < f->dims[0]; i++)
+                    mk_ffd_control_point(f, i, j, kk, current + 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * kk)));
+        if ((r = parse_ffd_moves(ctx, f, key, kpath, current, plan->key_displacements[k])) != MK_OK) return r;
+    }
+    return MK_OK;
+}
+
 /* ---- recipe ---- */
 
 static mk_result resolve_mesh(recipe_ctx *ctx, const cJSON *item, const char *path, uint32_t *mesh)
@@ -714,12 +772,12 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     snprintf(path, sizeof path, "channels[%d]", index);
     if (!cJSON_IsObject(ch)) return field_error(ctx, path, "", "must be an object%s", NULL);
     const cJSON *op = cJSON_GetObjectItemCaseSensitive(ch, "op");
-    if (!op) return field_error(ctx, path, "op", "missing (ffd, ffd_travel, taper, twist, bend, cage, laplacian or arap)%s", NULL);
+    if (!op) return field_error(ctx, path, "op", "missing (ffd, ffd_travel, ffd_keys, taper, twist, bend, cage, laplacian or arap)%s", NULL);
     if (!cJSON_IsString(op)) return field_error(ctx, path, "op", "must be a string%s", NULL);
     int k = -1;
     for (int i = 0; i < (int)(sizeof op_names / sizeof op_names[0]); i++)
         if (!strcmp(op_names[i], op->valuestring)) k = i;
-    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, ffd_travel, taper, twist, bend, cage, laplacian or arap)", op->valuestring);
+    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, ffd_travel, ffd_keys, taper, twist, bend, cage, laplacian or arap)", op->valuestring);
     plan->op = (op_kind)k;
     mk_result r = check_fields(ctx, ch, path, common_fields, op_fields[k]);
     if (r != MK_OK) return r;
@@ -765,6 +823,7 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     case OP_TAPER: case OP_TWIST: case OP_BEND: r = parse_barr(ctx, plan, ch, path); break;
     case OP_FFD: r = parse_ffd(ctx, plan, ch, path, NULL); break;
     case OP_FFD_TRAVEL: r = parse_ffd_travel(ctx, plan, ch, path); break;
+    case OP_FFD_KEYS: r = parse_ffd_keys(ctx, plan, ch, path); break;
     case OP_CAGE: r = parse_cage(ctx, plan, ch, path); break;
     case OP_LAPLACIAN: case OP_ARAP: r = parse_edit(ctx, plan, ch, path); break;
     }
@@ -826,7 +885,7 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
         pw.map = mk_barr_map; pw.user = &plan->barr;
         deformer.eval = bake_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
         break;
-    case OP_FFD:
+    case OP_FFD: case OP_FFD_KEYS:
         pw.map = mk_ffd_map; pw.user = &plan->ffd;
         deformer.eval = bake_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
         break;
@@ -890,6 +949,63 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
     return MK_OK;
 }
 
+/* ffd_keys: one channel per key (the lattice at that key, one exact target each: FFD is linear
+ * in the control points) and a clip that cross-fades consecutive keys linearly, so the clip
+ * plays the lattice with its control points interpolated linearly between keys. */
+static mk_result bake_ffd_keys(recipe_ctx *ctx, channel_plan *plan, int index, mk_bake_report *report)
+{
+    mk_raw_asset *raw = ctx->raw;
+    uint32_t n = plan->key_count;
+    char base[sizeof plan->name];
+    memcpy(base, plan->name, sizeof base);
+    uint32_t *channel = mk_arena_array(ctx->scratch, n, sizeof(uint32_t));
+    if (!channel) return mk_error_oom(ctx->err, "lattice keys");
+    size_t values = 3 * (size_t)plan->ffd.dims[0] * plan->ffd.dims[1] * plan->ffd.dims[2];
+    uint32_t track_count = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        /* A key with the lattice at rest contributes zero displacement: no channel, no track. */
+        uint32_t q = 0;
+        while (q < values && plan->key_displacements[k][q] == 0) q++;
+        channel[k] = UINT32_MAX;
+        if (q == values) continue;
+        snprintf(plan->name, sizeof plan->name, "%.119s.key%u", base, k % 1000);
+        plan->ffd.displacements = plan->key_displacements[k];
+        mk_result r = bake_plan(ctx, plan, index, report);
+        if (r != MK_OK) return r;
+        channel[k] = raw->channel_count - 1;
+        track_count++;
+    }
+    memcpy(plan->name, base, sizeof base);
+    if (track_count == 0)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "channels[%d].keys: no key moves the lattice", index);
+    mk_raw_track *tracks = mk_arena_array(&raw->arena, n, sizeof *tracks);
+    mk_key *keys = mk_arena_array(&raw->arena, 3 * (size_t)n, sizeof *keys);
+    char *name = mk_arena_strdup(&raw->arena, base);
+    mk_raw_clip *clip = tracks && keys && name ? mk_raw_add_clips(raw, 1) : NULL;
+    if (!clip) return mk_error_oom(ctx->err, "lattice key clip");
+    const double *t = plan->key_times;
+    for (uint32_t k = 0, track = 0; k < n; k++) {
+        if (channel[k] == UINT32_MAX) continue;
+        /* Hat function: 0 at the previous key, 1 at this one, 0 at the next (held outside). */
+        mk_key *kk = keys + 3 * (size_t)k;
+        uint32_t m = 0;
+        if (k > 0) kk[m++] = (mk_key){ .time = (float)t[k - 1], .value = 0 };
+        kk[m++] = (mk_key){ .time = (float)t[k], .value = 1 };
+        if (k + 1 < n) kk[m++] = (mk_key){ .time = (float)t[k + 1], .value = 0 };
+        for (uint32_t i = 0; i < m; i++) {
+            kk[i].interp = MK_INTERP_LINEAR;
+            kk[i].left_weight = kk[i].right_weight = 1.0f / 3;
+        }
+        tracks[track++] = (mk_raw_track){ .channel = channel[k], .key_count = m, .keys = kk };
+    }
+    clip->name = name;
+    clip->start = 0;
+    clip->duration = (float)t[n - 1];
+    clip->track_count = track_count;
+    clip->tracks = tracks;
+    return MK_OK;
+}
+
 static mk_result run_recipe(recipe_ctx *ctx, const char *json, size_t size, mk_bake_report *report)
 {
     const char *end = NULL;
@@ -921,7 +1037,8 @@ static mk_result run_recipe(recipe_ctx *ctx, const char *json, size_t size, mk_b
     for (const cJSON *ch = channels->child; ch; ch = ch->next, i++)
         if ((r = parse_channel(ctx, ch, i, mesh_item != NULL, top_mesh, &plans[i])) != MK_OK) goto done;
     for (i = 0; i < count; i++)
-        if ((r = bake_plan(ctx, &plans[i], i, report)) != MK_OK) goto done;
+        if ((r = plans[i].op == OP_FFD_KEYS ? bake_ffd_keys(ctx, &plans[i], i, report)
+                                            : bake_plan(ctx, &plans[i], i, report)) != MK_OK) goto done;
 done:
     cJSON_Delete(root);
     return r;

@@ -968,6 +968,78 @@ static void ffd_travel_through_a_bent_lattice_follows_the_bernstein_formula(void
     mk_raw_free(&raw);
 }
 
+/* Displacements of the test's lattice keys: 3 x 3 x 4 points, layer k = 3 (and 2) moved. */
+static void lattice_key_displacements(int key, double *d)
+{
+    memset(d, 0, 36 * 3 * sizeof(double));
+    for (int p = 0; p < 9; p++) {
+        double *top = d + 3 * (27 + p), *below = d + 3 * (18 + p);
+        if (key == 1) top[0] = 0.5;
+        if (key == 2) { top[1] = 0.4; top[2] = 0.2; below[2] = -0.3; }
+    }
+}
+
+static void ffd_keys_clip_interpolates_the_lattice_linearly(void)
+{
+    mk_raw_asset raw;
+    /* FFD is linear in the control points: one channel per key, cross-faded linearly by the
+     * clip, plays the lattice with linearly interpolated control points, exactly (to float). */
+    const char *recipe = "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"wobble\", \"op\": \"ffd_keys\","
+        " \"dims\": [3, 3, 4], \"origin\": [-1.5, -1.5, -0.5], \"axes\": [[3, 0, 0], [0, 3, 0], [0, 0, 5]],"
+        " \"keys\": [{\"time\": 0}, {\"time\": 1, \"moves\": [{\"k\": 3, \"translate\": [0.5, 0, 0]}]},"
+        "  {\"time\": 3, \"moves\": [{\"k\": 3, \"translate\": [0, 0.4, 0.2]}, {\"k\": 2, \"translate\": [0, 0, -0.3]}]}]}]}";
+    const mk_raw_mesh *m = baked_cylinder(&raw, "tube", 1, 4, 16, 8, recipe);
+    if (!m) return;
+    /* key 0 leaves the lattice at rest: no channel for it */
+    CHECK_EQ_INT(raw.channel_count, 2);
+    CHECK_EQ_INT(raw.clip_count, 1);
+    CHECK(!find_channel(&raw, "wobble.key0") && find_channel(&raw, "wobble.key1") && find_channel(&raw, "wobble.key2"));
+    for (uint32_t c = 0; c < raw.channel_count; c++) CHECK(raw.channels[c].target_count == 1);
+    mk_asset asset;
+    if (raw.channel_count != 2 || !write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
+    double keyed[3][108], d[108] = { 0 };
+    for (int k = 0; k < 3; k++) lattice_key_displacements(k, keyed[k]);
+    mk_ffd_lattice f = { .basis = MK_FFD_BERNSTEIN, .dims = { 3, 3, 4 }, .origin = { -1.5, -1.5, -0.5 },
+                         .axes = { { 3, 0, 0 }, { 0, 3, 0 }, { 0, 0, 5 } }, .displacements = d };
+    mk_error err;
+    CHECK(mk_ffd_prepare(&f, &err) == MK_OK);
+    size_t scratch_size = mk_eval_scratch_size(&asset, 0);
+    void *scratch = scratch_size ? aligned_alloc(16, (scratch_size + 15) / 16 * 16) : NULL;
+    float *out = malloc(3 * m->vertex_count * sizeof(float)), weights[2];
+    const double times[] = { -0.5, 0, 0.25, 0.5, 1, 1.7, 2.5, 3, 4 }, key_time[3] = { 0, 1, 3 };
+    double worst = 0, moved = 0;
+    for (size_t i = 0; i < sizeof times / sizeof times[0]; i++) {
+        mk_sample_job sj = { .asset = &asset, .clip = 0, .time = times[i], .weights = weights, .weight_count = 2 };
+        mk_eval_job ej = { .asset = &asset, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = weights,
+                           .weight_count = 2, .scratch = scratch, .scratch_size = scratch_size,
+                           .positions = out, .positions_size = 3 * m->vertex_count * sizeof(float) };
+        mk_result r = mk_sample_run(&sj, &err);
+        if (r == MK_OK) r = mk_eval_run(&ej, &err);
+        CHECK_MSG(r == MK_OK, "sample/eval: %s", err.message);
+        if (r != MK_OK) break;
+        /* Control points interpolated linearly between the keys (held outside). */
+        double t = fmin(fmax(times[i], 0), 3);
+        int k = t < 1 ? 0 : 1;
+        double lambda = (t - key_time[k]) / (key_time[k + 1] - key_time[k]);
+        for (int q = 0; q < 108; q++) d[q] = (1 - lambda) * keyed[k][q] + lambda * keyed[k + 1][q];
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, e[3], J[9];
+            mk_ffd_map(&f, 1, p, e, J);
+            for (int c = 0; c < 3; c++) {
+                worst = fmax(worst, fabs(out[3 * v + c] - e[c]));
+                moved = fmax(moved, fabs(e[c] - p[c]));
+            }
+        }
+    }
+    fprintf(stderr, "ffd_keys: clip playback vs interpolated lattice: max difference %.3g (largest motion %.3g)\n",
+            worst, moved);
+    CHECK(moved > 0.2);
+    CHECK_MSG(worst < 2e-6, "clip playback differs from the interpolated lattice by %g", worst);
+    free(out);
+    free(scratch);
+    mk_raw_free(&raw);
+}
+
 static void fixed_inbetweens_and_linear_ops(void)
 {
     mk_raw_asset raw;
@@ -1021,27 +1093,6 @@ static void bad_recipes_name_the_field(void)
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd\", \"origin\": [0, 0, 0],"
                        " \"axes\": [[1, 0, 0], [0, 1, 0], [1, 1, 0]]}]}", "degenerate");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd\", \"dims\": [1, 4, 4]}]}", "channels[0].dims");
-    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\"}]}", "channels[0].travel: missing");
-    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {}}]}",
-                 "channels[0].travel: moves nothing");
-    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0, 1e999]}}]}",
-                 "channels[0].travel.translate");
-    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0]}}]}",
-                 "channels[0].travel.translate");
-    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"shift\": [1, 0, 0]}}]}",
-                 "channels[0].travel.shift: unknown field");
-    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"duration\": 0,"
-                       " \"travel\": {\"translate\": [1, 0, 0]}}]}", "channels[0].duration");
-    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0, 0]},"
-                       " \"moves\": [{\"j\": 1, \"translate\": [0, 0.2, 0]}]}]}", "moves the mesh before it travels");
-    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0, 0]},"
-                       " \"origin\": [0, 0, 0], \"axes\": [[1, 0, 0], [2, 0, 0], [0, 0, 1]]}]}", "degenerate");
-    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"convergence\": -0.1,"
-                       " \"handles\": [{\"indices\": [0]}]}]}", "channels[0].convergence: must be in [0, 1)");
-    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"convergence\": 1e999,"
-                       " \"handles\": [{\"indices\": [0]}]}]}", "channels[0].convergence");
-    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"acceleration\": \"fast\","
-                       " \"handles\": [{\"indices\": [0]}]}]}", "channels[0].acceleration");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"twist\", \"angle\": 1e999}]}", "channels[0].angle");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"twist\", \"angle\": NaN}]}", "JSON");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"twist\"}]}", "channels[0].angle: missing");
@@ -1060,6 +1111,51 @@ static void bad_recipes_name_the_field(void)
     /* a later channel failing drops the earlier ones too (all or nothing) */
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"twist\", \"angle\": 30}, {\"op\": \"nope\"}]}", "channels[1].op");
     CHECK_EQ_INT(raw.channel_count, 0);
+    mk_raw_free(&raw);
+}
+
+static void bad_arap_and_animated_ffd_recipes_name_the_field(void)
+{
+    static const char *const cases[][2] = {
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\"}]}",
+          "channels[0].travel: missing" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\"}]}",
+          "channels[0].keys: missing" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\", \"keys\": []}]}",
+          "channels[0].keys" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\", \"keys\": [{\"time\": 0}]}]}",
+          "channels[0].keys: no key moves the lattice" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\", \"keys\": [{\"time\": 1}, {\"time\": 1}]}]}",
+          "channels[0].keys[1].time: must be later" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\", \"keys\": [{\"moves\": []}]}]}",
+          "channels[0].keys[0].time: missing" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\", \"keys\": [{\"time\": 0, \"moves\": [{\"i\": 9}]}]}]}",
+          "channels[0].keys[0].moves[0].i" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {}}]}",
+          "channels[0].travel: moves nothing" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0, 1e999]}}]}",
+          "channels[0].travel.translate" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0]}}]}",
+          "channels[0].travel.translate" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"shift\": [1, 0, 0]}}]}",
+          "channels[0].travel.shift: unknown field" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"duration\": 0, \"travel\": {\"translate\": [1, 0, 0]}}]}",
+          "channels[0].duration" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0, 0]}, \"moves\": [{\"j\": 1, \"translate\": [0, 0.2, 0]}]}]}",
+          "moves the mesh before it travels" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0, 0]}, \"origin\": [0, 0, 0], \"axes\": [[1, 0, 0], [2, 0, 0], [0, 0, 1]]}]}",
+          "degenerate" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"convergence\": -0.1, \"handles\": [{\"indices\": [0]}]}]}",
+          "channels[0].convergence: must be in [0, 1)" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"convergence\": 1e999, \"handles\": [{\"indices\": [0]}]}]}",
+          "channels[0].convergence" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"acceleration\": \"fast\", \"handles\": [{\"indices\": [0]}]}]}",
+          "channels[0].acceleration" },
+    };
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_cylinder(&raw, "tube", 1, 4, 16, 8);
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) expect_error(&raw, cases[i][0], cases[i][1]);
     mk_raw_free(&raw);
 }
 
@@ -1118,7 +1214,7 @@ static void record_channels(void *user, const mk_bake_channel_report *c)
 static void sample_recipes_bake(void)
 {
     static const char *const names[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json",
-                                         "ffd_travel.json" };
+                                         "ffd_travel.json", "ffd_keys.json" };
     const char *root = getenv("MORPHKIT_SOURCE_ROOT");
     if (!root) root = MK_SOURCE_ROOT;
     char dir[4096];
@@ -1265,5 +1361,7 @@ CHECK_MAIN(CASE(identity_deformations_give_zero_deltas),
            CASE(fixed_inbetweens_and_linear_ops),
            CASE(ffd_travel_through_an_unmoved_lattice_is_the_rigid_travel),
            CASE(ffd_travel_through_a_bent_lattice_follows_the_bernstein_formula),
+           CASE(ffd_keys_clip_interpolates_the_lattice_linearly),
            CASE(bad_recipes_name_the_field),
+           CASE(bad_arap_and_animated_ffd_recipes_name_the_field),
            CASE(bake_keeps_existing_channels))
