@@ -62,6 +62,7 @@ typedef struct channel_plan {
     uint32_t key_count;           /* ffd_keys: lattice keys, their times and displacements */
     double *key_times;
     double **key_displacements;
+    double *lattice_rest;         /* ffd, ffd_keys, ffd_cylinder: rest control points */
 } channel_plan;
 
 typedef struct recipe_ctx {
@@ -339,8 +340,8 @@ static mk_result parse_index_range(recipe_ctx *ctx, const cJSON *mv, const char 
     return MK_OK;
 }
 
-static mk_result parse_ffd_moves(recipe_ctx *ctx, const mk_ffd_lattice *f, const cJSON *obj, const char *path,
-                                 double *current, double *displacements);
+static mk_result parse_ffd_moves(recipe_ctx *ctx, const uint32_t dims[3], const cJSON *obj, const char *path,
+                                 const double *rest, double *current, double *displacements);
 
 /* bounds: the box the default lattice encloses (min, max), NULL = the mesh's bounding box. */
 static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path,
@@ -401,15 +402,16 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
     size_t count = (size_t)f->dims[0] * f->dims[1] * f->dims[2];
     plan->ffd_displacements = mk_arena_array(ctx->scratch, 3 * count, sizeof(double));
     double *current = mk_arena_array(ctx->scratch, 3 * count, sizeof(double));
-    if (!plan->ffd_displacements || !current) return mk_error_oom(ctx->err, "lattice");
+    plan->lattice_rest = mk_arena_array(ctx->scratch, 3 * count, sizeof(double));
+    if (!plan->ffd_displacements || !current || !plan->lattice_rest) return mk_error_oom(ctx->err, "lattice");
     for (uint32_t k = 0; k < f->dims[2]; k++)
         for (uint32_t j = 0; j < f->dims[1]; j++)
             for (uint32_t i = 0; i < f->dims[0]; i++)
-                mk_ffd_control_point(f, i, j, k, current + 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k)));
+                mk_ffd_control_point(f, i, j, k, plan->lattice_rest + 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k)));
     mk_error inner;
     if (mk_ffd_prepare(f, &inner) != MK_OK)
         return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
-    mk_result r = parse_ffd_moves(ctx, f, ch, path, current, plan->ffd_displacements);
+    mk_result r = parse_ffd_moves(ctx, f->dims, ch, path, plan->lattice_rest, current, plan->ffd_displacements);
     if (r != MK_OK) return r;
     f->displacements = plan->ffd_displacements;
     if (mk_ffd_prepare(f, &inner) != MK_OK)
@@ -417,11 +419,14 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
     return MK_OK;
 }
 
-/* The "moves" of obj (at path) applied to the control points `current` (rest positions on
- * entry, moved on return); displacements gets moved - rest. f is prepared. */
-static mk_result parse_ffd_moves(recipe_ctx *ctx, const mk_ffd_lattice *f, const cJSON *obj, const char *path,
-                                 double *current, double *displacements)
+/* The "moves" of obj (at path) applied to a lattice of dims control points (point (i, j, k) at
+ * index i + dims[0] (j + dims[1] k)): current starts as a copy of rest and ends moved;
+ * displacements gets moved - rest. */
+static mk_result parse_ffd_moves(recipe_ctx *ctx, const uint32_t dims[3], const cJSON *obj, const char *path,
+                                 const double *rest, double *current, double *displacements)
 {
+    size_t points = (size_t)dims[0] * dims[1] * dims[2];
+    memcpy(current, rest, 3 * points * sizeof(double));
     const cJSON *moves = cJSON_GetObjectItemCaseSensitive(obj, "moves");
     if (moves && !cJSON_IsArray(moves))
         return field_error(ctx, path, "moves", "must be an array of moves%s", NULL);
@@ -436,7 +441,7 @@ static mk_result parse_ffd_moves(recipe_ctx *ctx, const mk_ffd_lattice *f, const
         uint32_t lo[3], hi[3];
         static const char *const ijk[3] = { "i", "j", "k" };
         for (int a = 0; a < 3; a++)
-            if ((r = parse_index_range(ctx, mv, mpath, ijk[a], f->dims[a], &lo[a], &hi[a])) != MK_OK) return r;
+            if ((r = parse_index_range(ctx, mv, mpath, ijk[a], dims[a], &lo[a], &hi[a])) != MK_OK) return r;
         /* Default pivot: centroid of the selected control points (current positions). */
         double centroid[3] = { 0, 0, 0 };
         size_t sel = 0;
@@ -444,7 +449,7 @@ static mk_result parse_ffd_moves(recipe_ctx *ctx, const mk_ffd_lattice *f, const
             for (uint32_t j = lo[1]; j <= hi[1]; j++)
                 for (uint32_t i = lo[0]; i <= hi[0]; i++, sel++)
                     for (int c = 0; c < 3; c++)
-                        centroid[c] += current[3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k)) + c];
+                        centroid[c] += current[3 * (i + dims[0] * ((size_t)j + dims[1] * k)) + c];
         for (int c = 0; c < 3; c++) centroid[c] /= (double)sel;
         double pivot[3] = { centroid[0], centroid[1], centroid[2] };
         if (get_vec3(ctx, mv, mpath, "pivot", pivot) < 0) return ctx->err->code;
@@ -462,21 +467,14 @@ static mk_result parse_ffd_moves(recipe_ctx *ctx, const mk_ffd_lattice *f, const
         for (uint32_t k = lo[2]; k <= hi[2]; k++)
             for (uint32_t j = lo[1]; j <= hi[1]; j++)
                 for (uint32_t i = lo[0]; i <= hi[0]; i++) {
-                    double *p = current + 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k));
+                    double *p = current + 3 * (i + dims[0] * ((size_t)j + dims[1] * k));
                     double q[3], o[3];
                     for (int c = 0; c < 3; c++) q[c] = pivot[c] + scale[c] * (p[c] - pivot[c]) - rpivot[c];
                     mat3_mul_vec(o, R, q);
                     for (int c = 0; c < 3; c++) p[c] = rpivot[c] + o[c] + translate[c];
                 }
     }
-    for (uint32_t k = 0; k < f->dims[2]; k++)
-        for (uint32_t j = 0; j < f->dims[1]; j++)
-            for (uint32_t i = 0; i < f->dims[0]; i++) {
-                size_t q = 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k));
-                double rest[3];
-                mk_ffd_control_point(f, i, j, k, rest);
-                for (int c = 0; c < 3; c++) displacements[q + c] = current[q + c] - rest[c];
-            }
+    for (size_t q = 0; q < 3 * points; q++) displacements[q] = current[q] - rest[q];
     return MK_OK;
 }
 
@@ -706,11 +704,8 @@ static mk_result parse_ffd_keys(recipe_ctx *ctx, channel_plan *plan, const cJSON
             return field_error(ctx, kpath, "time", "must be later than the previous key's%s", NULL);
         plan->key_displacements[k] = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
         if (!plan->key_displacements[k]) return mk_error_oom(ctx->err, "lattice keys");
-        for (uint32_t kk = 0; kk < f->dims[2]; kk++)
-            for (uint32_t j = 0; j < f->dims[1]; j++)
-                for (uint32_t i = 0; i < f->dims[0]; i++)
-                    mk_ffd_control_point(f, i, j, kk, current + 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * kk)));
-        if ((r = parse_ffd_moves(ctx, f, key, kpath, current, plan->key_displacements[k])) != MK_OK) return r;
+        if ((r = parse_ffd_moves(ctx, f->dims, key, kpath, plan->lattice_rest, current, plan->key_displacements[k])) != MK_OK)
+            return r;
     }
     return MK_OK;
 }

@@ -15,6 +15,7 @@
 #include "check.h"
 #include "ffd.h"
 #include "ffd_travel.h"
+#include "ffd_cylinder.h"
 #include "fixtures.h"
 #include "inbetween.h"
 #include "surface_edit.h"
@@ -1040,6 +1041,96 @@ static void ffd_keys_clip_interpolates_the_lattice_linearly(void)
     mk_raw_free(&raw);
 }
 
+/* ---- extended FFD: cylindrical lattice ---- */
+
+static void cylinder_lattice_inverts_moves_rigidly_and_is_seamless(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_raw_mesh *m = fixture_icosphere(&raw, "ball", 1, 4);
+    /* Around the unit sphere: z from -1.1 to 1.1, control radius 1.15 (the B-spline circle of
+     * 8 sectors reaches 0.90 of it between sectors, so the sphere is inside). */
+    mk_cylinder_lattice c = { .dims = { 3, 8, 4 }, .center = { 0, 0, -1.1 }, .axis = { 0, 0, 2.2 },
+                              .reference = { 1, 0, 0 }, .inner_radius = 0, .outer_radius = 1.15 };
+    mk_error err;
+    CHECK(mk_cylinder_prepare(&c, &err) == MK_OK);
+    size_t points = 3 * 8 * 4;
+    double *d = calloc(3 * points, sizeof(double)), *stu = malloc(3 * m->vertex_count * sizeof(double));
+    c.displacements = d;
+    uint32_t most = 0, failed = 0;
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] };
+        uint32_t it = 0;
+        if (mk_cylinder_coordinates(&c, p, stu + 3 * v, &it, &err) != MK_OK) {
+            if (!failed) fprintf(stderr, "vertex %u: %s\n", v, err.message);
+            failed++;
+        }
+        if (it > most) most = it;
+    }
+    fprintf(stderr, "cylinder lattice: Newton converged for %u of %u vertices, at most %u iterations\n",
+            m->vertex_count - failed, m->vertex_count, most);
+    CHECK_EQ_INT(failed, 0);
+    /* Unmoved: the identity; moved rigidly: the mesh moves rigidly. */
+    double axis[3] = { 0.3, -0.5, 0.8 }, R[9], t[3] = { 0.2, -0.1, 0.4 }, identity = 0, rigid = 0;
+    vec3_normalize(axis);
+    mat3_rotation(R, axis, 0.9);
+    for (int pass = 0; pass < 2; pass++) {
+        for (uint32_t k = 0; k < 4; k++)
+            for (uint32_t j = 0; j < 8; j++)
+                for (uint32_t i = 0; i < 3; i++) {
+                    double P[3], RP[3];
+                    mk_cylinder_control_point(&c, i, j, k, P);
+                    mat3_mul_vec(RP, R, P);
+                    for (int q = 0; q < 3; q++) d[3 * (i + 3 * (j + 8 * k)) + q] = pass ? RP[q] + t[q] - P[q] : 0;
+                }
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, out[3], e[3];
+            mk_cylinder_eval(&c, 1, stu + 3 * v, p, out);
+            mat3_mul_vec(e, R, p);
+            for (int q = 0; q < 3; q++) {
+                if (!pass) identity = fmax(identity, fabs(out[q] - p[q]));
+                else rigid = fmax(rigid, fabs(out[q] - e[q] - t[q]));
+            }
+        }
+    }
+    double diag = diag_of(m);
+    fprintf(stderr, "cylinder lattice: identity error %.3g, rigid motion error %.3g x diagonal\n", identity / diag, rigid / diag);
+    CHECK(identity <= 1e-6 * diag);
+    CHECK_MSG(rigid <= 1e-6 * diag, "rigid lattice motion moves the mesh %g x diagonal off", rigid / diag);
+    /* Seam: sector 0 alone moved; points just either side of angle 0 land together. */
+    memset(d, 0, 3 * points * sizeof(double));
+    for (uint32_t k = 0; k < 4; k++)
+        for (uint32_t i = 1; i < 3; i++) d[3 * (i + 3 * (0 + 8 * k)) + 1] = 0.3;
+    double gap = 0;
+    uint32_t seam_failures = 0;
+    for (int z = 0; z <= 10; z++)
+        for (int r = 1; r <= 10; r++) {
+            double side[2][3];
+            for (int sgn = 0; sgn < 2; sgn++) {
+                double a = sgn ? 1e-9 : -1e-9, p[3] = { 0.1 * r * cos(a), 0.1 * r * sin(a), -1 + 0.2 * z }, q[3];
+                seam_failures += mk_cylinder_coordinates(&c, p, q, NULL, &err) != MK_OK;
+                mk_cylinder_eval(&c, 1, q, p, side[sgn]);
+            }
+            double g[3];
+            vec3_sub(g, side[0], side[1]);
+            gap = fmax(gap, vec3_length(g));
+        }
+    fprintf(stderr, "cylinder lattice: largest gap across the seam %.3g\n", gap);
+    CHECK_EQ_INT(seam_failures, 0);
+    CHECK(gap <= 1e-6 * diag);
+    /* Outside, and degenerate lattices, are errors. */
+    double far[3] = { 0, 0, 5 }, q[3];
+    CHECK(mk_cylinder_coordinates(&c, far, q, NULL, &err) != MK_OK && strstr(err.message, "outside"));
+    mk_cylinder_lattice flat = c;
+    flat.axis[2] = 0;
+    CHECK(mk_cylinder_prepare(&flat, &err) != MK_OK && strstr(err.message, "axis"));
+    flat = c;
+    flat.outer_radius = 0;
+    CHECK(mk_cylinder_prepare(&flat, &err) != MK_OK && strstr(err.message, "radius"));
+    free(d); free(stu);
+    mk_raw_free(&raw);
+}
+
 static void fixed_inbetweens_and_linear_ops(void)
 {
     mk_raw_asset raw;
@@ -1362,6 +1453,7 @@ CHECK_MAIN(CASE(identity_deformations_give_zero_deltas),
            CASE(ffd_travel_through_an_unmoved_lattice_is_the_rigid_travel),
            CASE(ffd_travel_through_a_bent_lattice_follows_the_bernstein_formula),
            CASE(ffd_keys_clip_interpolates_the_lattice_linearly),
+           CASE(cylinder_lattice_inverts_moves_rigidly_and_is_seamless),
            CASE(bad_recipes_name_the_field),
            CASE(bad_arap_and_animated_ffd_recipes_name_the_field),
            CASE(bake_keeps_existing_channels))
