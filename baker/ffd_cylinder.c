@@ -201,3 +201,34 @@ void mk_cylinder_eval(const mk_cylinder_lattice *c, double amplitude, const doub
     lattice_eval(c, q, c->displacements, amplitude, moved, NULL);
     for (int k = 0; k < 3; k++) out[k] = p[k] + moved[k];
 }
+
+double mk_cylinder_ring_ratio(uint32_t sectors)
+{
+    /* |C(t)| for control points on the unit circle, sampled 64 times per sector (the minimum
+     * is between sectors, where the curve cuts the chord the most). */
+    double least = 1;
+    for (uint32_t q = 0; q < 64 * sectors; q++) {
+        uint32_t taps[4];
+        double w[4], dw[4], x = 0, y = 0;
+        periodic_bspline(sectors, (double)q / (64 * sectors), taps, w, dw);
+        for (int b = 0; b < 4; b++) {
+            x += w[b] * cos(2 * PI * taps[b] / sectors);
+            y += w[b] * sin(2 * PI * taps[b] / sectors);
+        }
+        least = fmin(least, sqrt(x * x + y * y));
+    }
+    return least;
+}
+
+mk_result mk_cylinder_bind(const mk_cylinder_lattice *c, const mk_raw_mesh *mesh, double *stu, mk_error *err)
+{
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        const float *pf = mesh->positions + 3 * (size_t)v;
+        double p[3] = { pf[0], pf[1], pf[2] };
+        mk_error inner;
+        if (mk_cylinder_coordinates(c, p, stu + 3 * (size_t)v, NULL, &inner) != MK_OK)
+            return mk_error_set(err, inner.code, UINT64_MAX, "vertex %u (%g, %g, %g): %s", v, p[0], p[1], p[2],
+                                inner.message);
+    }
+    return MK_OK;
+}

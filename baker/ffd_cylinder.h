@@ -39,4 +39,12 @@ mk_result mk_cylinder_coordinates(const mk_cylinder_lattice *lattice, const doub
 void mk_cylinder_eval(const mk_cylinder_lattice *lattice, double amplitude, const double stu[3], const double p[3],
                       double out[3]);
 
+/* Smallest radius of the rest lattice's ring curve for a unit control radius (about 0.90 for 8
+ * sectors): a control radius of R / ratio encloses everything within R of the axis. */
+double mk_cylinder_ring_ratio(uint32_t sectors);
+
+/* Coordinates of every vertex of mesh into stu (3 per vertex); the error names the first
+ * vertex outside the lattice or where Newton failed. */
+mk_result mk_cylinder_bind(const mk_cylinder_lattice *lattice, const mk_raw_mesh *mesh, double *stu, mk_error *err);
+
 #endif

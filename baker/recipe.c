@@ -17,15 +17,16 @@
 #include "cage_mvc.h"
 #include "ffd.h"
 #include "ffd_travel.h"
+#include "ffd_cylinder.h"
 #include "inbetween.h"
 #include "surface_edit.h"
 #include "obj.h"
 
 #define PI 3.14159265358979323846
 
-typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP, OP_FFD_TRAVEL, OP_FFD_KEYS } op_kind;
+typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP, OP_FFD_TRAVEL, OP_FFD_KEYS, OP_FFD_CYLINDER } op_kind;
 
-static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap", "ffd_travel", "ffd_keys" };
+static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap", "ffd_travel", "ffd_keys", "ffd_cylinder" };
 
 /* Fields accepted by every op, and per op. */
 static const char *const common_fields[] = { "name", "op", "mesh", "inbetweens", "tolerance",
@@ -41,6 +42,8 @@ static const char *const op_fields[][12] = {
                   "convergence", "acceleration", NULL },
     [OP_FFD_TRAVEL] = { "dims", "basis", "origin", "axes", "padding", "moves", "travel", "duration", NULL },
     [OP_FFD_KEYS] = { "dims", "basis", "origin", "axes", "padding", "keys", NULL },
+    [OP_FFD_CYLINDER] = { "dims", "axis", "center", "range", "radius", "inner_radius", "reference", "padding",
+                          "moves", NULL },
 };
 
 /* Everything parsed for one channel before baking. */
@@ -63,6 +66,8 @@ typedef struct channel_plan {
     double *key_times;
     double **key_displacements;
     double *lattice_rest;         /* ffd, ffd_keys, ffd_cylinder: rest control points */
+    mk_cylinder_lattice cylinder;
+    double *cylinder_coordinates; /* ffd_cylinder: (s, t, u) per vertex */
 } channel_plan;
 
 typedef struct recipe_ctx {
@@ -710,6 +715,114 @@ static mk_result parse_ffd_keys(recipe_ctx *ctx, channel_plan *plan, const cJSON
     return MK_OK;
 }
 
+/* ffd_cylinder: the cylindrical lattice around the axis, its moves, every vertex's coordinates. */
+static mk_result parse_ffd_cylinder(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    const mk_raw_mesh *mesh = &ctx->raw->meshes[plan->mesh];
+    mk_cylinder_lattice *c = &plan->cylinder;
+    memset(c, 0, sizeof *c);
+    c->dims[0] = 3; c->dims[1] = 8; c->dims[2] = 4;
+    const cJSON *dims = cJSON_GetObjectItemCaseSensitive(ch, "dims");
+    if (dims) {
+        static const double least[3] = { 2, 3, 2 };
+        if (!cJSON_IsArray(dims) || cJSON_GetArraySize(dims) != 3)
+            return field_error(ctx, path, "dims", "must be [rings, sectors, layers]%s", NULL);
+        int a = 0;
+        for (const cJSON *e = dims->child; e; e = e->next, a++) {
+            double v = e->valuedouble;
+            if (!cJSON_IsNumber(e) || !isfinite(v) || v != floor(v) || v < least[a] || v > (untrusted(ctx) ? 8 : 64))
+                return field_error(ctx, path, "dims", "rings 2..64, sectors 3..64, layers 2..64 (8 when untrusted)%s", NULL);
+            c->dims[a] = (uint32_t)v;
+        }
+    }
+    double axis[3], bmin[3], bmax[3], diag, padding = 0.05;
+    mk_result r = parse_axis(ctx, ch, path, axis);
+    if (r != MK_OK) return r;
+    vec3_normalize(axis);
+    bake_bounds(mesh, bmin, bmax, &diag);
+    double center[3];
+    for (int k = 0; k < 3; k++) center[k] = 0.5 * (bmin[k] + bmax[k]);
+    if (get_vec3(ctx, ch, path, "center", center) < 0) return ctx->err->code;
+    if ((r = get_number(ctx, ch, path, "padding", &padding, 0)) != MK_OK) return r;
+    if (padding < 0) return field_error(ctx, path, "padding", "must be >= 0%s", NULL);
+    /* Extent along the axis and largest distance from it. */
+    double lo = INFINITY, hi = -INFINITY, far = 0;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        const float *pf = mesh->positions + 3 * (size_t)v;
+        double d[3] = { pf[0] - center[0], pf[1] - center[1], pf[2] - center[2] }, a = vec3_dot(d, axis);
+        lo = fmin(lo, a + vec3_dot(center, axis)); hi = fmax(hi, a + vec3_dot(center, axis));
+        for (int k = 0; k < 3; k++) d[k] -= a * axis[k];
+        far = fmax(far, vec3_length(d));
+    }
+    double range[2] = { lo - padding * diag, hi + padding * diag };
+    const cJSON *ritem = cJSON_GetObjectItemCaseSensitive(ch, "range");
+    if (ritem) {
+        if (!cJSON_IsArray(ritem) || cJSON_GetArraySize(ritem) != 2 || !cJSON_IsNumber(ritem->child) ||
+            !cJSON_IsNumber(ritem->child->next) || !isfinite(ritem->child->valuedouble) ||
+            !isfinite(ritem->child->next->valuedouble))
+            return field_error(ctx, path, "range", "must be [min, max] along the axis (p . axis, mesh units)%s", NULL);
+        range[0] = ritem->child->valuedouble;
+        range[1] = ritem->child->next->valuedouble;
+    }
+    if (!(range[1] > range[0])) return field_error(ctx, path, "range", "must have min < max%s", NULL);
+    c->outer_radius = (far + padding * diag) / mk_cylinder_ring_ratio(c->dims[1]);
+    if ((r = get_number(ctx, ch, path, "radius", &c->outer_radius, 0)) != MK_OK) return r;
+    if ((r = get_number(ctx, ch, path, "inner_radius", &c->inner_radius, 0)) != MK_OK) return r;
+    /* Default reference: the coordinate axis least aligned with the cylinder's. */
+    int least = 0;
+    for (int k = 1; k < 3; k++) if (fabs(axis[k]) < fabs(axis[least])) least = k;
+    c->reference[least] = 1;
+    if (get_vec3(ctx, ch, path, "reference", c->reference) < 0) return ctx->err->code;
+    for (int k = 0; k < 3; k++) {
+        c->center[k] = center[k] + (range[0] - vec3_dot(center, axis)) * axis[k];
+        c->axis[k] = (range[1] - range[0]) * axis[k];
+    }
+    mk_error inner;
+    if (mk_cylinder_prepare(c, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
+    size_t points = (size_t)c->dims[0] * c->dims[1] * c->dims[2];
+    plan->lattice_rest = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+    double *current = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+    double *displacements = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+    plan->cylinder_coordinates = mk_arena_array(ctx->scratch, 3 * (size_t)mesh->vertex_count, sizeof(double));
+    if (!plan->lattice_rest || !current || !displacements || !plan->cylinder_coordinates)
+        return mk_error_oom(ctx->err, "cylinder lattice");
+    for (uint32_t k = 0; k < c->dims[2]; k++)
+        for (uint32_t j = 0; j < c->dims[1]; j++)
+            for (uint32_t i = 0; i < c->dims[0]; i++)
+                mk_cylinder_control_point(c, i, j, k, plan->lattice_rest + 3 * (i + c->dims[0] * ((size_t)j + c->dims[1] * k)));
+    if ((r = parse_ffd_moves(ctx, c->dims, ch, path, plan->lattice_rest, current, displacements)) != MK_OK) return r;
+    if (c->inner_radius == 0)
+        /* Ring 0 is on the axis: its points of one layer are one point; they move by their mean. */
+        for (uint32_t k = 0; k < c->dims[2]; k++) {
+            double mean[3] = { 0, 0, 0 };
+            for (uint32_t j = 0; j < c->dims[1]; j++)
+                for (int q = 0; q < 3; q++) mean[q] += displacements[3 * (c->dims[0] * ((size_t)j + c->dims[1] * k)) + q] / c->dims[1];
+            for (uint32_t j = 0; j < c->dims[1]; j++)
+                for (int q = 0; q < 3; q++) displacements[3 * (c->dims[0] * ((size_t)j + c->dims[1] * k)) + q] = mean[q];
+        }
+    c->displacements = displacements;
+    if (mk_cylinder_bind(c, mesh, plan->cylinder_coordinates, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s: %s (enlarge radius or range)", path, inner.message);
+    return MK_OK;
+}
+
+/* mk_deformer for ffd_cylinder: p + a sum w(s, t, u) d per vertex. */
+static mk_result cylinder_eval(void *user, double amplitude, double *positions, double *normals, double *tangents,
+                               uint32_t *inverted, mk_error *err)
+{
+    (void)normals; (void)tangents; (void)err;
+    const channel_plan *plan = ((const bake_pointwise *)user)->user;
+    const mk_raw_mesh *mesh = ((const bake_pointwise *)user)->mesh;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        const float *pf = mesh->positions + 3 * (size_t)v;
+        double p[3] = { pf[0], pf[1], pf[2] };
+        mk_cylinder_eval(&plan->cylinder, amplitude, plan->cylinder_coordinates + 3 * (size_t)v, p, positions + 3 * (size_t)v);
+    }
+    if (inverted) *inverted = 0;
+    return MK_OK;
+}
+
 /* ---- recipe ---- */
 
 static mk_result resolve_mesh(recipe_ctx *ctx, const cJSON *item, const char *path, uint32_t *mesh)
@@ -767,12 +880,12 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     snprintf(path, sizeof path, "channels[%d]", index);
     if (!cJSON_IsObject(ch)) return field_error(ctx, path, "", "must be an object%s", NULL);
     const cJSON *op = cJSON_GetObjectItemCaseSensitive(ch, "op");
-    if (!op) return field_error(ctx, path, "op", "missing (ffd, ffd_travel, ffd_keys, taper, twist, bend, cage, laplacian or arap)%s", NULL);
+    if (!op) return field_error(ctx, path, "op", "missing (ffd, ffd_travel, ffd_keys, ffd_cylinder, taper, twist, bend, cage, laplacian or arap)%s", NULL);
     if (!cJSON_IsString(op)) return field_error(ctx, path, "op", "must be a string%s", NULL);
     int k = -1;
     for (int i = 0; i < (int)(sizeof op_names / sizeof op_names[0]); i++)
         if (!strcmp(op_names[i], op->valuestring)) k = i;
-    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, ffd_travel, ffd_keys, taper, twist, bend, cage, laplacian or arap)", op->valuestring);
+    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, ffd_travel, ffd_keys, ffd_cylinder, taper, twist, bend, cage, laplacian or arap)", op->valuestring);
     plan->op = (op_kind)k;
     mk_result r = check_fields(ctx, ch, path, common_fields, op_fields[k]);
     if (r != MK_OK) return r;
@@ -819,6 +932,7 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     case OP_FFD: r = parse_ffd(ctx, plan, ch, path, NULL); break;
     case OP_FFD_TRAVEL: r = parse_ffd_travel(ctx, plan, ch, path); break;
     case OP_FFD_KEYS: r = parse_ffd_keys(ctx, plan, ch, path); break;
+    case OP_FFD_CYLINDER: r = parse_ffd_cylinder(ctx, plan, ch, path); break;
     case OP_CAGE: r = parse_cage(ctx, plan, ch, path); break;
     case OP_LAPLACIAN: case OP_ARAP: r = parse_edit(ctx, plan, ch, path); break;
     }
@@ -883,6 +997,10 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
     case OP_FFD: case OP_FFD_KEYS:
         pw.map = mk_ffd_map; pw.user = &plan->ffd;
         deformer.eval = bake_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
+        break;
+    case OP_FFD_CYLINDER:
+        pw.user = plan;
+        deformer.eval = cylinder_eval; deformer.user = &pw;
         break;
     case OP_FFD_TRAVEL:
         pw.map = mk_ffd_travel_map; pw.user = &plan->travel;

@@ -1131,6 +1131,40 @@ static void cylinder_lattice_inverts_moves_rigidly_and_is_seamless(void)
     mk_raw_free(&raw);
 }
 
+/* One linear target of the rigid motion below, played at weight w: p + w (M p - p) with M the
+ * turn of 40 degrees about x through (0, 0, 2), then (0.3, 0, -0.2). */
+static void turn_blend(const void *user, double w, const double p[3], double q[3], double J[9])
+{
+    (void)user;
+    static const double x_axis[3] = { 1, 0, 0 }, t[3] = { 0.3, 0, -0.2 };
+    double R[9], d[3] = { p[0], p[1], p[2] - 2 }, m[3];
+    mat3_rotation(R, x_axis, 40 * PI / 180);
+    mat3_mul_vec(m, R, d);
+    m[2] += 2;
+    for (int c = 0; c < 3; c++) q[c] = p[c] + w * (m[c] + t[c] - p[c]);
+    memcpy(J, R, sizeof R);
+}
+
+static void ffd_cylinder_recipe_moved_rigidly_plays_the_rigid_motion(void)
+{
+    mk_raw_asset raw;
+    /* Every control point turned 40 degrees about x through (0, 0, 2) and moved by
+     * (0.3, 0, -0.2): through the runtime, the tube at weight 1 is the rigidly moved tube (the
+     * B-spline sectors, Bernstein rings/layers and Newton's coordinates all have to be right). */
+    const char *recipe = "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"turn\", \"op\": \"ffd_cylinder\","
+        " \"axis\": \"z\", \"center\": [0, 0, 2], \"dims\": [3, 6, 3], \"moves\": [{\"translate\": [0.3, 0, -0.2],"
+        " \"rotate\": {\"axis\": [1, 0, 0], \"degrees\": 40, \"pivot\": [0, 0, 2]}}]}]}";
+    const mk_raw_mesh *m = baked_cylinder(&raw, "tube", 1, 4, 16, 8, recipe);
+    if (!m) return;
+    CHECK_EQ_INT(raw.channels[0].target_count, 1);
+    mk_asset asset;
+    if (!write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
+    double worst = playback_error(&asset, m, 0, 1, turn_blend, NULL);
+    fprintf(stderr, "ffd_cylinder rigid lattice motion through the runtime: %.3g x diagonal\n", worst / diag_of(m));
+    CHECK_MSG(worst <= 1e-6 * diag_of(m) + 2e-6, "off the rigid motion by %g", worst);
+    mk_raw_free(&raw);
+}
+
 static void fixed_inbetweens_and_linear_ops(void)
 {
     mk_raw_asset raw;
@@ -1208,6 +1242,18 @@ static void bad_recipes_name_the_field(void)
 static void bad_arap_and_animated_ffd_recipes_name_the_field(void)
 {
     static const char *const cases[][2] = {
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"axis\": \"z\", \"radius\": 0.5}]}",
+          "outside the lattice" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"radius\": 2, \"inner_radius\": 3}]}",
+          "channels[0].radius" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"dims\": [3, 2, 3]}]}",
+          "channels[0].dims" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"axis\": \"z\", \"range\": [1, 1]}]}",
+          "channels[0].range" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"axis\": \"z\", \"reference\": [0, 0, 2]}]}",
+          "channels[0].reference: parallel" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"radius\": 1e999}]}",
+          "channels[0].radius" },
         { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\"}]}",
           "channels[0].travel: missing" },
         { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\"}]}",
@@ -1305,7 +1351,7 @@ static void record_channels(void *user, const mk_bake_channel_report *c)
 static void sample_recipes_bake(void)
 {
     static const char *const names[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json",
-                                         "ffd_travel.json", "ffd_keys.json" };
+                                         "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json" };
     const char *root = getenv("MORPHKIT_SOURCE_ROOT");
     if (!root) root = MK_SOURCE_ROOT;
     char dir[4096];
@@ -1454,6 +1500,7 @@ CHECK_MAIN(CASE(identity_deformations_give_zero_deltas),
            CASE(ffd_travel_through_a_bent_lattice_follows_the_bernstein_formula),
            CASE(ffd_keys_clip_interpolates_the_lattice_linearly),
            CASE(cylinder_lattice_inverts_moves_rigidly_and_is_seamless),
+           CASE(ffd_cylinder_recipe_moved_rigidly_plays_the_rigid_motion),
            CASE(bad_recipes_name_the_field),
            CASE(bad_arap_and_animated_ffd_recipes_name_the_field),
            CASE(bake_keeps_existing_channels))
