@@ -17,6 +17,7 @@
 #include "ffd_travel.h"
 #include "ffd_cylinder.h"
 #include "fixtures.h"
+#include "import.h"
 #include "inbetween.h"
 #include "surface_edit.h"
 
@@ -1165,6 +1166,58 @@ static void ffd_cylinder_recipe_moved_rigidly_plays_the_rigid_motion(void)
     mk_raw_free(&raw);
 }
 
+static void ffd_cylinder_locates_every_vertex_of_corpus_meshes(void)
+{
+    /* Default lattices around real meshes: Newton must locate every vertex (the bake fails
+     * naming the vertex otherwise), and a lattice turned 30 degrees about y through the origin
+     * must turn every vertex by exactly that. */
+    static const char *const files[] = { "gltf/MorphStressTest/glTF/MorphStressTest.gltf",
+                                         "gltf/MorphPrimitivesTest/glTF/MorphPrimitivesTest.gltf",
+                                         "fbx/zbrush_d20_7500_binary.fbx" };
+    const char *recipe = "{\"mesh\": %u, \"channels\": [{\"name\": \"turn\", \"op\": \"ffd_cylinder\", \"dims\": [3, 12, 5],"
+        " \"moves\": [{\"rotate\": {\"axis\": [0, 1, 0], \"degrees\": 30, \"pivot\": [0, 0, 0]}}]}]}";
+    uint32_t meshes = 0, vertices = 0;
+    for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
+        char path[4200];
+        snprintf(path, sizeof path, "%s/%s", check_corpus_dir(), files[f]);
+        FILE *probe = fopen(path, "rb");
+        if (!probe) SKIP("corpus file %s not found", path);
+        fclose(probe);
+        for (uint32_t mesh = 0;; mesh++) {
+            mk_raw_asset raw;
+            mk_raw_init(&raw, NULL);
+            mk_error err;
+            mk_result r = mk_import_file(path, NULL, &raw, &err);
+            CHECK_MSG(r == MK_OK, "%s: %s", files[f], err.message);
+            if (r != MK_OK || mesh >= raw.mesh_count) { mk_raw_free(&raw); break; }
+            char text[512];
+            snprintf(text, sizeof text, recipe, mesh);
+            r = bake(&raw, text, &err);
+            CHECK_MSG(r == MK_OK, "%s mesh %u: %s", files[f], mesh, err.message);
+            const mk_raw_channel *ch = r == MK_OK ? find_channel(&raw, "turn") : NULL;
+            if (ch) {
+                const mk_raw_mesh *m = &raw.meshes[mesh];
+                double *pos = malloc(3 * m->vertex_count * sizeof(double)), axis[3] = { 0, 1, 0 }, R[9], worst = 0;
+                mat3_rotation(R, axis, 30 * PI / 180);
+                last_target_positions(m, ch, pos);
+                for (uint32_t v = 0; v < m->vertex_count; v++) {
+                    double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, q[3];
+                    mat3_mul_vec(q, R, p);
+                    for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(pos[3 * v + c] - q[c]));
+                }
+                CHECK_MSG(worst <= 1e-5 * diag_of(m), "%s mesh %u: off the turn by %g x diagonal", files[f], mesh,
+                          worst / diag_of(m));
+                meshes++;
+                vertices += m->vertex_count;
+                free(pos);
+            }
+            mk_raw_free(&raw);
+        }
+    }
+    fprintf(stderr, "ffd_cylinder on the corpus: %u meshes, %u vertices located, each turned rigidly\n", meshes, vertices);
+    CHECK(meshes >= 5 && vertices > 1000);
+}
+
 static void fixed_inbetweens_and_linear_ops(void)
 {
     mk_raw_asset raw;
@@ -1501,6 +1554,7 @@ CHECK_MAIN(CASE(identity_deformations_give_zero_deltas),
            CASE(ffd_keys_clip_interpolates_the_lattice_linearly),
            CASE(cylinder_lattice_inverts_moves_rigidly_and_is_seamless),
            CASE(ffd_cylinder_recipe_moved_rigidly_plays_the_rigid_motion),
+           CASE(ffd_cylinder_locates_every_vertex_of_corpus_meshes),
            CASE(bad_recipes_name_the_field),
            CASE(bad_arap_and_animated_ffd_recipes_name_the_field),
            CASE(bake_keeps_existing_channels))
