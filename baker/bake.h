@@ -4,7 +4,8 @@
  * Every baker turns a deformation of one mesh into an ordinary channel: one or more targets
  * (in-betweens with full weights in (0, 1], the last one at 1), so the runtime plays a baked
  * channel like an authored shape. The recipe format is documented in docs/baking.md; the
- * per-algorithm C APIs are in barr.h, ffd.h, cage_mvc.h, surface_edit.h and inbetween.h.
+ * per-algorithm C APIs are in barr.h, ffd.h, ffd_travel.h, ffd_cylinder.h, cage_mvc.h,
+ * surface_edit.h and inbetween.h.
  */
 #ifndef MK_BAKE_H
 #define MK_BAKE_H
@@ -52,7 +53,7 @@ typedef struct mk_bake_options {
     void *user;
     /* Nonzero for recipes from untrusted sources (fuzzing, services): cage OBJ paths are
      * refused and work is capped (samples <= 200, lattice dims <= 8, ARAP iterations <= 50,
-     * in-betweens <= 32), so a hostile recipe cannot read files or run for hours. */
+     * in-betweens <= 32, lattice keys <= 32), so a hostile recipe cannot read files or run for hours. */
     int untrusted;
     /* Called with the path of every file the recipe makes the bake read (cage OBJ files), e.g.
      * for a build system's depfile; may be NULL. */
