@@ -228,10 +228,16 @@ static void fit_rotation(const double S[9], double R[9])
     quaternion_rotation(best, R);
 }
 
-static void local_step(mk_surface_edit *s)
+/* Local step: R_i for the current positions. Returns the ARAP energy of those positions with
+ * those rotations, E = sum_i sum_j w_ij |f_ij - R_i e_ij|^2 (+ 2 w^2 |p' - c|^2 per soft
+ * constraint, the factor that makes the global step its exact minimizer), from
+ * |f - R e|^2 = |e|^2 + |f|^2 - 2 f.(R e) and sum_j w_ij f.(R e) = tr(R_i S_i); *scale gets
+ * sum w (|e|^2 + |f|^2), the size of the rounding error of E. */
+static double local_step(mk_surface_edit *s, double *scale)
 {
+    double energy = 0, magnitude = 0;
     for (uint32_t i = 0; i < s->welded; i++) {
-        double S[9] = { 0 };
+        double S[9] = { 0 }, squares = 0;
         const double *pi = s->rest + 3 * (size_t)i, *qi = s->solution + 3 * (size_t)i;
         for (uint32_t k = s->offsets[i]; k < s->offsets[i + 1]; k++) {
             uint32_t j = s->neighbors[k];
@@ -239,21 +245,160 @@ static void local_step(mk_surface_edit *s)
             const double *pj = s->rest + 3 * (size_t)j, *qj = s->solution + 3 * (size_t)j;
             double e[3] = { pi[0] - pj[0], pi[1] - pj[1], pi[2] - pj[2] };
             double f[3] = { qi[0] - qj[0], qi[1] - qj[1], qi[2] - qj[2] };
+            squares += w * (vec3_dot(e, e) + vec3_dot(f, f));
             for (int a = 0; a < 3; a++)
                 for (int c = 0; c < 3; c++) S[3 * a + c] += w * e[a] * f[c];
         }
-        fit_rotation(S, s->rotations + 9 * (size_t)i);
+        double *R = s->rotations + 9 * (size_t)i;
+        fit_rotation(S, R);
+        double trace = 0;
+        for (int a = 0; a < 3; a++)
+            for (int c = 0; c < 3; c++) trace += R[3 * c + a] * S[3 * a + c];
+        energy += squares - 2 * trace;
+        magnitude += squares;
     }
+    if (s->params.soft) {
+        double w2 = s->params.soft_weight * s->params.soft_weight;
+        for (uint32_t i = 0; i < s->welded; i++) {
+            if (s->constraint[i] < 0) continue;
+            double d[3];
+            vec3_sub(d, s->solution + 3 * (size_t)i, s->target + 3 * (size_t)i);
+            energy += 2 * w2 * vec3_dot(d, d);
+        }
+    }
+    *scale = magnitude;
+    return energy > 0 ? energy : 0;
 }
 
+static double dot(const double *a, const double *b, size_t n)
+{
+    double acc = 0;
+    for (size_t i = 0; i < n; i++) acc += a[i] * b[i];
+    return acc;
+}
+
+/* Anderson mixing coefficients: theta minimizing |f - sum_j theta_j dF_j| from the normal
+ * equations G theta = dF^T f (G = dF^T dF, m <= EDIT_ANDERSON_HISTORY), Cholesky with a small
+ * ridge. Returns 0 when G is too ill-conditioned to trust (the caller takes the plain step). */
+static int anderson_coefficients(double G[EDIT_ANDERSON_HISTORY][EDIT_ANDERSON_HISTORY],
+                                 const double *rhs, uint32_t m, double *theta)
+{
+    double L[EDIT_ANDERSON_HISTORY][EDIT_ANDERSON_HISTORY], y[EDIT_ANDERSON_HISTORY];
+    double ridge = 0;
+    for (uint32_t a = 0; a < m; a++) ridge += G[a][a];
+    ridge *= 1e-10 / m;
+    for (uint32_t a = 0; a < m; a++)
+        for (uint32_t b = 0; b <= a; b++) {
+            double v = G[a][b] + (a == b ? ridge : 0);
+            for (uint32_t k = 0; k < b; k++) v -= L[a][k] * L[b][k];
+            if (a == b) {
+                if (!(v > 1e-300)) return 0;
+                L[a][a] = sqrt(v);
+            } else L[a][b] = v / L[b][b];
+        }
+    for (uint32_t a = 0; a < m; a++) {
+        double v = rhs[a];
+        for (uint32_t k = 0; k < a; k++) v -= L[a][k] * y[k];
+        y[a] = v / L[a][a];
+    }
+    for (uint32_t a = m; a-- > 0;) {
+        double v = y[a];
+        for (uint32_t k = a + 1; k < m; k++) v -= L[k][a] * theta[k];
+        theta[a] = v / L[a][a];
+    }
+    for (uint32_t a = 0; a < m; a++)
+        if (!isfinite(theta[a])) return 0;
+    return 1;
+}
+
+/* Local/global iterations from the global step with identity rotations, as a fixed-point map
+ * x -> G(x) = global(local(x)) on the stacked positions (constrained entries are constant).
+ * Plain: x_{k+1} = G(x_k); each iteration cannot raise the energy (both steps minimize it).
+ * Anderson (H. Peng, J. Deng, J. Zhou, J. Liu, "Anderson Acceleration for Geometry
+ * Optimization and Physics Simulation", SIGGRAPH 2018): with f_k = G(x_k) - x_k and the last m
+ * differences dF, dG of f and G, x_{k+1} = G(x_k) - dG theta with theta = argmin
+ * |f_k - dF theta|; if the energy at x_{k+1} exceeds the energy at x_k, x_{k+1} = G(x_k)
+ * instead (the plain step, whose energy cannot be higher) and the history restarts, so the
+ * accepted energies decrease monotonically either way.
+ * Stops when an iteration lowers the energy by no more than params.convergence times the
+ * previous energy (or the energy is at the rounding level, 1e-14 of its terms), or after
+ * params.iterations global steps. */
 mk_result edit_arap_solve(mk_surface_edit *s, mk_error *err)
 {
+    const size_t n3 = 3 * (size_t)s->welded;
+    const uint32_t cap = s->params.iterations, window = EDIT_ANDERSON_HISTORY;
+    const double tolerance = s->params.convergence;
     mk_result r = global_step(s, 1, err);
-    for (uint32_t it = 0; r == MK_OK && it < s->params.iterations; it++) {
-        double t0 = bake_now();
-        local_step(s);
-        s->local_seconds += bake_now() - t0;
-        r = global_step(s, 0, err);
+    if (r != MK_OK) return r;
+    double *x = s->solution, *previous = s->work;
+    double *g_prev = NULL, *f_prev = NULL, *dF = NULL, *dG = NULL;
+    if (s->anderson) {
+        g_prev = s->anderson;
+        f_prev = g_prev + n3;
+        dF = f_prev + n3;
+        dG = dF + window * n3;
     }
-    return r;
+    double gram[EDIT_ANDERSON_HISTORY][EDIT_ANDERSON_HISTORY];
+    uint32_t history = 0, head = 0, it = 0;
+    int accelerated = 0;
+    double energy_prev = INFINITY, energy = 0;
+    for (;; it++) {
+        double t0 = bake_now(), scale;
+        energy = local_step(s, &scale);
+        if (accelerated && !(energy <= energy_prev)) {
+            memcpy(x, g_prev, n3 * sizeof(double));
+            energy = local_step(s, &scale);
+            history = 0;
+            s->stats.rejected_steps++;
+        }
+        s->local_seconds += bake_now() - t0;
+        if (it == 0) s->stats.start_energy = energy;
+        if (s->params.iteration_done) s->params.iteration_done(s->params.user, it, energy);
+        if (energy <= 1e-14 * scale) break;
+        if (it > 0 && tolerance >= 0 && energy_prev - energy <= tolerance * energy_prev) break;
+        if (it == cap) { s->stats.unconverged++; break; }
+        energy_prev = energy;
+        if (s->anderson) memcpy(previous, x, n3 * sizeof(double));
+        if ((r = global_step(s, 0, err)) != MK_OK) return r;
+        accelerated = 0;
+        if (!s->anderson) continue;
+        /* x now holds G(previous). New differences into slot head of the ring. */
+        t0 = bake_now();
+        double *df = dF + head * n3, *dg = dG + head * n3;
+        for (size_t i = 0; i < n3; i++) {
+            double f = x[i] - previous[i];
+            if (it > 0) { df[i] = f - f_prev[i]; dg[i] = x[i] - g_prev[i]; }
+            f_prev[i] = f;
+            g_prev[i] = x[i];
+        }
+        if (it == 0) continue;  /* the plain first step: no differences yet */
+        if (history < window) history++;
+        for (uint32_t a = 0; a < history; a++) {
+            uint32_t slot = (head + window - a) % window;
+            double v = dot(df, dF + slot * n3, n3);
+            gram[head][slot] = gram[slot][head] = v;
+        }
+        /* Work in ring order; theta per slot. */
+        double Gm[EDIT_ANDERSON_HISTORY][EDIT_ANDERSON_HISTORY], rhs[EDIT_ANDERSON_HISTORY],
+               theta[EDIT_ANDERSON_HISTORY];
+        uint32_t slots[EDIT_ANDERSON_HISTORY];
+        for (uint32_t a = 0; a < history; a++) slots[a] = (head + window - a) % window;
+        for (uint32_t a = 0; a < history; a++) {
+            rhs[a] = dot(dF + slots[a] * n3, f_prev, n3);
+            for (uint32_t b = 0; b < history; b++) Gm[a][b] = gram[slots[a]][slots[b]];
+        }
+        head = (head + 1) % window;
+        if (!anderson_coefficients(Gm, rhs, history, theta)) { history = 0; continue; }
+        for (uint32_t a = 0; a < history; a++) {
+            const double *col = dG + slots[a] * n3;
+            for (size_t i = 0; i < n3; i++) x[i] -= theta[a] * col[i];
+        }
+        accelerated = 1;
+        s->local_seconds += bake_now() - t0;
+    }
+    s->stats.evaluations++;
+    s->stats.iterations += it;
+    if (it > s->stats.max_iterations) s->stats.max_iterations = it;
+    s->stats.energy = energy;
+    return MK_OK;
 }

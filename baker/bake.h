@@ -4,7 +4,8 @@
  * Every baker turns a deformation of one mesh into an ordinary channel: one or more targets
  * (in-betweens with full weights in (0, 1], the last one at 1), so the runtime plays a baked
  * channel like an authored shape. The recipe format is documented in docs/baking.md; the
- * per-algorithm C APIs are in barr.h, ffd.h, cage_mvc.h, surface_edit.h and inbetween.h.
+ * per-algorithm C APIs are in barr.h, ffd.h, ffd_travel.h, ffd_cylinder.h, cage_mvc.h,
+ * surface_edit.h and inbetween.h.
  */
 #ifndef MK_BAKE_H
 #define MK_BAKE_H
@@ -32,6 +33,12 @@ typedef struct mk_bake_channel_report {
     double factor_seconds;     /* Laplacian/ARAP: analyze + factorize wall time */
     double solve_seconds;      /* Laplacian/ARAP: total time of all triangular solves */
     uint32_t solves;           /* Laplacian/ARAP: solves (each one with 3 right-hand sides) */
+    uint32_t iterations;       /* ARAP: local/global iterations over all evaluations */
+    uint32_t max_iterations;   /* ARAP: most iterations one evaluation took */
+    uint32_t unconverged;      /* ARAP: evaluations stopped by the iteration cap */
+    double energy;             /* ARAP: energy of the last evaluation (amplitude 1 unless the
+                                * in-between search evaluated later weights last) */
+    double start_energy;       /* ARAP: energy of that evaluation's initial guess */
     double seconds;            /* whole channel, wall time */
 } mk_bake_channel_report;
 
@@ -46,7 +53,7 @@ typedef struct mk_bake_options {
     void *user;
     /* Nonzero for recipes from untrusted sources (fuzzing, services): cage OBJ paths are
      * refused and work is capped (samples <= 200, lattice dims <= 8, ARAP iterations <= 50,
-     * in-betweens <= 32), so a hostile recipe cannot read files or run for hours. */
+     * in-betweens <= 32, lattice keys <= 32), so a hostile recipe cannot read files or run for hours. */
     int untrusted;
     /* Called with the path of every file the recipe makes the bake read (cage OBJ files), e.g.
      * for a build system's depfile; may be NULL. */

@@ -18,6 +18,11 @@ static inline void vec3_cross(double out[3], const double a[3], const double b[3
            z = a[0] * b[1] - a[1] * b[0];
     out[0] = x; out[1] = y; out[2] = z;
 }
+static inline void vec3_sub(double out[3], const double a[3], const double b[3])
+{
+    out[0] = a[0] - b[0]; out[1] = a[1] - b[1]; out[2] = a[2] - b[2];
+}
+
 static inline double vec3_length(const double a[3]) { return sqrt(vec3_dot(a, a)); }
 /* Normalizes in place; returns the old length (0 leaves the vector unchanged). */
 static inline double vec3_normalize(double a[3])

@@ -115,7 +115,7 @@ static double span_error(sampler *s, uint32_t a, uint32_t c, double limit, mk_er
     uint32_t mid = a + (c - a) / 2;
     for (uint32_t q = 0; q + a + 1 < c; q++) {
         /* visit mid first, then the others in order */
-        uint32_t k = q == 0 ? mid : (a + q <= mid ? a + q : a + q + 1);
+        uint32_t k = q == 0 ? mid : (a + q < mid ? a + q : a + q + 1);
         if (k <= a || k >= c) continue;
         const float *ds = get_sample(s, k, 2, err);
         if (!ds) return -1;

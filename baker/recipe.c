@@ -16,15 +16,17 @@
 #include "barr.h"
 #include "cage_mvc.h"
 #include "ffd.h"
+#include "ffd_travel.h"
+#include "ffd_cylinder.h"
 #include "inbetween.h"
 #include "surface_edit.h"
 #include "obj.h"
 
 #define PI 3.14159265358979323846
 
-typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP } op_kind;
+typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP, OP_FFD_TRAVEL, OP_FFD_KEYS, OP_FFD_CYLINDER } op_kind;
 
-static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap" };
+static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap", "ffd_travel", "ffd_keys", "ffd_cylinder" };
 
 /* Fields accepted by every op, and per op. */
 static const char *const common_fields[] = { "name", "op", "mesh", "inbetweens", "tolerance",
@@ -36,7 +38,12 @@ static const char *const op_fields[][12] = {
     [OP_BEND] = { "axis", "center", "range", "angle", "direction", NULL },
     [OP_CAGE] = { "cage", "deformed_cage", NULL },
     [OP_LAPLACIAN] = { "weights", "constraints", "soft_weight", "anchors", "handles", NULL },
-    [OP_ARAP] = { "weights", "constraints", "soft_weight", "anchors", "handles", "iterations", NULL },
+    [OP_ARAP] = { "weights", "constraints", "soft_weight", "anchors", "handles", "iterations",
+                  "convergence", "acceleration", NULL },
+    [OP_FFD_TRAVEL] = { "dims", "basis", "origin", "axes", "padding", "moves", "travel", "duration", NULL },
+    [OP_FFD_KEYS] = { "dims", "basis", "origin", "axes", "padding", "keys", NULL },
+    [OP_FFD_CYLINDER] = { "dims", "axis", "center", "range", "radius", "inner_radius", "reference", "padding",
+                          "moves", NULL },
 };
 
 /* Everything parsed for one channel before baking. */
@@ -53,6 +60,14 @@ typedef struct channel_plan {
     mk_cage cage;
     mk_edit_params edit;
     mk_edit_handle *handles;
+    mk_ffd_travel travel;
+    double clip_duration;         /* ffd_travel: seconds of the clip playing 0 -> 1; 0 = no clip */
+    uint32_t key_count;           /* ffd_keys: lattice keys, their times and displacements */
+    double *key_times;
+    double **key_displacements;
+    double *lattice_rest;         /* ffd, ffd_keys, ffd_cylinder: rest control points */
+    mk_cylinder_lattice cylinder;
+    double *cylinder_coordinates; /* ffd_cylinder: (s, t, u) per vertex */
 } channel_plan;
 
 typedef struct recipe_ctx {
@@ -330,7 +345,12 @@ static mk_result parse_index_range(recipe_ctx *ctx, const cJSON *mv, const char 
     return MK_OK;
 }
 
-static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+static mk_result parse_ffd_moves(recipe_ctx *ctx, const uint32_t dims[3], const cJSON *obj, const char *path,
+                                 const double *rest, double *current, double *displacements);
+
+/* bounds: the box the default lattice encloses (min, max), NULL = the mesh's bounding box. */
+static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path,
+                           const double (*bounds)[3])
 {
     const mk_raw_mesh *mesh = &ctx->raw->meshes[plan->mesh];
     mk_ffd_lattice *f = &plan->ffd;
@@ -371,6 +391,12 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
         if (r != MK_OK) return r;
         if (padding < 0) return field_error(ctx, path, "padding", "must be >= 0%s", NULL);
         bake_bounds(mesh, bmin, bmax, &diag);
+        if (bounds) {
+            double d[3];
+            for (int c = 0; c < 3; c++) { bmin[c] = bounds[0][c]; bmax[c] = bounds[1][c]; }
+            vec3_sub(d, bmax, bmin);
+            diag = vec3_length(d);
+        }
         double pad = padding * diag;
         for (int a = 0; a < 3; a++) {
             f->origin[a] = bmin[a] - pad;
@@ -381,15 +407,32 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
     size_t count = (size_t)f->dims[0] * f->dims[1] * f->dims[2];
     plan->ffd_displacements = mk_arena_array(ctx->scratch, 3 * count, sizeof(double));
     double *current = mk_arena_array(ctx->scratch, 3 * count, sizeof(double));
-    if (!plan->ffd_displacements || !current) return mk_error_oom(ctx->err, "lattice");
+    plan->lattice_rest = mk_arena_array(ctx->scratch, 3 * count, sizeof(double));
+    if (!plan->ffd_displacements || !current || !plan->lattice_rest) return mk_error_oom(ctx->err, "lattice");
     for (uint32_t k = 0; k < f->dims[2]; k++)
         for (uint32_t j = 0; j < f->dims[1]; j++)
             for (uint32_t i = 0; i < f->dims[0]; i++)
-                mk_ffd_control_point(f, i, j, k, current + 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k)));
+                mk_ffd_control_point(f, i, j, k, plan->lattice_rest + 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k)));
     mk_error inner;
     if (mk_ffd_prepare(f, &inner) != MK_OK)
         return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
-    const cJSON *moves = cJSON_GetObjectItemCaseSensitive(ch, "moves");
+    mk_result r = parse_ffd_moves(ctx, f->dims, ch, path, plan->lattice_rest, current, plan->ffd_displacements);
+    if (r != MK_OK) return r;
+    f->displacements = plan->ffd_displacements;
+    if (mk_ffd_prepare(f, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
+    return MK_OK;
+}
+
+/* The "moves" of obj (at path) applied to a lattice of dims control points (point (i, j, k) at
+ * index i + dims[0] (j + dims[1] k)): current starts as a copy of rest and ends moved;
+ * displacements gets moved - rest. */
+static mk_result parse_ffd_moves(recipe_ctx *ctx, const uint32_t dims[3], const cJSON *obj, const char *path,
+                                 const double *rest, double *current, double *displacements)
+{
+    size_t points = (size_t)dims[0] * dims[1] * dims[2];
+    memcpy(current, rest, 3 * points * sizeof(double));
+    const cJSON *moves = cJSON_GetObjectItemCaseSensitive(obj, "moves");
     if (moves && !cJSON_IsArray(moves))
         return field_error(ctx, path, "moves", "must be an array of moves%s", NULL);
     int m = 0;
@@ -403,7 +446,7 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
         uint32_t lo[3], hi[3];
         static const char *const ijk[3] = { "i", "j", "k" };
         for (int a = 0; a < 3; a++)
-            if ((r = parse_index_range(ctx, mv, mpath, ijk[a], f->dims[a], &lo[a], &hi[a])) != MK_OK) return r;
+            if ((r = parse_index_range(ctx, mv, mpath, ijk[a], dims[a], &lo[a], &hi[a])) != MK_OK) return r;
         /* Default pivot: centroid of the selected control points (current positions). */
         double centroid[3] = { 0, 0, 0 };
         size_t sel = 0;
@@ -411,7 +454,7 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
             for (uint32_t j = lo[1]; j <= hi[1]; j++)
                 for (uint32_t i = lo[0]; i <= hi[0]; i++, sel++)
                     for (int c = 0; c < 3; c++)
-                        centroid[c] += current[3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k)) + c];
+                        centroid[c] += current[3 * (i + dims[0] * ((size_t)j + dims[1] * k)) + c];
         for (int c = 0; c < 3; c++) centroid[c] /= (double)sel;
         double pivot[3] = { centroid[0], centroid[1], centroid[2] };
         if (get_vec3(ctx, mv, mpath, "pivot", pivot) < 0) return ctx->err->code;
@@ -429,24 +472,14 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
         for (uint32_t k = lo[2]; k <= hi[2]; k++)
             for (uint32_t j = lo[1]; j <= hi[1]; j++)
                 for (uint32_t i = lo[0]; i <= hi[0]; i++) {
-                    double *p = current + 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k));
+                    double *p = current + 3 * (i + dims[0] * ((size_t)j + dims[1] * k));
                     double q[3], o[3];
                     for (int c = 0; c < 3; c++) q[c] = pivot[c] + scale[c] * (p[c] - pivot[c]) - rpivot[c];
                     mat3_mul_vec(o, R, q);
                     for (int c = 0; c < 3; c++) p[c] = rpivot[c] + o[c] + translate[c];
                 }
     }
-    for (uint32_t k = 0; k < f->dims[2]; k++)
-        for (uint32_t j = 0; j < f->dims[1]; j++)
-            for (uint32_t i = 0; i < f->dims[0]; i++) {
-                size_t q = 3 * (i + f->dims[0] * ((size_t)j + f->dims[1] * k));
-                double rest[3];
-                mk_ffd_control_point(f, i, j, k, rest);
-                for (int c = 0; c < 3; c++) plan->ffd_displacements[q + c] = current[q + c] - rest[c];
-            }
-    f->displacements = plan->ffd_displacements;
-    if (mk_ffd_prepare(f, &inner) != MK_OK)
-        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
+    for (size_t q = 0; q < 3 * points; q++) displacements[q] = current[q] - rest[q];
     return MK_OK;
 }
 
@@ -517,8 +550,19 @@ static mk_result parse_edit(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch
     mk_result r = get_number(ctx, ch, path, "soft_weight", &e->soft_weight, 0);
     if (r != MK_OK) return r;
     if (!(e->soft_weight > 0)) return field_error(ctx, path, "soft_weight", "must be > 0%s", NULL);
-    e->iterations = 10;
+    e->iterations = untrusted(ctx) ? 50 : 1000;
     if ((r = get_uint(ctx, ch, path, "iterations", &e->iterations, 1, untrusted(ctx) ? 50 : 10000)) != MK_OK) return r;
+    e->convergence = 1e-6;
+    if ((r = get_number(ctx, ch, path, "convergence", &e->convergence, 0)) != MK_OK) return r;
+    if (!(e->convergence >= 0 && e->convergence < 1))
+        return field_error(ctx, path, "convergence", "must be in [0, 1) (0: run all iterations)%s", NULL);
+    if (e->convergence == 0) e->convergence = -1;  /* the C API's "all iterations" */
+    const cJSON *acc = cJSON_GetObjectItemCaseSensitive(ch, "acceleration");
+    if (acc) {
+        if (cJSON_IsString(acc) && !strcmp(acc->valuestring, "anderson")) e->acceleration = MK_ARAP_ANDERSON;
+        else if (cJSON_IsString(acc) && !strcmp(acc->valuestring, "none")) e->acceleration = MK_ARAP_PLAIN;
+        else return field_error(ctx, path, "acceleration", "must be \"anderson\" or \"none\"%s", NULL);
+    }
 
     unsigned char *mark = mk_arena_array(ctx->scratch, mesh->vertex_count ? mesh->vertex_count : 1, 1);
     if (!mark) return mk_error_oom(ctx->err, "selection");
@@ -567,6 +611,215 @@ static mk_result parse_edit(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch
     }
     e->handles = plan->handles;
     e->handle_count = (uint32_t)hcount;
+    return MK_OK;
+}
+
+/* ffd_travel: the travel (a rigid motion), a lattice around the swept mesh, the clip. */
+static mk_result parse_ffd_travel(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    static const char *const travel_fields[] = { "translate", "rotate", NULL };
+    const mk_raw_mesh *mesh = &ctx->raw->meshes[plan->mesh];
+    mk_ffd_travel *t = &plan->travel;
+    memset(t, 0, sizeof *t);
+    char tpath[96];
+    snprintf(tpath, sizeof tpath, "%s.travel", path);
+    const cJSON *travel = cJSON_GetObjectItemCaseSensitive(ch, "travel");
+    if (!travel) return field_error(ctx, path, "travel", "missing (translate and/or rotate: the mesh's path through the lattice)%s", NULL);
+    if (!cJSON_IsObject(travel)) return field_error(ctx, path, "travel", "must be an object {translate, rotate}%s", NULL);
+    mk_result r = check_fields(ctx, travel, tpath, travel_fields, NULL);
+    if (r != MK_OK) return r;
+    double bmin[3], bmax[3], diag, centre[3];
+    bake_bounds(mesh, bmin, bmax, &diag);
+    for (int c = 0; c < 3; c++) centre[c] = 0.5 * (bmin[c] + bmax[c]);
+    if (get_vec3(ctx, travel, tpath, "translate", t->translate) < 0) return ctx->err->code;
+    if ((r = parse_rotate(ctx, travel, tpath, t->axis, &t->angle, t->pivot, centre)) != MK_OK) return r;
+    if (vec3_length(t->translate) == 0 && t->angle == 0)
+        return field_error(ctx, tpath, "", "moves nothing: give a nonzero translate or rotate%s", NULL);
+    plan->clip_duration = 0;
+    if ((r = get_number(ctx, ch, path, "duration", &plan->clip_duration, 0)) != MK_OK) return r;
+    if (cJSON_HasObjectItem(ch, "duration") && !(plan->clip_duration > 0))
+        return field_error(ctx, path, "duration", "must be > 0 seconds%s", NULL);
+    /* Default lattice: around the mesh at 17 points of its travel. */
+    double bounds[2][3];
+    for (int c = 0; c < 3; c++) { bounds[0][c] = bmin[c]; bounds[1][c] = bmax[c]; }
+    for (int k = 1; k <= 16; k++) {
+        double R[9];
+        mat3_rotation(R, t->axis, k / 16.0 * t->angle);
+        for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+            const float *p = mesh->positions + 3 * (size_t)v;
+            double d[3] = { p[0] - t->pivot[0], p[1] - t->pivot[1], p[2] - t->pivot[2] }, q[3];
+            mat3_mul_vec(q, R, d);
+            for (int c = 0; c < 3; c++) {
+                q[c] += t->pivot[c] + k / 16.0 * t->translate[c];
+                if (q[c] < bounds[0][c]) bounds[0][c] = q[c];
+                if (q[c] > bounds[1][c]) bounds[1][c] = q[c];
+            }
+        }
+    }
+    if ((r = parse_ffd(ctx, plan, ch, path, (const double (*)[3])bounds)) != MK_OK) return r;
+    t->lattice = &plan->ffd;
+    /* The channel's weight 0 is the rest mesh: the lattice may not move the start pose. */
+    double worst = 0;
+    uint32_t worst_v = 0;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        const float *p = mesh->positions + 3 * (size_t)v;
+        double pd[3] = { p[0], p[1], p[2] }, q[3], J[9], d[3];
+        mk_ffd_travel_map(t, 0, pd, q, J);
+        vec3_sub(d, q, pd);
+        if (vec3_length(d) > worst) { worst = vec3_length(d); worst_v = v; }
+    }
+    if (worst > 1e-6 * diag) {
+        char msg[200];
+        snprintf(msg, sizeof msg, "the deformed lattice moves the mesh before it travels (vertex %u by %.3g x diagonal): "
+                 "keep the control points around the start pose at rest", worst_v, worst / diag);
+        return field_error(ctx, path, "moves", "%s", msg);
+    }
+    return MK_OK;
+}
+
+/* ffd_keys: the lattice, then per key its time and its own moves from the rest lattice. */
+static mk_result parse_ffd_keys(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    static const char *const key_fields[] = { "time", "moves", NULL };
+    mk_result r = parse_ffd(ctx, plan, ch, path, NULL);
+    if (r != MK_OK) return r;
+    if (strlen(plan->name) + 8 >= sizeof plan->name)
+        return field_error(ctx, path, "name", "must be under 120 bytes for ffd_keys (channels are named NAME.keyK)%s", NULL);
+    const cJSON *keys = cJSON_GetObjectItemCaseSensitive(ch, "keys");
+    if (!keys) return field_error(ctx, path, "keys", "missing (an array of {time, moves})%s", NULL);
+    int count = cJSON_IsArray(keys) ? cJSON_GetArraySize(keys) : 0;
+    if (count < 1 || count > (untrusted(ctx) ? 32 : 256))
+        return field_error(ctx, path, "keys", "must be an array of 1..256 keys {time, moves} (32 when untrusted)%s", NULL);
+    const mk_ffd_lattice *f = &plan->ffd;
+    size_t points = (size_t)f->dims[0] * f->dims[1] * f->dims[2];
+    plan->key_count = (uint32_t)count;
+    plan->key_times = mk_arena_array(ctx->scratch, (size_t)count, sizeof(double));
+    plan->key_displacements = mk_arena_array(ctx->scratch, (size_t)count, sizeof(double *));
+    double *current = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+    if (!plan->key_times || !plan->key_displacements || !current) return mk_error_oom(ctx->err, "lattice keys");
+    int k = 0;
+    for (const cJSON *key = keys->child; key; key = key->next, k++) {
+        char kpath[96];
+        snprintf(kpath, sizeof kpath, "%s.keys[%d]", path, k);
+        if (!cJSON_IsObject(key)) return field_error(ctx, kpath, "", "must be an object {time, moves}%s", NULL);
+        if ((r = check_fields(ctx, key, kpath, key_fields, NULL)) != MK_OK) return r;
+        if ((r = get_number(ctx, key, kpath, "time", &plan->key_times[k], 1)) != MK_OK) return r;
+        if (plan->key_times[k] < 0) return field_error(ctx, kpath, "time", "must be >= 0 seconds%s", NULL);
+        if (k > 0 && !(plan->key_times[k] > plan->key_times[k - 1]))
+            return field_error(ctx, kpath, "time", "must be later than the previous key's%s", NULL);
+        plan->key_displacements[k] = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+        if (!plan->key_displacements[k]) return mk_error_oom(ctx->err, "lattice keys");
+        if ((r = parse_ffd_moves(ctx, f->dims, key, kpath, plan->lattice_rest, current, plan->key_displacements[k])) != MK_OK)
+            return r;
+    }
+    return MK_OK;
+}
+
+/* ffd_cylinder: the cylindrical lattice around the axis, its moves, every vertex's coordinates. */
+static mk_result parse_ffd_cylinder(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    const mk_raw_mesh *mesh = &ctx->raw->meshes[plan->mesh];
+    mk_cylinder_lattice *c = &plan->cylinder;
+    memset(c, 0, sizeof *c);
+    c->dims[0] = 3; c->dims[1] = 8; c->dims[2] = 4;
+    const cJSON *dims = cJSON_GetObjectItemCaseSensitive(ch, "dims");
+    if (dims) {
+        static const double least[3] = { 2, 3, 2 };
+        if (!cJSON_IsArray(dims) || cJSON_GetArraySize(dims) != 3)
+            return field_error(ctx, path, "dims", "must be [rings, sectors, layers]%s", NULL);
+        int a = 0;
+        for (const cJSON *e = dims->child; e; e = e->next, a++) {
+            double v = e->valuedouble;
+            if (!cJSON_IsNumber(e) || !isfinite(v) || v != floor(v) || v < least[a] || v > (untrusted(ctx) ? 8 : 64))
+                return field_error(ctx, path, "dims", "rings 2..64, sectors 3..64, layers 2..64 (8 when untrusted)%s", NULL);
+            c->dims[a] = (uint32_t)v;
+        }
+    }
+    double axis[3], bmin[3], bmax[3], diag, padding = 0.05;
+    mk_result r = parse_axis(ctx, ch, path, axis);
+    if (r != MK_OK) return r;
+    vec3_normalize(axis);
+    bake_bounds(mesh, bmin, bmax, &diag);
+    double center[3];
+    for (int k = 0; k < 3; k++) center[k] = 0.5 * (bmin[k] + bmax[k]);
+    if (get_vec3(ctx, ch, path, "center", center) < 0) return ctx->err->code;
+    if ((r = get_number(ctx, ch, path, "padding", &padding, 0)) != MK_OK) return r;
+    if (padding < 0) return field_error(ctx, path, "padding", "must be >= 0%s", NULL);
+    /* Extent along the axis and largest distance from it. */
+    double lo = INFINITY, hi = -INFINITY, far = 0;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        const float *pf = mesh->positions + 3 * (size_t)v;
+        double d[3] = { pf[0] - center[0], pf[1] - center[1], pf[2] - center[2] }, a = vec3_dot(d, axis);
+        lo = fmin(lo, a + vec3_dot(center, axis)); hi = fmax(hi, a + vec3_dot(center, axis));
+        for (int k = 0; k < 3; k++) d[k] -= a * axis[k];
+        far = fmax(far, vec3_length(d));
+    }
+    double range[2] = { lo - padding * diag, hi + padding * diag };
+    const cJSON *ritem = cJSON_GetObjectItemCaseSensitive(ch, "range");
+    if (ritem) {
+        if (!cJSON_IsArray(ritem) || cJSON_GetArraySize(ritem) != 2 || !cJSON_IsNumber(ritem->child) ||
+            !cJSON_IsNumber(ritem->child->next) || !isfinite(ritem->child->valuedouble) ||
+            !isfinite(ritem->child->next->valuedouble))
+            return field_error(ctx, path, "range", "must be [min, max] along the axis (p . axis, mesh units)%s", NULL);
+        range[0] = ritem->child->valuedouble;
+        range[1] = ritem->child->next->valuedouble;
+    }
+    if (!(range[1] > range[0])) return field_error(ctx, path, "range", "must have min < max%s", NULL);
+    c->outer_radius = (far + padding * diag) / mk_cylinder_ring_ratio(c->dims[1]);
+    if ((r = get_number(ctx, ch, path, "radius", &c->outer_radius, 0)) != MK_OK) return r;
+    if ((r = get_number(ctx, ch, path, "inner_radius", &c->inner_radius, 0)) != MK_OK) return r;
+    /* Default reference: the coordinate axis least aligned with the cylinder's. */
+    int least = 0;
+    for (int k = 1; k < 3; k++) if (fabs(axis[k]) < fabs(axis[least])) least = k;
+    c->reference[least] = 1;
+    if (get_vec3(ctx, ch, path, "reference", c->reference) < 0) return ctx->err->code;
+    for (int k = 0; k < 3; k++) {
+        c->center[k] = center[k] + (range[0] - vec3_dot(center, axis)) * axis[k];
+        c->axis[k] = (range[1] - range[0]) * axis[k];
+    }
+    mk_error inner;
+    if (mk_cylinder_prepare(c, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
+    size_t points = (size_t)c->dims[0] * c->dims[1] * c->dims[2];
+    plan->lattice_rest = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+    double *current = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+    double *displacements = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+    plan->cylinder_coordinates = mk_arena_array(ctx->scratch, 3 * (size_t)mesh->vertex_count, sizeof(double));
+    if (!plan->lattice_rest || !current || !displacements || !plan->cylinder_coordinates)
+        return mk_error_oom(ctx->err, "cylinder lattice");
+    for (uint32_t k = 0; k < c->dims[2]; k++)
+        for (uint32_t j = 0; j < c->dims[1]; j++)
+            for (uint32_t i = 0; i < c->dims[0]; i++)
+                mk_cylinder_control_point(c, i, j, k, plan->lattice_rest + 3 * (i + c->dims[0] * ((size_t)j + c->dims[1] * k)));
+    if ((r = parse_ffd_moves(ctx, c->dims, ch, path, plan->lattice_rest, current, displacements)) != MK_OK) return r;
+    if (c->inner_radius == 0)
+        /* Ring 0 is on the axis: its points of one layer are one point; they move by their mean. */
+        for (uint32_t k = 0; k < c->dims[2]; k++) {
+            double mean[3] = { 0, 0, 0 };
+            for (uint32_t j = 0; j < c->dims[1]; j++)
+                for (int q = 0; q < 3; q++) mean[q] += displacements[3 * (c->dims[0] * ((size_t)j + c->dims[1] * k)) + q] / c->dims[1];
+            for (uint32_t j = 0; j < c->dims[1]; j++)
+                for (int q = 0; q < 3; q++) displacements[3 * (c->dims[0] * ((size_t)j + c->dims[1] * k)) + q] = mean[q];
+        }
+    c->displacements = displacements;
+    if (mk_cylinder_bind(c, mesh, plan->cylinder_coordinates, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s: %s (enlarge radius or range)", path, inner.message);
+    return MK_OK;
+}
+
+/* mk_deformer for ffd_cylinder: p + a sum w(s, t, u) d per vertex. */
+static mk_result cylinder_eval(void *user, double amplitude, double *positions, double *normals, double *tangents,
+                               uint32_t *inverted, mk_error *err)
+{
+    (void)normals; (void)tangents; (void)err;
+    const channel_plan *plan = ((const bake_pointwise *)user)->user;
+    const mk_raw_mesh *mesh = ((const bake_pointwise *)user)->mesh;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        const float *pf = mesh->positions + 3 * (size_t)v;
+        double p[3] = { pf[0], pf[1], pf[2] };
+        mk_cylinder_eval(&plan->cylinder, amplitude, plan->cylinder_coordinates + 3 * (size_t)v, p, positions + 3 * (size_t)v);
+    }
+    if (inverted) *inverted = 0;
     return MK_OK;
 }
 
@@ -627,12 +880,12 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     snprintf(path, sizeof path, "channels[%d]", index);
     if (!cJSON_IsObject(ch)) return field_error(ctx, path, "", "must be an object%s", NULL);
     const cJSON *op = cJSON_GetObjectItemCaseSensitive(ch, "op");
-    if (!op) return field_error(ctx, path, "op", "missing (ffd, taper, twist, bend, cage, laplacian or arap)%s", NULL);
+    if (!op) return field_error(ctx, path, "op", "missing (ffd, ffd_travel, ffd_keys, ffd_cylinder, taper, twist, bend, cage, laplacian or arap)%s", NULL);
     if (!cJSON_IsString(op)) return field_error(ctx, path, "op", "must be a string%s", NULL);
     int k = -1;
     for (int i = 0; i < (int)(sizeof op_names / sizeof op_names[0]); i++)
         if (!strcmp(op_names[i], op->valuestring)) k = i;
-    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, taper, twist, bend, cage, laplacian or arap)", op->valuestring);
+    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, ffd_travel, ffd_keys, ffd_cylinder, taper, twist, bend, cage, laplacian or arap)", op->valuestring);
     plan->op = (op_kind)k;
     mk_result r = check_fields(ctx, ch, path, common_fields, op_fields[k]);
     if (r != MK_OK) return r;
@@ -650,9 +903,10 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     if (name) snprintf(plan->name, sizeof plan->name, "%s", name->valuestring);
     else snprintf(plan->name, sizeof plan->name, "%s%d", op_names[k], index);
 
-    /* Twist, bend, Laplacian (with rotations) and ARAP are nonlinear in the amplitude: they
+    /* Twist, bend, Laplacian (with rotations), ARAP and FFD travel are nonlinear in the amplitude: they
      * default to adaptive in-betweens; FFD, taper and cage are linear: one target is exact. */
-    int nonlinear = plan->op == OP_TWIST || plan->op == OP_BEND || plan->op == OP_LAPLACIAN || plan->op == OP_ARAP;
+    int nonlinear = plan->op == OP_TWIST || plan->op == OP_BEND || plan->op == OP_LAPLACIAN || plan->op == OP_ARAP ||
+                    plan->op == OP_FFD_TRAVEL;
     plan->inbetween.count = nonlinear ? 0 : 1;
     const cJSON *ib = cJSON_GetObjectItemCaseSensitive(ch, "inbetweens");
     if (ib) {
@@ -675,7 +929,10 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
 
     switch (plan->op) {
     case OP_TAPER: case OP_TWIST: case OP_BEND: r = parse_barr(ctx, plan, ch, path); break;
-    case OP_FFD: r = parse_ffd(ctx, plan, ch, path); break;
+    case OP_FFD: r = parse_ffd(ctx, plan, ch, path, NULL); break;
+    case OP_FFD_TRAVEL: r = parse_ffd_travel(ctx, plan, ch, path); break;
+    case OP_FFD_KEYS: r = parse_ffd_keys(ctx, plan, ch, path); break;
+    case OP_FFD_CYLINDER: r = parse_ffd_cylinder(ctx, plan, ch, path); break;
     case OP_CAGE: r = parse_cage(ctx, plan, ch, path); break;
     case OP_LAPLACIAN: case OP_ARAP: r = parse_edit(ctx, plan, ch, path); break;
     }
@@ -685,6 +942,35 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     plan->origin = mk_arena_strdup(ctx->scratch, json);
     cJSON_free(json);
     if (!plan->origin) return mk_error_oom(ctx->err, "recipe origin");
+    return MK_OK;
+}
+
+/* A clip named like the channel that plays its weight linearly from 0 to 1 over the duration. */
+static mk_result add_travel_clip(recipe_ctx *ctx, const channel_plan *plan, uint32_t channel)
+{
+    mk_raw_asset *raw = ctx->raw;
+    mk_raw_track *track = mk_arena_array(&raw->arena, 1, sizeof *track);
+    mk_key *keys = mk_arena_array(&raw->arena, 2, sizeof *keys);
+    char *name = mk_arena_strdup(&raw->arena, plan->name);
+    mk_raw_clip *clip = track && keys && name ? mk_raw_add_clips(raw, 1) : NULL;
+    if (!clip) return mk_error_oom(ctx->err, "travel clip");
+    keys[0].time = 0;
+    keys[0].value = 0;
+    keys[1].time = (float)plan->clip_duration;
+    keys[1].value = 1;
+    for (int k = 0; k < 2; k++) {
+        keys[k].interp = MK_INTERP_LINEAR;
+        keys[k].left_weight = keys[k].right_weight = 1.0f / 3;
+        keys[k].left_slope = keys[k].right_slope = (float)(1 / plan->clip_duration);
+    }
+    track->channel = channel;
+    track->key_count = 2;
+    track->keys = keys;
+    clip->name = name;
+    clip->start = 0;
+    clip->duration = (float)plan->clip_duration;
+    clip->track_count = 1;
+    clip->tracks = track;
     return MK_OK;
 }
 
@@ -708,8 +994,16 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
         pw.map = mk_barr_map; pw.user = &plan->barr;
         deformer.eval = bake_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
         break;
-    case OP_FFD:
+    case OP_FFD: case OP_FFD_KEYS:
         pw.map = mk_ffd_map; pw.user = &plan->ffd;
+        deformer.eval = bake_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
+        break;
+    case OP_FFD_CYLINDER:
+        pw.user = plan;
+        deformer.eval = cylinder_eval; deformer.user = &pw;
+        break;
+    case OP_FFD_TRAVEL:
+        pw.map = mk_ffd_travel_map; pw.user = &plan->travel;
         deformer.eval = bake_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
         break;
     case OP_CAGE:
@@ -737,11 +1031,17 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
         cr.factor_seconds = st.factor_seconds;
         cr.solve_seconds = st.solve_seconds;
         cr.solves = st.solves;
+        cr.iterations = st.iterations;
+        cr.max_iterations = st.max_iterations;
+        cr.unconverged = st.unconverged;
+        cr.energy = st.energy;
+        cr.start_energy = st.start_energy;
         mk_surface_edit_destroy(edit);
     }
     if (binding) mk_cage_unbind(binding);
     if (r != MK_OK) return mk_error_set(ctx->err, inner.code, inner.offset, "%s (%s): %s", path, op_names[plan->op], inner.message);
     raw->channels[raw->channel_count - 1].default_weight = plan->default_weight;
+    if (plan->clip_duration > 0 && (r = add_travel_clip(ctx, plan, raw->channel_count - 1)) != MK_OK) return r;
     if (res.inverted_vertices)
         mk_raw_warn(raw, "channel \"%s\": %u vertices where the deformation folds (det J <= 0); "
                     "their normals come from the deformed surface", plan->name, res.inverted_vertices);
@@ -759,6 +1059,63 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
     report->channels_added++;
     report->targets_added += res.targets;
     if (res.max_error > report->max_error) report->max_error = res.max_error;
+    return MK_OK;
+}
+
+/* ffd_keys: one channel per key (the lattice at that key, one exact target each: FFD is linear
+ * in the control points) and a clip that cross-fades consecutive keys linearly, so the clip
+ * plays the lattice with its control points interpolated linearly between keys. */
+static mk_result bake_ffd_keys(recipe_ctx *ctx, channel_plan *plan, int index, mk_bake_report *report)
+{
+    mk_raw_asset *raw = ctx->raw;
+    uint32_t n = plan->key_count;
+    char base[sizeof plan->name];
+    memcpy(base, plan->name, sizeof base);
+    uint32_t *channel = mk_arena_array(ctx->scratch, n, sizeof(uint32_t));
+    if (!channel) return mk_error_oom(ctx->err, "lattice keys");
+    size_t values = 3 * (size_t)plan->ffd.dims[0] * plan->ffd.dims[1] * plan->ffd.dims[2];
+    uint32_t track_count = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        /* A key with the lattice at rest contributes zero displacement: no channel, no track. */
+        uint32_t q = 0;
+        while (q < values && plan->key_displacements[k][q] == 0) q++;
+        channel[k] = UINT32_MAX;
+        if (q == values) continue;
+        snprintf(plan->name, sizeof plan->name, "%.119s.key%u", base, k % 1000);
+        plan->ffd.displacements = plan->key_displacements[k];
+        mk_result r = bake_plan(ctx, plan, index, report);
+        if (r != MK_OK) return r;
+        channel[k] = raw->channel_count - 1;
+        track_count++;
+    }
+    memcpy(plan->name, base, sizeof base);
+    if (track_count == 0)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "channels[%d].keys: no key moves the lattice", index);
+    mk_raw_track *tracks = mk_arena_array(&raw->arena, n, sizeof *tracks);
+    mk_key *keys = mk_arena_array(&raw->arena, 3 * (size_t)n, sizeof *keys);
+    char *name = mk_arena_strdup(&raw->arena, base);
+    mk_raw_clip *clip = tracks && keys && name ? mk_raw_add_clips(raw, 1) : NULL;
+    if (!clip) return mk_error_oom(ctx->err, "lattice key clip");
+    const double *t = plan->key_times;
+    for (uint32_t k = 0, track = 0; k < n; k++) {
+        if (channel[k] == UINT32_MAX) continue;
+        /* Hat function: 0 at the previous key, 1 at this one, 0 at the next (held outside). */
+        mk_key *kk = keys + 3 * (size_t)k;
+        uint32_t m = 0;
+        if (k > 0) kk[m++] = (mk_key){ .time = (float)t[k - 1], .value = 0 };
+        kk[m++] = (mk_key){ .time = (float)t[k], .value = 1 };
+        if (k + 1 < n) kk[m++] = (mk_key){ .time = (float)t[k + 1], .value = 0 };
+        for (uint32_t i = 0; i < m; i++) {
+            kk[i].interp = MK_INTERP_LINEAR;
+            kk[i].left_weight = kk[i].right_weight = 1.0f / 3;
+        }
+        tracks[track++] = (mk_raw_track){ .channel = channel[k], .key_count = m, .keys = kk };
+    }
+    clip->name = name;
+    clip->start = 0;
+    clip->duration = (float)t[n - 1];
+    clip->track_count = track_count;
+    clip->tracks = tracks;
     return MK_OK;
 }
 
@@ -793,7 +1150,8 @@ static mk_result run_recipe(recipe_ctx *ctx, const char *json, size_t size, mk_b
     for (const cJSON *ch = channels->child; ch; ch = ch->next, i++)
         if ((r = parse_channel(ctx, ch, i, mesh_item != NULL, top_mesh, &plans[i])) != MK_OK) goto done;
     for (i = 0; i < count; i++)
-        if ((r = bake_plan(ctx, &plans[i], i, report)) != MK_OK) goto done;
+        if ((r = plans[i].op == OP_FFD_KEYS ? bake_ffd_keys(ctx, &plans[i], i, report)
+                                            : bake_plan(ctx, &plans[i], i, report)) != MK_OK) goto done;
 done:
     cJSON_Delete(root);
     return r;
@@ -814,11 +1172,13 @@ mk_result mk_bake_recipe(mk_raw_asset *raw, const char *recipe_json, size_t reci
     if (!err) ctx.err = &local_err;
     uint32_t old_channels = raw->channel_count;
     uint32_t old_warnings = raw->warning_count;
+    uint32_t old_clips = raw->clip_count;
     mk_result r = run_recipe(&ctx, recipe_json, recipe_size, report);
     if (r == MK_OK) r = mk_raw_group_channels(raw, ctx.err);
     if (r != MK_OK) {
         raw->channel_count = old_channels;
         raw->warning_count = old_warnings;  /* drop warnings of the abandoned bake */
+        raw->clip_count = old_clips;        /* and travel clips */
         memset(report, 0, sizeof *report);
     }
     mk_arena_free_all(&scratch);

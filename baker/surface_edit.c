@@ -235,9 +235,12 @@ mk_result mk_surface_edit_create(const mk_raw_mesh *mesh, const mk_edit_params *
     s->mesh = mesh;
     s->params = *params;
     if (s->params.soft_weight <= 0) s->params.soft_weight = 100;
-    if (s->params.iterations == 0) s->params.iterations = 10;
+    if (s->params.iterations == 0) s->params.iterations = 1000;
+    if (s->params.convergence == 0) s->params.convergence = 1e-6;
     mk_result r = MK_OK;
 #define FAIL(expr) do { r = (expr); goto fail; } while (0)
+    if ((unsigned)params->acceleration > MK_ARAP_PLAIN)
+        FAIL(mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "acceleration: %d is not an mk_arap_acceleration", (int)params->acceleration));
     if (params->handle_count == 0) FAIL(mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "handles: none given"));
     s->weld = mk_mesh_weld(mesh, &s->arena, &s->welded);
     if (!s->weld) FAIL(mk_error_oom(err, "weld"));
@@ -323,6 +326,11 @@ mk_result mk_surface_edit_create(const mk_raw_mesh *mesh, const mk_edit_params *
     if (s->params.method == MK_EDIT_ARAP) {
         s->rotations = mk_arena_array(&s->arena, 9 * (size_t)n, sizeof(double));
         if (!s->rotations) FAIL(mk_error_oom(err, "rotations"));
+        if (s->params.acceleration == MK_ARAP_ANDERSON) {
+            s->anderson = mk_arena_array(&s->arena, (2 + 2 * (size_t)EDIT_ANDERSON_HISTORY) * 3 * n,
+                                         sizeof(double));
+            if (!s->anderson) FAIL(mk_error_oom(err, "Anderson acceleration history"));
+        }
     }
     s->stats.unknowns = s->unknown_count;
 

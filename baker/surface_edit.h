@@ -16,6 +16,13 @@ typedef enum mk_laplacian_weights {
     MK_WEIGHTS_UNIFORM = 1     /* w_ij = 1 per edge */
 } mk_laplacian_weights;
 
+typedef enum mk_arap_acceleration {
+    MK_ARAP_ANDERSON = 0,      /* Anderson acceleration of the local/global map (Peng et al. 2018),
+                                * an accelerated step that raises the energy is replaced by the
+                                * plain one */
+    MK_ARAP_PLAIN = 1          /* plain local/global iterations (Sorkine & Alexa 2007) */
+} mk_arap_acceleration;
+
 /* A set of vertices moved rigidly: at amplitude a a handle vertex goes to
  * pivot + R(axis, a * angle) (x - pivot) + a * translate. */
 typedef struct mk_edit_handle {
@@ -36,7 +43,14 @@ typedef struct mk_edit_params {
     const uint32_t *anchors;
     uint32_t handle_count;
     const mk_edit_handle *handles;
-    uint32_t iterations;       /* ARAP local/global iterations; 0 = 10 */
+    uint32_t iterations;       /* ARAP: cap on local/global iterations (a safety limit); 0 = 1000 */
+    double convergence;        /* ARAP: stop when the energy drops by less than this fraction in
+                                * one iteration; 0 = 1e-6; negative = run all iterations */
+    mk_arap_acceleration acceleration; /* ARAP: default Anderson */
+    /* ARAP: called after each iteration's local step with the energy of the current positions
+     * (iteration 0: the initial guess); may be NULL. */
+    void (*iteration_done)(void *user, uint32_t iteration, double energy);
+    void *user;
 } mk_edit_params;
 
 typedef struct mk_solver_stats {
@@ -48,6 +62,14 @@ typedef struct mk_solver_stats {
     double local_seconds;      /* ARAP: all local (rotation fitting) steps */
     uint32_t unknowns;         /* size of the factored system */
     double factor_nonzeros;    /* nonzeros of the Cholesky factor */
+    /* ARAP, over all evaluations of the edit: */
+    uint32_t evaluations;      /* mk_surface_edit_eval calls */
+    uint32_t iterations;       /* local/global iterations, all evaluations */
+    uint32_t max_iterations;   /* most iterations of one evaluation */
+    uint32_t unconverged;      /* evaluations stopped by the iteration cap */
+    uint32_t rejected_steps;   /* Anderson steps replaced by the plain step */
+    double energy;             /* ARAP energy of the last evaluation's result (arap.c) */
+    double start_energy;       /* ... and of its initial guess (rotations fitted to it) */
 } mk_solver_stats;
 
 typedef struct mk_surface_edit mk_surface_edit;

@@ -27,6 +27,8 @@ struct mk_surface_edit {
     double *solution;         /* 3 per welded vertex */
     double *work;             /* 3 per welded vertex */
     double *rotations;        /* ARAP: 9 per welded vertex */
+    double *anderson;         /* ARAP with Anderson acceleration: (2 + 2 * EDIT_ANDERSON_HISTORY)
+                               * vectors of 3 per welded vertex (arap.c) */
     double local_seconds;     /* ARAP: time in local steps */
     cholmod_common cm;
     int cm_started;
@@ -34,6 +36,9 @@ struct mk_surface_edit {
     cholmod_dense *rhs, *x, *y, *e;
     mk_solver_stats stats;
 };
+
+/* Anderson acceleration window (previous iterates combined per step), Peng et al. 2018 use 5-6. */
+#define EDIT_ANDERSON_HISTORY 5
 
 /* ---- the core (surface_edit.c) ---- */
 

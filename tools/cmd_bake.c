@@ -78,6 +78,10 @@ static void on_channel(void *user, const mk_bake_channel_report *c)
     if (c->factorizations && !ui->quiet)
         printf("  solver: %u factorization (%.3f s), %u solves (%.4f s each)\n", c->factorizations, c->factor_seconds,
                c->solves, c->solves ? c->solve_seconds / c->solves : 0.0);
+    if (c->iterations && !ui->quiet)
+        printf("  arap: %u iterations (at most %u per evaluation%s), energy %.4g (initial guess %.4g)\n",
+               c->iterations, c->max_iterations, c->unconverged ? ", some stopped by the cap" : "",
+               c->energy, c->start_energy);
     if (c->inverted_vertices)
         printf("  %u vertices fold (det J <= 0): normals taken from the deformed surface\n", c->inverted_vertices);
 }

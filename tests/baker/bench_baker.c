@@ -1,13 +1,21 @@
 /* SPDX-License-Identifier: MIT */
 /* Baker benchmark: Laplacian (cotangent) and ARAP (10 iterations) bakes of a ~100 000-vertex
  * sphere, one factorization each; prints factor time, per-solve time and total wall time.
- * usage: bench_baker [rings segments]   (default 250 x 400 = 99 602 vertices) */
+ * usage: bench_baker [rings segments]   (default 250 x 400 = 99 602 vertices)
+ *
+ * ARAP convergence: bench_baker arap LEVELS (icosphere, 6: 40 962 vertices, 7: 163 842):
+ * anchors z < -0.5, handle z > 0.8 moved by (0.3, 0, 0.2). Prints energy, time and distance
+ * to a tightly converged reference (Anderson, relative energy change 1e-9) for 10 plain
+ * iterations, plain to convergence and Anderson to convergence, and the time each run took to
+ * come within 1 % of the reference energy. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "bake.h"
 #include "bake_util.h"
 #include "fixtures.h"
+#include "surface_edit.h"
 
 typedef struct bench_user { mk_bake_channel_report last; } bench_user;
 
@@ -40,8 +48,94 @@ static int run(const char *label, const char *recipe, uint32_t rings, uint32_t s
     return 0;
 }
 
+typedef struct arap_trace {
+    double t0, target_energy, reached_seconds;  /* reached: first time within 1 % (or -1) */
+    uint32_t reached_iteration;
+} arap_trace;
+
+static void on_iteration(void *user, uint32_t iteration, double energy)
+{
+    arap_trace *t = user;
+    if (t->reached_seconds < 0 && energy <= 1.01 * t->target_energy) {
+        t->reached_seconds = bake_now() - t->t0;
+        t->reached_iteration = iteration;
+    }
+}
+
+static int arap_convergence(uint32_t levels)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_raw_mesh *m = fixture_icosphere(&raw, "ico", 1, levels);
+    uint32_t *anchors = malloc(m->vertex_count * sizeof(uint32_t)), *handle = malloc(m->vertex_count * sizeof(uint32_t));
+    uint32_t na = fixture_select_z(m, -2, -0.5f, anchors), nh = fixture_select_z(m, 0.8f, 2, handle);
+    mk_edit_handle h = { nh, handle, { 0.3, 0, 0.2 }, { 0, 0, 1 }, 0, { 0, 0, 0 } };
+    const double move = sqrt(0.3 * 0.3 + 0.2 * 0.2);
+    /* BENCH_ARAP_RUNS=n: only the first n runs (the reference always). */
+    struct { const char *label; mk_arap_acceleration acc; uint32_t cap; double convergence; } runs[] = {
+        { "reference (anderson, 1e-9)", MK_ARAP_ANDERSON, 5000, 1e-9 },
+        { "plain, 10 iterations", MK_ARAP_PLAIN, 10, -1 },
+        { "anderson, default", MK_ARAP_ANDERSON, 1000, 0 },
+        { "plain, default", MK_ARAP_PLAIN, 1000, 0 },
+        { "anderson, 1e-4", MK_ARAP_ANDERSON, 1000, 1e-4 },
+        { "anderson, 1e-5", MK_ARAP_ANDERSON, 1000, 1e-5 },
+        { "plain, 1000 iterations", MK_ARAP_PLAIN, 1000, -1 },
+    };
+    size_t n3 = 3 * (size_t)m->vertex_count;
+    double *reference = malloc(n3 * sizeof(double)), *pos = malloc(n3 * sizeof(double));
+    double reference_energy = 0;
+    int fails = 0;
+    printf("ARAP on an icosphere of %u vertices, %u anchors, %u handle vertices moved by %.4f\n",
+           m->vertex_count, na, nh, move);
+    size_t run_count = sizeof runs / sizeof runs[0];
+    if (getenv("BENCH_ARAP_RUNS")) {
+        size_t n = (size_t)atoi(getenv("BENCH_ARAP_RUNS"));
+        if (n >= 1 && n < run_count) run_count = n;
+    }
+    for (size_t k = 0; k < run_count; k++) {
+        fflush(stdout);
+        arap_trace trace = { 0, reference_energy, -1, 0 };
+        mk_edit_params p = { .method = MK_EDIT_ARAP, .anchor_count = na, .anchors = anchors,
+                             .handle_count = 1, .handles = &h, .iterations = runs[k].cap,
+                             .convergence = runs[k].convergence, .acceleration = runs[k].acc,
+                             .iteration_done = k ? on_iteration : NULL, .user = &trace };
+        mk_surface_edit *e = NULL;
+        mk_error err;
+        if (mk_surface_edit_create(m, &p, NULL, &e, &err) != MK_OK) {
+            fprintf(stderr, "%s: %s\n", runs[k].label, err.message);
+            fails++;
+            continue;
+        }
+        trace.t0 = bake_now();
+        mk_result r = mk_surface_edit_eval(e, 1, k ? pos : reference, NULL, NULL, NULL, &err);
+        double seconds = bake_now() - trace.t0;
+        mk_solver_stats st;
+        mk_surface_edit_stats(e, &st);
+        mk_surface_edit_destroy(e);
+        if (r != MK_OK) { fprintf(stderr, "%s: %s\n", runs[k].label, err.message); fails++; continue; }
+        if (k == 0) reference_energy = st.energy;
+        double far = 0;
+        for (size_t i = 0; k && i < n3; i += 3) {
+            double d[3] = { pos[i] - reference[i], pos[i + 1] - reference[i + 1], pos[i + 2] - reference[i + 2] };
+            far = fmax(far, sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+        }
+        printf("  %-28s %4u iterations %7.3f s (local %.3f s, %u rejected), energy %.6f (initial %.4f, "
+               "%.4f x reference), max distance to reference %.4f x handle move",
+               runs[k].label, st.iterations, seconds, st.local_seconds, st.rejected_steps, st.energy,
+               st.start_energy, reference_energy > 0 ? st.energy / reference_energy : 1.0, far / move);
+        if (k && trace.reached_seconds >= 0)
+            printf(", within 1 %% of the reference energy after %u iterations, %.3f s\n",
+                   trace.reached_iteration, trace.reached_seconds);
+        else printf("\n");
+    }
+    free(reference); free(pos); free(anchors); free(handle);
+    mk_raw_free(&raw);
+    return fails;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 3 && !strcmp(argv[1], "arap")) return arap_convergence((uint32_t)atoi(argv[2])) ? 1 : 0;
     uint32_t rings = 250, segments = 400;
     if (argc == 3) { rings = (uint32_t)atoi(argv[1]); segments = (uint32_t)atoi(argv[2]); }
     if (rings < 4 || segments < 4) { fprintf(stderr, "usage: bench_baker [rings segments]\n"); return 2; }
@@ -56,7 +150,8 @@ int main(int argc, char **argv)
     int fails = 0;
     snprintf(recipe, sizeof recipe, edit, "lap", "laplacian", "");
     fails += run("laplacian (cotangent)", recipe, rings, segments);
-    snprintf(recipe, sizeof recipe, edit, "arap", "arap", ", \"iterations\": 10");
+    snprintf(recipe, sizeof recipe, edit, "arap", "arap",
+             ", \"iterations\": 10, \"convergence\": 0, \"acceleration\": \"none\"");
     fails += run("arap (10 iterations)", recipe, rings, segments);
     return fails ? 1 : 0;
 }

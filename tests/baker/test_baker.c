@@ -14,7 +14,10 @@
 #include "cage_mvc.h"
 #include "check.h"
 #include "ffd.h"
+#include "ffd_travel.h"
+#include "ffd_cylinder.h"
 #include "fixtures.h"
+#include "import.h"
 #include "inbetween.h"
 #include "surface_edit.h"
 
@@ -537,6 +540,22 @@ static void laplacian_translation_of_everything_is_exact(void)
     mk_raw_free(&raw);
 }
 
+/* Largest distance of pos from the tube moved by the rigid motion of the ARAP rigidity tests
+ * (50 degrees about (1, 1, 0.5) through (0, 0, 1.5), then (0.3, -0.2, 0.5)), / diagonal. */
+static double rigid_deviation(const mk_raw_mesh *m, const double *pos)
+{
+    double axis[3] = { 1, 1, 0.5 }, R[9], worst = 0;
+    vec3_normalize(axis);
+    mat3_rotation(R, axis, 50 * PI / 180);
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        double d[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] - 1.5 }, q[3];
+        mat3_mul_vec(q, R, d);
+        double expect[3] = { q[0] + 0.3, q[1] - 0.2, q[2] + 1.5 + 0.5 };
+        for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(pos[3 * v + c] - expect[c]));
+    }
+    return worst / diag_of(m);
+}
+
 static double arap_rigid_error(int iterations)
 {
     mk_raw_asset raw;
@@ -549,6 +568,7 @@ static double arap_rigid_error(int iterations)
     snprintf(recipe, sizeof recipe,
         "{\"mesh\": \"tube\", \"channels\": ["
         " {\"name\": \"rigid\", \"op\": \"arap\", \"inbetweens\": 1, \"iterations\": %d,"
+        "  \"convergence\": 0, \"acceleration\": \"none\","
         "  \"handles\": ["
         "   {\"min\": [-2, -2, -1], \"max\": [2, 2, 0.01], \"translate\": [0.3, -0.2, 0.5],"
         "    \"rotate\": {\"axis\": [1, 1, 0.5], \"degrees\": 50, \"pivot\": [0, 0, 1.5]}},"
@@ -560,19 +580,9 @@ static double arap_rigid_error(int iterations)
     double worst = 1e9;
     if (r == MK_OK) {
         m = &raw.meshes[0];
-        double axis[3] = { 1, 1, 0.5 }, R[9];
-        vec3_normalize(axis);
-        mat3_rotation(R, axis, 50 * PI / 180);
         double *pos = malloc(3 * m->vertex_count * sizeof(double));
         last_target_positions(m, &raw.channels[0], pos);
-        worst = 0;
-        for (uint32_t v = 0; v < m->vertex_count; v++) {
-            double d[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] - 1.5 }, q[3];
-            mat3_mul_vec(q, R, d);
-            double expect[3] = { q[0] + 0.3, q[1] - 0.2, q[2] + 1.5 + 0.5 };
-            for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(pos[3 * v + c] - expect[c]));
-        }
-        worst /= diag_of(m);
+        worst = rigid_deviation(m, pos);
         free(pos);
     }
     mk_raw_free(&raw);
@@ -589,6 +599,118 @@ static void arap_rigid_handles_without_anchors_move_rigidly(void)
     CHECK(e10 < e0);
     CHECK(e300 < e10);
     CHECK_MSG(e300 < 1e-5, "ARAP deviates from the rigid motion by %g x diagonal", e300);
+}
+
+typedef struct energy_log { double energy[2048]; uint32_t count; } energy_log;
+
+static void log_energy(void *user, uint32_t iteration, double energy)
+{
+    energy_log *l = user;
+    CHECK_EQ_INT(iteration, l->count);
+    if (l->count < 2048) l->energy[l->count++] = energy;
+}
+
+/* 1 when every logged energy is at most the one before (to rounding, 1e-12 relative). */
+static int energies_decrease(const energy_log *l)
+{
+    for (uint32_t k = 1; k < l->count; k++)
+        if (!(l->energy[k] <= l->energy[k - 1] * (1 + 1e-12))) {
+            fprintf(stderr, "energy rises at iteration %u: %.17g -> %.17g\n", k, l->energy[k - 1], l->energy[k]);
+            return 0;
+        }
+    return 1;
+}
+
+/* Surface edit of m at amplitude 1 into pos, with its stats; 0 (after a failed check) on error. */
+static int edit_at_full_amplitude(const mk_raw_mesh *m, const mk_edit_params *p, double *pos, mk_solver_stats *st)
+{
+    mk_surface_edit *e = NULL;
+    mk_error err;
+    mk_result r = mk_surface_edit_create(m, p, NULL, &e, &err);
+    CHECK_MSG(r == MK_OK, "create: %s", err.message);
+    if (r != MK_OK) return 0;
+    r = mk_surface_edit_eval(e, 1, pos, NULL, NULL, NULL, &err);
+    CHECK_MSG(r == MK_OK, "eval: %s", err.message);
+    mk_surface_edit_stats(e, st);
+    mk_surface_edit_destroy(e);
+    return r == MK_OK;
+}
+
+static void arap_converges_to_the_rigid_optimum_with_falling_energy(void)
+{
+    /* Handles at both ends of a tube moved by one rigid motion, nothing anchored: the rigidly
+     * moved tube has zero energy, so it is the optimum, and with the default convergence test
+     * both iterations (plain and Anderson-accelerated) must stop there, their energy falling at
+     * every iteration. */
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_raw_mesh *m = fixture_cylinder(&raw, "tube", 1, 3, 24, 12);
+    uint32_t *bottom = malloc(m->vertex_count * sizeof(uint32_t)), *top = malloc(m->vertex_count * sizeof(uint32_t));
+    uint32_t nb = 0, nt = 0;
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        float z = m->positions[3 * (size_t)v + 2];
+        if (z < 0.01f) bottom[nb++] = v;
+        else if (z > 2.99f) top[nt++] = v;
+    }
+    double angle = 50 * PI / 180;
+    mk_edit_handle h[2] = { { nb, bottom, { 0.3, -0.2, 0.5 }, { 1, 1, 0.5 }, angle, { 0, 0, 1.5 } },
+                            { nt, top, { 0.3, -0.2, 0.5 }, { 1, 1, 0.5 }, angle, { 0, 0, 1.5 } } };
+    double *pos = malloc(3 * m->vertex_count * sizeof(double));
+    for (int acc = 0; acc < 2; acc++) {
+        energy_log log = { .count = 0 };
+        mk_edit_params p = { .method = MK_EDIT_ARAP, .handle_count = 2, .handles = h,
+                             .acceleration = (mk_arap_acceleration)acc, .iteration_done = log_energy, .user = &log };
+        mk_solver_stats st;
+        if (!edit_at_full_amplitude(m, &p, pos, &st)) continue;
+        double worst = rigid_deviation(m, pos);
+        fprintf(stderr, "ARAP rigid optimum (%s): %u iterations, energy %.3g -> %.3g, deviation %.3g x diagonal\n",
+                acc ? "plain" : "anderson", st.iterations, st.start_energy, st.energy, worst);
+        CHECK(log.count == st.iterations + 1);
+        CHECK(energies_decrease(&log));
+        CHECK_EQ_INT(st.unconverged, 0);
+        CHECK(st.start_energy > 1e-3);
+        CHECK_MSG(st.energy < 1e-10 * st.start_energy, "energy %g of %g left", st.energy, st.start_energy);
+        CHECK_MSG(worst < 1e-6, "deviation %g x diagonal from the rigid motion", worst);
+        if (acc == 0) CHECK_MSG(st.iterations < 100, "Anderson took %u iterations", st.iterations);
+    }
+    free(pos); free(bottom); free(top);
+    mk_raw_free(&raw);
+}
+
+static void arap_anderson_lowers_energy_faster_than_plain(void)
+{
+    /* A bent sphere (no known optimum): both iterations lower the energy at every step; with
+     * the same number of iterations the accelerated one ends at least as low, and converged
+     * runs of both agree on the energy to 1e-3. */
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_raw_mesh *m = fixture_icosphere(&raw, "ico", 1, 3);
+    uint32_t *anchors = malloc(m->vertex_count * sizeof(uint32_t)), *handle = malloc(m->vertex_count * sizeof(uint32_t));
+    uint32_t na = fixture_select_z(m, -2, -0.5f, anchors), nh = fixture_select_z(m, 0.8f, 2, handle);
+    mk_edit_handle h = { nh, handle, { 0.3, 0, 0.2 }, { 1, 0, 0 }, 0.6, { 0, 0, 0.9 } };
+    double energy[2][2];
+    double *pos = malloc(3 * m->vertex_count * sizeof(double));
+    for (int acc = 0; acc < 2; acc++)
+        for (int run = 0; run < 2; run++) {
+            energy_log log = { .count = 0 };
+            mk_edit_params p = { .method = MK_EDIT_ARAP, .anchor_count = na, .anchors = anchors,
+                                 .handle_count = 1, .handles = &h, .acceleration = (mk_arap_acceleration)acc,
+                                 .iterations = run ? 2000 : 20, .convergence = run ? 1e-12 : -1,
+                                 .iteration_done = log_energy, .user = &log };
+            mk_solver_stats st;
+            if (!edit_at_full_amplitude(m, &p, pos, &st)) continue;
+            energy[acc][run] = st.energy;
+            CHECK(energies_decrease(&log));
+            CHECK(log.count >= 2 && log.energy[log.count - 1] < log.energy[0]);
+            if (!run) CHECK_EQ_INT(st.iterations, 20);
+        }
+    fprintf(stderr, "ARAP bent sphere energy: 20 iterations plain %.6f, anderson %.6f; converged %.6f, %.6f\n",
+            energy[1][0], energy[0][0], energy[1][1], energy[0][1]);
+    CHECK(energy[0][0] <= energy[1][0]);
+    CHECK(fabs(energy[0][1] - energy[1][1]) <= 1e-3 * energy[1][1]);
+    CHECK(energy[0][1] <= energy[0][0] && energy[1][1] <= energy[1][0]);
+    free(pos); free(anchors); free(handle);
+    mk_raw_free(&raw);
 }
 
 static void component_without_constraint_is_rejected(void)
@@ -624,6 +746,51 @@ static void component_without_constraint_is_rejected(void)
 
 /* ---- adaptive in-betweens through the real runtime ---- */
 
+/* Writes raw as a float blob (into raw's arena) and opens it; 0 (after a failed check) on error. */
+static int write_and_open(mk_raw_asset *raw, mk_asset *asset)
+{
+    mk_write_options wo = { .precision = MK_PRECISION_FLOAT };
+    void *blob = NULL;
+    size_t size = 0;
+    mk_error err;
+    mk_result r = mk_write_blob(raw, &wo, &raw->arena, &blob, &size, NULL, &err);
+    CHECK_MSG(r == MK_OK, "write: %s", err.message);
+    if (r == MK_OK) r = mk_asset_open(blob, size, asset, &err);
+    CHECK_MSG(r == MK_OK, "open: %s", err.message);
+    return r == MK_OK;
+}
+
+/* Largest distance (mesh units) between the runtime's playback of mesh 0 with channel
+ * `channel` of `channel_count` at weight w (the others at 0) and truth(w, p), over w = k/100. */
+static double playback_error(const mk_asset *asset, const mk_raw_mesh *m, uint32_t channel, uint32_t channel_count,
+                             bake_point_map truth, const void *user)
+{
+    size_t scratch_size = mk_eval_scratch_size(asset, 0);
+    void *scratch = scratch_size ? aligned_alloc(16, (scratch_size + 15) / 16 * 16) : NULL;
+    float *out = malloc(3 * m->vertex_count * sizeof(float)), weights[16] = { 0 };
+    double worst = 0;
+    for (int step = 0; step <= 100 && channel_count <= 16; step++) {
+        weights[channel] = (float)step / 100;
+        mk_eval_job job = { .asset = asset, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = weights,
+                            .weight_count = channel_count, .scratch = scratch, .scratch_size = scratch_size,
+                            .positions = out, .positions_size = 3 * m->vertex_count * sizeof(float) };
+        mk_error err;
+        mk_result r = mk_eval_run(&job, &err);
+        CHECK_MSG(r == MK_OK, "eval: %s", err.message);
+        if (r != MK_OK) { worst = INFINITY; break; }
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, q[3], J[9];
+            truth(user, (double)step / 100, p, q, J);
+            double e2 = 0;
+            for (int c = 0; c < 3; c++) e2 += (out[3 * v + c] - q[c]) * (out[3 * v + c] - q[c]);
+            worst = fmax(worst, sqrt(e2));
+        }
+    }
+    free(out);
+    free(scratch);
+    return worst;
+}
+
 static void twist_180_auto_inbetweens_play_back_within_tolerance(void)
 {
     mk_raw_asset raw;
@@ -646,15 +813,8 @@ static void twist_180_auto_inbetweens_play_back_within_tolerance(void)
     /* The origin holds the channel's recipe. */
     CHECK(raw.channels[0].origin && strstr(raw.channels[0].origin, "\"twist\"") != NULL);
 
-    mk_write_options wo = { .precision = MK_PRECISION_FLOAT };
-    void *blob = NULL;
-    size_t size = 0;
-    r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, NULL, &err);
-    CHECK_MSG(r == MK_OK, "write: %s", err.message);
     mk_asset asset;
-    if (r == MK_OK) r = mk_asset_open(blob, size, &asset, &err);
-    CHECK_MSG(r == MK_OK, "open: %s", err.message);
-    if (r != MK_OK) { mk_raw_free(&raw); return; }
+    if (!write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
     mk_channel_info ci;
     CHECK(mk_channel_get(&asset, 0, &ci) && ci.target_count == targets);
     CHECK(ci.origin && strstr(ci.origin, "twist"));
@@ -665,35 +825,397 @@ static void twist_180_auto_inbetweens_play_back_within_tolerance(void)
     for (int c = 0; c < 3; c++) tw.center[c] = 0.5 * (lo[c] + hi[c]);
     tw.range[0] = lo[2]; tw.range[1] = hi[2];
     CHECK(mk_barr_prepare(&tw, &err) == MK_OK);
-    size_t scratch_size = mk_eval_scratch_size(&asset, 0);
-    void *scratch = scratch_size ? aligned_alloc(16, (scratch_size + 15) / 16 * 16) : NULL;
-    float *out = malloc(3 * m->vertex_count * sizeof(float));
-    double worst = 0;
-    for (int step = 0; step <= 100; step++) {
-        float w = (float)step / 100;
-        mk_eval_job job = { .asset = &asset, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = &w, .weight_count = 1,
-                            .scratch = scratch, .scratch_size = scratch_size,
-                            .positions = out, .positions_size = 3 * m->vertex_count * sizeof(float) };
-        r = mk_eval_run(&job, &err);
-        CHECK_MSG(r == MK_OK, "eval: %s", err.message);
-        if (r != MK_OK) break;
-        for (uint32_t v = 0; v < m->vertex_count; v++) {
-            double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, q[3], J[9];
-            mk_barr_map(&tw, (double)step / 100, p, q, J);
-            double e2 = 0;
-            for (int c = 0; c < 3; c++) e2 += (out[3 * v + c] - q[c]) * (out[3 * v + c] - q[c]);
-            worst = fmax(worst, sqrt(e2));
-        }
-    }
+    double worst = playback_error(&asset, m, 0, 1, mk_barr_map, &tw);
     fprintf(stderr, "twist playback through the runtime: max error %.3g x diagonal over 101 weights\n",
             worst / d);
     CHECK_MSG(worst <= 0.001 * d, "playback error %g > 0.001 x diagonal %g", worst, 0.001 * d);
     /* a single target would be far off: linear blending of a 180 degree rotation collapses
      * the tube through its axis at w = 0.5 */
     CHECK(targets >= 8);
+    mk_raw_free(&raw);
+}
+
+/* ---- ffd_travel ---- */
+
+typedef struct rigid_travel { double translate[3], axis[3], angle; } rigid_travel;
+
+/* pivot at the origin */
+static void rigid_travel_map(const void *user, double a, const double p[3], double q[3], double J[9])
+{
+    const rigid_travel *t = user;
+    double R[9];
+    mat3_rotation(R, t->axis, a * t->angle);
+    mat3_mul_vec(q, R, p);
+    for (int c = 0; c < 3; c++) q[c] += a * t->translate[c];
+    memcpy(J, R, sizeof R);
+}
+
+/* A cylinder fixture (see fixture_cylinder) in a fresh raw with the recipe baked on it; NULL
+ * (after a failed check, raw freed) if the bake fails. */
+static mk_raw_mesh *baked_cylinder(mk_raw_asset *raw, const char *name, float radius, float height,
+                                   uint32_t segments, uint32_t rings, const char *recipe)
+{
+    mk_raw_init(raw, NULL);
+    fixture_cylinder(raw, name, radius, height, segments, rings);
+    mk_error err;
+    mk_result r = bake(raw, recipe, &err);
+    CHECK_MSG(r == MK_OK, "bake: %s", err.message);
+    if (r != MK_OK) { mk_raw_free(raw); return NULL; }
+    return &raw->meshes[0];
+}
+
+static void ffd_travel_through_an_unmoved_lattice_is_the_rigid_travel(void)
+{
+    const char *recipe =
+        "{\"mesh\": \"tube\", \"channels\": ["
+        " {\"name\": \"slide\", \"op\": \"ffd_travel\", \"dims\": [3, 3, 3], \"duration\": 2,"
+        "  \"travel\": {\"translate\": [1.5, 0, 0.5]}},"
+        " {\"name\": \"spin\", \"op\": \"ffd_travel\", \"basis\": \"bspline\","
+        "  \"travel\": {\"translate\": [0, 0, 1], \"rotate\": {\"axis\": [0, 0, 1], \"degrees\": 90, \"pivot\": [0, 0, 0]}}}"
+        "]}";
+    mk_raw_asset raw;
+    const mk_raw_mesh *m = baked_cylinder(&raw, "tube", 1, 4, 16, 8, recipe);
+    if (!m) return;
+    /* A pure translation is linear in the weight: one target, every delta the translation. */
+    const mk_raw_channel *slide = find_channel(&raw, "slide"), *spin = find_channel(&raw, "spin");
+    CHECK(slide && spin);
+    if (!slide || !spin) { mk_raw_free(&raw); return; }
+    CHECK_EQ_INT(slide->target_count, 1);
+    CHECK_EQ_INT(slide->targets[0].count, m->vertex_count);
+    double worst = 0;
+    for (uint32_t k = 0; k < slide->targets[0].count; k++) {
+        const float *d = slide->targets[0].positions + 3 * (size_t)k;
+        worst = fmax(worst, fabs(d[0] - 1.5) + fabs(d[1]) + fabs(d[2] - 0.5));
+    }
+    CHECK_MSG(worst < 1e-6, "slide delta off the translation by %g", worst);
+    CHECK(spin->target_count > 1);
+    /* The clip plays slide's weight 0 -> 1 over 2 s. */
+    CHECK_EQ_INT(raw.clip_count, 1);
+    if (raw.clip_count == 1) {
+        const mk_raw_clip *clip = &raw.clips[0];
+        CHECK(!strcmp(clip->name, "slide") && clip->duration == 2 && clip->track_count == 1);
+        CHECK(&raw.channels[clip->tracks[0].channel] == slide);
+        CHECK(clip->tracks[0].key_count == 2 && clip->tracks[0].keys[1].value == 1 && clip->tracks[0].keys[1].time == 2);
+    }
+    mk_asset asset;
+    if (!write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
+    rigid_travel spin_truth = { { 0, 0, 1 }, { 0, 0, 1 }, PI / 2 };
+    double e = playback_error(&asset, m, (uint32_t)(spin - raw.channels), 2, rigid_travel_map, &spin_truth);
+    fprintf(stderr, "ffd_travel spin through an unmoved lattice: %u targets, playback error %.3g x diagonal\n",
+            spin->target_count, e / diag_of(m));
+    CHECK_MSG(e <= 0.001 * diag_of(m) + 1e-5, "playback error %g x diagonal", e / diag_of(m));
+    mk_raw_free(&raw);
+}
+
+/* The bent lattice of the next test: x in [0.2, 2.2], y in [-1, 1], z in [-1, 2], 3 x 2 x 2
+ * Bernstein points, the middle layer moved by (0, 0.3, 0): inside, y gains 0.3 * 2 s (1 - s)
+ * (the degree-2 Bernstein weight of the middle layer), s = (x - 0.2) / 2; outside nothing. The
+ * mesh travels by (1.2, 0, 0). */
+static void bent_lattice_truth(const void *user, double a, const double p[3], double q[3], double J[9])
+{
+    (void)user; (void)J;
+    q[0] = p[0] + 1.2 * a; q[1] = p[1]; q[2] = p[2];
+    double s = (q[0] - 0.2) / 2;
+    if (s >= 0 && s <= 1) q[1] += 0.3 * 2 * s * (1 - s);
+}
+
+static void ffd_travel_through_a_bent_lattice_follows_the_bernstein_formula(void)
+{
+    const char *recipe = "{\"mesh\": \"rod\", \"channels\": [{\"name\": \"wave\", \"op\": \"ffd_travel\","
+        " \"dims\": [3, 2, 2], \"tolerance\": 0.002, \"origin\": [0.2, -1, -1], \"axes\": [[2, 0, 0], [0, 2, 0], [0, 0, 3]],"
+        " \"moves\": [{\"i\": 1, \"translate\": [0, 0.3, 0]}], \"travel\": {\"translate\": [1.2, 0, 0]}}]}";
+    mk_raw_asset raw;
+    const mk_raw_mesh *m = baked_cylinder(&raw, "rod", 0.1f, 0.2f, 12, 2, recipe);
+    if (!m) return;
+    mk_error err;
+    /* The map itself, exactly. */
+    double lattice_displacements[12 * 3] = { 0 };
+    for (int k = 0; k < 12; k++) if (k % 3 == 1) lattice_displacements[3 * k + 1] = 0.3;
+    mk_ffd_lattice f = { .basis = MK_FFD_BERNSTEIN, .dims = { 3, 2, 2 }, .origin = { 0.2, -1, -1 },
+                         .axes = { { 2, 0, 0 }, { 0, 2, 0 }, { 0, 0, 3 } }, .displacements = lattice_displacements };
+    CHECK(mk_ffd_prepare(&f, &err) == MK_OK);
+    mk_ffd_travel t = { .lattice = &f, .translate = { 1.2, 0, 0 }, .axis = { 0, 0, 1 } };
+    double worst_map = 0;
+    for (int step = 0; step <= 20; step++)
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, q[3], e[3], J[9];
+            mk_ffd_travel_map(&t, step / 20.0, p, q, J);
+            bent_lattice_truth(NULL, step / 20.0, p, e, J);
+            for (int c = 0; c < 3; c++) worst_map = fmax(worst_map, fabs(q[c] - e[c]));
+        }
+    CHECK_MSG(worst_map < 1e-12, "ffd_travel map off the formula by %g", worst_map);
+    /* Its Jacobian (J_ffd R, for the normals) against central differences, with a turn. */
+    mk_ffd_travel turning = { .lattice = &f, .translate = { 1.2, 0, 0 }, .axis = { 0.6, 0, 0.8 }, .angle = 0.7 };
+    double worst_jacobian = 0;
+    for (uint32_t v = 0; v < m->vertex_count; v += 5) {
+        double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, q[3], J[9], Jd[9];
+        mk_ffd_travel_map(&turning, 0.5, p, q, J);
+        for (int c = 0; c < 3; c++) {
+            double pp[3] = { p[0], p[1], p[2] }, pm[3] = { p[0], p[1], p[2] }, qp[3], qm[3];
+            pp[c] += 1e-6; pm[c] -= 1e-6;
+            mk_ffd_travel_map(&turning, 0.5, pp, qp, Jd);
+            mk_ffd_travel_map(&turning, 0.5, pm, qm, Jd);
+            for (int r = 0; r < 3; r++) worst_jacobian = fmax(worst_jacobian, fabs((qp[r] - qm[r]) / 2e-6 - J[3 * r + c]));
+        }
+    }
+    CHECK_MSG(worst_jacobian < 1e-6, "ffd_travel Jacobian off the finite differences by %g", worst_jacobian);
+    const mk_raw_channel *ch = &raw.channels[0];
+    mk_asset asset;
+    if (!write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
+    double d = diag_of(m), e = playback_error(&asset, m, 0, 1, bent_lattice_truth, NULL);
+    fprintf(stderr, "ffd_travel through a bent lattice: %u targets, playback error %.3g x diagonal\n",
+            ch->target_count, e / d);
+    CHECK(ch->target_count > 2);
+    CHECK_MSG(e <= 0.002 * d + 1e-5, "playback error %g x diagonal", e / d);
+    mk_raw_free(&raw);
+}
+
+/* Displacements of the test's lattice keys: 3 x 3 x 4 points, layer k = 3 (and 2) moved. */
+static void lattice_key_displacements(int key, double *d)
+{
+    memset(d, 0, 36 * 3 * sizeof(double));
+    for (int p = 0; p < 9; p++) {
+        double *top = d + 3 * (27 + p), *below = d + 3 * (18 + p);
+        if (key == 1) top[0] = 0.5;
+        if (key == 2) { top[1] = 0.4; top[2] = 0.2; below[2] = -0.3; }
+    }
+}
+
+static void ffd_keys_clip_interpolates_the_lattice_linearly(void)
+{
+    mk_raw_asset raw;
+    /* FFD is linear in the control points: one channel per key, cross-faded linearly by the
+     * clip, plays the lattice with linearly interpolated control points, exactly (to float). */
+    const char *recipe = "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"wobble\", \"op\": \"ffd_keys\","
+        " \"dims\": [3, 3, 4], \"origin\": [-1.5, -1.5, -0.5], \"axes\": [[3, 0, 0], [0, 3, 0], [0, 0, 5]],"
+        " \"keys\": [{\"time\": 0}, {\"time\": 1, \"moves\": [{\"k\": 3, \"translate\": [0.5, 0, 0]}]},"
+        "  {\"time\": 3, \"moves\": [{\"k\": 3, \"translate\": [0, 0.4, 0.2]}, {\"k\": 2, \"translate\": [0, 0, -0.3]}]}]}]}";
+    const mk_raw_mesh *m = baked_cylinder(&raw, "tube", 1, 4, 16, 8, recipe);
+    if (!m) return;
+    /* key 0 leaves the lattice at rest: no channel for it */
+    CHECK_EQ_INT(raw.channel_count, 2);
+    CHECK_EQ_INT(raw.clip_count, 1);
+    CHECK(!find_channel(&raw, "wobble.key0") && find_channel(&raw, "wobble.key1") && find_channel(&raw, "wobble.key2"));
+    for (uint32_t c = 0; c < raw.channel_count; c++) CHECK(raw.channels[c].target_count == 1);
+    mk_asset asset;
+    if (raw.channel_count != 2 || !write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
+    double keyed[3][108], d[108] = { 0 };
+    for (int k = 0; k < 3; k++) lattice_key_displacements(k, keyed[k]);
+    mk_ffd_lattice f = { .basis = MK_FFD_BERNSTEIN, .dims = { 3, 3, 4 }, .origin = { -1.5, -1.5, -0.5 },
+                         .axes = { { 3, 0, 0 }, { 0, 3, 0 }, { 0, 0, 5 } }, .displacements = d };
+    mk_error err;
+    CHECK(mk_ffd_prepare(&f, &err) == MK_OK);
+    size_t scratch_size = mk_eval_scratch_size(&asset, 0);
+    void *scratch = scratch_size ? aligned_alloc(16, (scratch_size + 15) / 16 * 16) : NULL;
+    float *out = malloc(3 * m->vertex_count * sizeof(float)), weights[2];
+    const double times[] = { -0.5, 0, 0.25, 0.5, 1, 1.7, 2.5, 3, 4 }, key_time[3] = { 0, 1, 3 };
+    double worst = 0, moved = 0;
+    for (size_t i = 0; i < sizeof times / sizeof times[0]; i++) {
+        mk_sample_job sj = { .asset = &asset, .clip = 0, .time = times[i], .weights = weights, .weight_count = 2 };
+        mk_eval_job ej = { .asset = &asset, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = weights,
+                           .weight_count = 2, .scratch = scratch, .scratch_size = scratch_size,
+                           .positions = out, .positions_size = 3 * m->vertex_count * sizeof(float) };
+        mk_result r = mk_sample_run(&sj, &err);
+        if (r == MK_OK) r = mk_eval_run(&ej, &err);
+        CHECK_MSG(r == MK_OK, "sample/eval: %s", err.message);
+        if (r != MK_OK) break;
+        /* Control points interpolated linearly between the keys (held outside). */
+        double t = fmin(fmax(times[i], 0), 3);
+        int k = t < 1 ? 0 : 1;
+        double lambda = (t - key_time[k]) / (key_time[k + 1] - key_time[k]);
+        for (int q = 0; q < 108; q++) d[q] = (1 - lambda) * keyed[k][q] + lambda * keyed[k + 1][q];
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, e[3], J[9];
+            mk_ffd_map(&f, 1, p, e, J);
+            for (int c = 0; c < 3; c++) {
+                worst = fmax(worst, fabs(out[3 * v + c] - e[c]));
+                moved = fmax(moved, fabs(e[c] - p[c]));
+            }
+        }
+    }
+    fprintf(stderr, "ffd_keys: clip playback vs interpolated lattice: max difference %.3g (largest motion %.3g)\n",
+            worst, moved);
+    CHECK(moved > 0.2);
+    CHECK_MSG(worst < 2e-6, "clip playback differs from the interpolated lattice by %g", worst);
     free(out);
     free(scratch);
     mk_raw_free(&raw);
+}
+
+/* ---- extended FFD: cylindrical lattice ---- */
+
+static void cylinder_lattice_inverts_moves_rigidly_and_is_seamless(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_raw_mesh *m = fixture_icosphere(&raw, "ball", 1, 4);
+    /* Around the unit sphere: z from -1.1 to 1.1, control radius 1.15 (the B-spline circle of
+     * 8 sectors reaches 0.90 of it between sectors, so the sphere is inside). */
+    mk_cylinder_lattice c = { .dims = { 3, 8, 4 }, .center = { 0, 0, -1.1 }, .axis = { 0, 0, 2.2 },
+                              .reference = { 1, 0, 0 }, .inner_radius = 0, .outer_radius = 1.15 };
+    mk_error err;
+    CHECK(mk_cylinder_prepare(&c, &err) == MK_OK);
+    size_t points = 3 * 8 * 4;
+    double *d = calloc(3 * points, sizeof(double)), *stu = malloc(3 * m->vertex_count * sizeof(double));
+    c.displacements = d;
+    uint32_t most = 0, failed = 0;
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] };
+        uint32_t it = 0;
+        if (mk_cylinder_coordinates(&c, p, stu + 3 * v, &it, &err) != MK_OK) {
+            if (!failed) fprintf(stderr, "vertex %u: %s\n", v, err.message);
+            failed++;
+        }
+        if (it > most) most = it;
+    }
+    fprintf(stderr, "cylinder lattice: Newton converged for %u of %u vertices, at most %u iterations\n",
+            m->vertex_count - failed, m->vertex_count, most);
+    CHECK_EQ_INT(failed, 0);
+    /* Unmoved: the identity; moved rigidly: the mesh moves rigidly. */
+    double axis[3] = { 0.3, -0.5, 0.8 }, R[9], t[3] = { 0.2, -0.1, 0.4 }, identity = 0, rigid = 0;
+    vec3_normalize(axis);
+    mat3_rotation(R, axis, 0.9);
+    for (int pass = 0; pass < 2; pass++) {
+        for (uint32_t k = 0; k < 4; k++)
+            for (uint32_t j = 0; j < 8; j++)
+                for (uint32_t i = 0; i < 3; i++) {
+                    double P[3], RP[3];
+                    mk_cylinder_control_point(&c, i, j, k, P);
+                    mat3_mul_vec(RP, R, P);
+                    for (int q = 0; q < 3; q++) d[3 * (i + 3 * (j + 8 * k)) + q] = pass ? RP[q] + t[q] - P[q] : 0;
+                }
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, out[3], e[3];
+            mk_cylinder_eval(&c, 1, stu + 3 * v, p, out);
+            mat3_mul_vec(e, R, p);
+            for (int q = 0; q < 3; q++) {
+                if (!pass) identity = fmax(identity, fabs(out[q] - p[q]));
+                else rigid = fmax(rigid, fabs(out[q] - e[q] - t[q]));
+            }
+        }
+    }
+    double diag = diag_of(m);
+    fprintf(stderr, "cylinder lattice: identity error %.3g, rigid motion error %.3g x diagonal\n", identity / diag, rigid / diag);
+    CHECK(identity <= 1e-6 * diag);
+    CHECK_MSG(rigid <= 1e-6 * diag, "rigid lattice motion moves the mesh %g x diagonal off", rigid / diag);
+    /* Seam: sector 0 alone moved; points just either side of angle 0 land together. */
+    memset(d, 0, 3 * points * sizeof(double));
+    for (uint32_t k = 0; k < 4; k++)
+        for (uint32_t i = 1; i < 3; i++) d[3 * (i + 3 * (0 + 8 * k)) + 1] = 0.3;
+    double gap = 0;
+    uint32_t seam_failures = 0;
+    for (int z = 0; z <= 10; z++)
+        for (int r = 1; r <= 10; r++) {
+            double side[2][3];
+            for (int sgn = 0; sgn < 2; sgn++) {
+                double a = sgn ? 1e-9 : -1e-9, p[3] = { 0.1 * r * cos(a), 0.1 * r * sin(a), -1 + 0.2 * z }, q[3];
+                seam_failures += mk_cylinder_coordinates(&c, p, q, NULL, &err) != MK_OK;
+                mk_cylinder_eval(&c, 1, q, p, side[sgn]);
+            }
+            double g[3];
+            vec3_sub(g, side[0], side[1]);
+            gap = fmax(gap, vec3_length(g));
+        }
+    fprintf(stderr, "cylinder lattice: largest gap across the seam %.3g\n", gap);
+    CHECK_EQ_INT(seam_failures, 0);
+    CHECK(gap <= 1e-6 * diag);
+    /* Outside, and degenerate lattices, are errors. */
+    double far[3] = { 0, 0, 5 }, q[3];
+    CHECK(mk_cylinder_coordinates(&c, far, q, NULL, &err) != MK_OK && strstr(err.message, "outside"));
+    mk_cylinder_lattice flat = c;
+    flat.axis[2] = 0;
+    CHECK(mk_cylinder_prepare(&flat, &err) != MK_OK && strstr(err.message, "axis"));
+    flat = c;
+    flat.outer_radius = 0;
+    CHECK(mk_cylinder_prepare(&flat, &err) != MK_OK && strstr(err.message, "radius"));
+    free(d); free(stu);
+    mk_raw_free(&raw);
+}
+
+/* One linear target of the rigid motion below, played at weight w: p + w (M p - p) with M the
+ * turn of 40 degrees about x through (0, 0, 2), then (0.3, 0, -0.2). */
+static void turn_blend(const void *user, double w, const double p[3], double q[3], double J[9])
+{
+    (void)user;
+    static const double x_axis[3] = { 1, 0, 0 }, t[3] = { 0.3, 0, -0.2 };
+    double R[9], d[3] = { p[0], p[1], p[2] - 2 }, m[3];
+    mat3_rotation(R, x_axis, 40 * PI / 180);
+    mat3_mul_vec(m, R, d);
+    m[2] += 2;
+    for (int c = 0; c < 3; c++) q[c] = p[c] + w * (m[c] + t[c] - p[c]);
+    memcpy(J, R, sizeof R);
+}
+
+static void ffd_cylinder_recipe_moved_rigidly_plays_the_rigid_motion(void)
+{
+    mk_raw_asset raw;
+    /* Every control point turned 40 degrees about x through (0, 0, 2) and moved by
+     * (0.3, 0, -0.2): through the runtime, the tube at weight 1 is the rigidly moved tube (the
+     * B-spline sectors, Bernstein rings/layers and Newton's coordinates all have to be right). */
+    const char *recipe = "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"turn\", \"op\": \"ffd_cylinder\","
+        " \"axis\": \"z\", \"center\": [0, 0, 2], \"dims\": [3, 6, 3], \"moves\": [{\"translate\": [0.3, 0, -0.2],"
+        " \"rotate\": {\"axis\": [1, 0, 0], \"degrees\": 40, \"pivot\": [0, 0, 2]}}]}]}";
+    const mk_raw_mesh *m = baked_cylinder(&raw, "tube", 1, 4, 16, 8, recipe);
+    if (!m) return;
+    CHECK_EQ_INT(raw.channels[0].target_count, 1);
+    mk_asset asset;
+    if (!write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
+    double worst = playback_error(&asset, m, 0, 1, turn_blend, NULL);
+    fprintf(stderr, "ffd_cylinder rigid lattice motion through the runtime: %.3g x diagonal\n", worst / diag_of(m));
+    CHECK_MSG(worst <= 1e-6 * diag_of(m) + 2e-6, "off the rigid motion by %g", worst);
+    mk_raw_free(&raw);
+}
+
+static void ffd_cylinder_locates_every_vertex_of_corpus_meshes(void)
+{
+    /* Default lattices around real meshes: Newton must locate every vertex (the bake fails
+     * naming the vertex otherwise), and a lattice turned 30 degrees about y through the origin
+     * must turn every vertex by exactly that. */
+    static const char *const files[] = { "gltf/MorphStressTest/glTF/MorphStressTest.gltf",
+                                         "gltf/MorphPrimitivesTest/glTF/MorphPrimitivesTest.gltf",
+                                         "fbx/zbrush_d20_7500_binary.fbx" };
+    const char *recipe = "{\"mesh\": %u, \"channels\": [{\"name\": \"turn\", \"op\": \"ffd_cylinder\", \"dims\": [3, 12, 5],"
+        " \"moves\": [{\"rotate\": {\"axis\": [0, 1, 0], \"degrees\": 30, \"pivot\": [0, 0, 0]}}]}]}";
+    uint32_t meshes = 0, vertices = 0;
+    for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
+        char path[4200];
+        snprintf(path, sizeof path, "%s/%s", check_corpus_dir(), files[f]);
+        FILE *probe = fopen(path, "rb");
+        if (!probe) SKIP("corpus file %s not found", path);
+        fclose(probe);
+        for (uint32_t mesh = 0;; mesh++) {
+            mk_raw_asset raw;
+            mk_raw_init(&raw, NULL);
+            mk_error err;
+            mk_result r = mk_import_file(path, NULL, &raw, &err);
+            CHECK_MSG(r == MK_OK, "%s: %s", files[f], err.message);
+            if (r != MK_OK || mesh >= raw.mesh_count) { mk_raw_free(&raw); break; }
+            char text[512];
+            snprintf(text, sizeof text, recipe, mesh);
+            r = bake(&raw, text, &err);
+            CHECK_MSG(r == MK_OK, "%s mesh %u: %s", files[f], mesh, err.message);
+            const mk_raw_channel *ch = r == MK_OK ? find_channel(&raw, "turn") : NULL;
+            if (ch) {
+                const mk_raw_mesh *m = &raw.meshes[mesh];
+                double *pos = malloc(3 * m->vertex_count * sizeof(double)), axis[3] = { 0, 1, 0 }, R[9], worst = 0;
+                mat3_rotation(R, axis, 30 * PI / 180);
+                last_target_positions(m, ch, pos);
+                for (uint32_t v = 0; v < m->vertex_count; v++) {
+                    double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, q[3];
+                    mat3_mul_vec(q, R, p);
+                    for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(pos[3 * v + c] - q[c]));
+                }
+                CHECK_MSG(worst <= 1e-5 * diag_of(m), "%s mesh %u: off the turn by %g x diagonal", files[f], mesh,
+                          worst / diag_of(m));
+                meshes++;
+                vertices += m->vertex_count;
+                free(pos);
+            }
+            mk_raw_free(&raw);
+        }
+    }
+    fprintf(stderr, "ffd_cylinder on the corpus: %u meshes, %u vertices located, each turned rigidly\n", meshes, vertices);
+    CHECK(meshes >= 5 && vertices > 1000);
 }
 
 static void fixed_inbetweens_and_linear_ops(void)
@@ -770,6 +1292,63 @@ static void bad_recipes_name_the_field(void)
     mk_raw_free(&raw);
 }
 
+static void bad_arap_and_animated_ffd_recipes_name_the_field(void)
+{
+    static const char *const cases[][2] = {
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"axis\": \"z\", \"radius\": 0.5}]}",
+          "outside the lattice" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"radius\": 2, \"inner_radius\": 3}]}",
+          "channels[0].radius" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"dims\": [3, 2, 3]}]}",
+          "channels[0].dims" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"axis\": \"z\", \"range\": [1, 1]}]}",
+          "channels[0].range" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"axis\": \"z\", \"reference\": [0, 0, 2]}]}",
+          "channels[0].reference: parallel" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"radius\": 1e999}]}",
+          "channels[0].radius" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\"}]}",
+          "channels[0].travel: missing" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\"}]}",
+          "channels[0].keys: missing" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\", \"keys\": []}]}",
+          "channels[0].keys" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\", \"keys\": [{\"time\": 0}]}]}",
+          "channels[0].keys: no key moves the lattice" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\", \"keys\": [{\"time\": 1}, {\"time\": 1}]}]}",
+          "channels[0].keys[1].time: must be later" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\", \"keys\": [{\"moves\": []}]}]}",
+          "channels[0].keys[0].time: missing" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\", \"keys\": [{\"time\": 0, \"moves\": [{\"i\": 9}]}]}]}",
+          "channels[0].keys[0].moves[0].i" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {}}]}",
+          "channels[0].travel: moves nothing" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0, 1e999]}}]}",
+          "channels[0].travel.translate" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0]}}]}",
+          "channels[0].travel.translate" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"shift\": [1, 0, 0]}}]}",
+          "channels[0].travel.shift: unknown field" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"duration\": 0, \"travel\": {\"translate\": [1, 0, 0]}}]}",
+          "channels[0].duration" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0, 0]}, \"moves\": [{\"j\": 1, \"translate\": [0, 0.2, 0]}]}]}",
+          "moves the mesh before it travels" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\", \"travel\": {\"translate\": [1, 0, 0]}, \"origin\": [0, 0, 0], \"axes\": [[1, 0, 0], [2, 0, 0], [0, 0, 1]]}]}",
+          "degenerate" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"convergence\": -0.1, \"handles\": [{\"indices\": [0]}]}]}",
+          "channels[0].convergence: must be in [0, 1)" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"convergence\": 1e999, \"handles\": [{\"indices\": [0]}]}]}",
+          "channels[0].convergence" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"arap\", \"acceleration\": \"fast\", \"handles\": [{\"indices\": [0]}]}]}",
+          "channels[0].acceleration" },
+    };
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_cylinder(&raw, "tube", 1, 4, 16, 8);
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) expect_error(&raw, cases[i][0], cases[i][1]);
+    mk_raw_free(&raw);
+}
+
 static void bake_keeps_existing_channels(void)
 {
     mk_raw_asset raw;
@@ -824,7 +1403,8 @@ static void record_channels(void *user, const mk_bake_channel_report *c)
  * y from 0 to 2), including the cage OBJ files that resolve against the recipe directory. */
 static void sample_recipes_bake(void)
 {
-    static const char *const names[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json" };
+    static const char *const names[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json",
+                                         "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json" };
     const char *root = getenv("MORPHKIT_SOURCE_ROOT");
     if (!root) root = MK_SOURCE_ROOT;
     char dir[4096];
@@ -964,8 +1544,17 @@ CHECK_MAIN(CASE(identity_deformations_give_zero_deltas),
            CASE(laplacian_kills_constants),
            CASE(laplacian_translation_of_everything_is_exact),
            CASE(arap_rigid_handles_without_anchors_move_rigidly),
+           CASE(arap_converges_to_the_rigid_optimum_with_falling_energy),
+           CASE(arap_anderson_lowers_energy_faster_than_plain),
            CASE(component_without_constraint_is_rejected),
            CASE(twist_180_auto_inbetweens_play_back_within_tolerance),
            CASE(fixed_inbetweens_and_linear_ops),
+           CASE(ffd_travel_through_an_unmoved_lattice_is_the_rigid_travel),
+           CASE(ffd_travel_through_a_bent_lattice_follows_the_bernstein_formula),
+           CASE(ffd_keys_clip_interpolates_the_lattice_linearly),
+           CASE(cylinder_lattice_inverts_moves_rigidly_and_is_seamless),
+           CASE(ffd_cylinder_recipe_moved_rigidly_plays_the_rigid_motion),
+           CASE(ffd_cylinder_locates_every_vertex_of_corpus_meshes),
            CASE(bad_recipes_name_the_field),
+           CASE(bad_arap_and_animated_ffd_recipes_name_the_field),
            CASE(bake_keeps_existing_channels))

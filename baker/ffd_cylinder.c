@@ -1,0 +1,234 @@
+/* SPDX-License-Identifier: MIT */
+/* Extended free-form deformation with a cylindrical lattice.
+ *
+ * Papers:
+ * - S. Coquillart, "Extended Free-Form Deformation: A Sculpturing Tool for 3D Geometric
+ *   Modeling", SIGGRAPH 1990: lattices that are not parallelepipeds (cylindrical ones among
+ *   them), whose local coordinates are no longer a linear solve.
+ * - T. W. Sederberg, S. R. Parry, SIGGRAPH 1986, for the Bernstein basis (see ffd.c).
+ *
+ * Conventions fixed here:
+ * - Control point (i, j, k) rests at center + r_i (cos a_j e1 + sin a_j e2) + k/(l-1) axis.
+ *   Basis: Bernstein of degree rings-1 in s (radial), the uniform periodic cubic B-spline in
+ *   t over the sectors (angular: the seam at t = 0 = 1 is C2 like everywhere else, no special
+ *   case), Bernstein of degree layers-1 in u (axial). The rest map is therefore
+ *   F(s,t,u) = center + r(s) C(t) + u axis with r linear in s and C the B-spline "circle" of
+ *   the sector directions (radius between 0.90 and 1 of a unit circle for 8 sectors), not an
+ *   affine map: coordinates come from Newton's method.
+ * - Displacement form, as ffd.c: X' = X + a sum w(s,t,u) d, so an unmoved lattice is the
+ *   identity, and moving every control point by one affine map moves X by that map (the
+ *   weights sum to 1 and reproduce F), provided Newton found the coordinates.
+ * - Newton: start from the cylindrical coordinates of the point (exact in s and u up to the
+ *   B-spline circle's radius), steps damped by halving until the residual falls, at most 50
+ *   iterations, converged at |F(q) - X| <= 1e-10 of the lattice size. Points with s or u
+ *   outside [-1e-9, 1 + 1e-9] are outside the lattice.
+ */
+#include <math.h>
+#include <string.h>
+#include "ffd_cylinder.h"
+#include "bake_util.h"
+
+#define PI 3.14159265358979323846
+#define MAX_DIM 64
+
+mk_result mk_cylinder_prepare(mk_cylinder_lattice *c, mk_error *err)
+{
+    static const uint32_t min_dims[3] = { 2, 3, 2 };
+    for (int a = 0; a < 3; a++)
+        if (c->dims[a] < min_dims[a] || c->dims[a] > MAX_DIM)
+            return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "dims[%d]: %u control points (need %u..%d)",
+                                a, c->dims[a], min_dims[a], MAX_DIM);
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(c->center[k]) || !isfinite(c->axis[k]) || !isfinite(c->reference[k]))
+            return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX, "center/axis/reference: not finite");
+    if (!isfinite(c->inner_radius) || !isfinite(c->outer_radius) || !(c->inner_radius >= 0) ||
+        !(c->outer_radius > c->inner_radius))
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
+                            "radius: need 0 <= inner radius < outer radius (got %g, %g)", c->inner_radius, c->outer_radius);
+    double *e1 = c->frame[0], *e2 = c->frame[1], *e3 = c->frame[2];
+    memcpy(e3, c->axis, sizeof c->axis);
+    c->height = vec3_normalize(e3);
+    if (!(c->height > 0)) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "axis: zero length (no height)");
+    double d = vec3_dot(c->reference, e3);
+    for (int k = 0; k < 3; k++) e1[k] = c->reference[k] - d * e3[k];
+    if (!(vec3_normalize(e1) > 1e-9 * vec3_length(c->reference)))
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "reference: parallel to the axis");
+    vec3_cross(e2, e3, e1);
+    return MK_OK;
+}
+
+void mk_cylinder_control_point(const mk_cylinder_lattice *c, uint32_t i, uint32_t j, uint32_t k, double out[3])
+{
+    double r = c->inner_radius + (c->outer_radius - c->inner_radius) * i / (c->dims[0] - 1);
+    double a = 2 * PI * j / c->dims[1], u = (double)k / (c->dims[2] - 1);
+    for (int q = 0; q < 3; q++)
+        out[q] = c->center[q] + r * (cos(a) * c->frame[0][q] + sin(a) * c->frame[1][q]) + u * c->height * c->frame[2][q];
+}
+
+/* Bernstein polynomial C(n, i) x^i (1 - x)^(n - i); 0 outside 0..n. */
+static double bernstein_value(int n, int i, double x)
+{
+    if (i < 0 || i > n) return 0;
+    double binomial = 1;
+    for (int k = 1; k <= i; k++) binomial = binomial * (n - i + k) / k;
+    return binomial * pow(x, i) * pow(1 - x, n - i);
+}
+
+/* Bernstein weights of degree n-1 at x and their derivatives n' (B_{i-1}^{n'-1} - B_i^{n'-1}). */
+static void bernstein(uint32_t n, double x, double *w, double *dw)
+{
+    int deg = (int)n - 1;
+    for (int i = 0; i <= deg; i++) {
+        w[i] = bernstein_value(deg, i, x);
+        dw[i] = deg * (bernstein_value(deg - 1, i - 1, x) - bernstein_value(deg - 1, i, x));
+    }
+}
+
+/* Periodic uniform cubic B-spline over n control points at t in [0, 1): the 4 taps (indices
+ * mod n), their weights and derivatives d/dt. */
+static void periodic_bspline(uint32_t n, double t, uint32_t taps[4], double w[4], double dw[4])
+{
+    double g = t * n, f = floor(g), x = g - f;
+    long base = (long)f;
+    for (int q = 0; q < 4; q++) taps[q] = (uint32_t)((((base - 1 + q) % (long)n) + (long)n) % (long)n);
+    double y = 1 - x;
+    w[0] = y * y * y / 6;
+    w[1] = (3 * x * x * x - 6 * x * x + 4) / 6;
+    w[2] = (-3 * x * x * x + 3 * x * x + 3 * x + 1) / 6;
+    w[3] = x * x * x / 6;
+    dw[0] = -y * y / 2 * n;
+    dw[1] = (9 * x * x - 12 * x) / 6 * n;
+    dw[2] = (-9 * x * x + 6 * x + 3) / 6 * n;
+    dw[3] = x * x / 2 * n;
+}
+
+/* sum w(q) P_ijk + amplitude * sum w(q) d_ijk and its derivatives (columns d/ds, d/dt, d/du,
+ * row-major J[3*row + col]); P from the rest control points, d = NULL for the rest map. */
+static void lattice_eval(const mk_cylinder_lattice *c, const double q[3], const double *disp, double amplitude,
+                         double out[3], double J[9])
+{
+    double ws[MAX_DIM], dws[MAX_DIM], wu[MAX_DIM], dwu[MAX_DIM], wt[4], dwt[4];
+    uint32_t taps[4];
+    double t = q[1] - floor(q[1]);
+    bernstein(c->dims[0], q[0], ws, dws);
+    periodic_bspline(c->dims[1], t, taps, wt, dwt);
+    bernstein(c->dims[2], q[2], wu, dwu);
+    memset(out, 0, 3 * sizeof(double));
+    if (J) memset(J, 0, 9 * sizeof(double));
+    for (uint32_t k = 0; k < c->dims[2]; k++)
+        for (int b = 0; b < 4; b++)
+            for (uint32_t i = 0; i < c->dims[0]; i++) {
+                uint32_t j = taps[b];
+                double p[3];
+                if (disp) {
+                    const double *d = disp + 3 * (i + c->dims[0] * ((size_t)j + c->dims[1] * k));
+                    for (int r = 0; r < 3; r++) p[r] = amplitude * d[r];
+                } else mk_cylinder_control_point(c, i, j, k, p);
+                double w = ws[i] * wt[b] * wu[k];
+                for (int r = 0; r < 3; r++) out[r] += w * p[r];
+                if (J)
+                    for (int r = 0; r < 3; r++) {
+                        J[3 * r + 0] += dws[i] * wt[b] * wu[k] * p[r];
+                        J[3 * r + 1] += ws[i] * dwt[b] * wu[k] * p[r];
+                        J[3 * r + 2] += ws[i] * wt[b] * dwu[k] * p[r];
+                    }
+            }
+}
+
+/* Solves J x = b for 3x3 J by Cramer's rule; 0 when J is singular relative to its size. */
+static int solve3(const double J[9], const double b[3], double x[3])
+{
+    double det = mat3_det(J), size = 0;
+    for (int i = 0; i < 9; i++) size = fmax(size, fabs(J[i]));
+    if (!(fabs(det) > 1e-14 * size * size * size)) return 0;
+    double cof[9];
+    mat3_cofactor(cof, J);  /* cof(J) = det(J) J^-T */
+    for (int r = 0; r < 3; r++) x[r] = (cof[r] * b[0] + cof[3 + r] * b[1] + cof[6 + r] * b[2]) / det;
+    return 1;
+}
+
+mk_result mk_cylinder_coordinates(const mk_cylinder_lattice *c, const double p[3], double q[3], uint32_t *iterations,
+                                  mk_error *err)
+{
+    double size = fmax(c->outer_radius, c->height), rel[3], target_error = 1e-10 * size;
+    vec3_sub(rel, p, c->center);
+    double x = vec3_dot(rel, c->frame[0]), y = vec3_dot(rel, c->frame[1]), z = vec3_dot(rel, c->frame[2]);
+    double radius = sqrt(x * x + y * y), angle = atan2(y, x);
+    q[0] = (radius - c->inner_radius) / (c->outer_radius - c->inner_radius);
+    q[1] = angle / (2 * PI);
+    q[2] = z / c->height;
+    q[0] = fmin(fmax(q[0], 0), 1);
+    double f[3], J[9], res = INFINITY;
+    uint32_t it = 0;
+    for (;; it++) {
+        lattice_eval(c, q, NULL, 0, f, J);
+        vec3_sub(f, f, p);
+        res = vec3_length(f);
+        if (res <= target_error || it == 50) break;
+        double step[3];
+        if (!solve3(J, f, step)) {
+            /* On the axis (inner radius 0, s = 0) the angle is free: solve for s and u only. */
+            double A[9] = { J[0], J[2], 0, J[3], J[5], 0, J[6], J[8], 1 }, sol[3];
+            if (!solve3(A, f, sol)) break;
+            step[0] = sol[0]; step[1] = 0; step[2] = sol[1];
+        }
+        double lambda = 1, trial[3], g[3];
+        for (int h = 0; h < 30; h++, lambda *= 0.5) {
+            for (int k = 0; k < 3; k++) trial[k] = q[k] - lambda * step[k];
+            trial[0] = fmax(trial[0], -0.5);
+            lattice_eval(c, trial, NULL, 0, g, NULL);
+            vec3_sub(g, g, p);
+            if (vec3_length(g) < res) break;
+        }
+        memcpy(q, trial, sizeof trial);
+    }
+    if (iterations) *iterations = it;
+    q[1] -= floor(q[1]);
+    if (!(res <= target_error))
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
+                            "Newton did not converge (residual %.3g of the lattice size after %u iterations)",
+                            res / size, it);
+    if (q[0] < -1e-9 || q[0] > 1 + 1e-9 || q[2] < -1e-9 || q[2] > 1 + 1e-9)
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
+                            "outside the lattice (s = %.4g, u = %.4g; both must be in [0, 1])", q[0], q[2]);
+    return MK_OK;
+}
+
+void mk_cylinder_eval(const mk_cylinder_lattice *c, double amplitude, const double q[3], const double p[3],
+                      double out[3])
+{
+    double moved[3];
+    lattice_eval(c, q, c->displacements, amplitude, moved, NULL);
+    for (int k = 0; k < 3; k++) out[k] = p[k] + moved[k];
+}
+
+double mk_cylinder_ring_ratio(uint32_t sectors)
+{
+    /* |C(t)| for control points on the unit circle, sampled 64 times per sector (the minimum
+     * is between sectors, where the curve cuts the chord the most). */
+    double least = 1;
+    for (uint32_t q = 0; q < 64 * sectors; q++) {
+        uint32_t taps[4];
+        double w[4], dw[4], x = 0, y = 0;
+        periodic_bspline(sectors, (double)q / (64 * sectors), taps, w, dw);
+        for (int b = 0; b < 4; b++) {
+            x += w[b] * cos(2 * PI * taps[b] / sectors);
+            y += w[b] * sin(2 * PI * taps[b] / sectors);
+        }
+        least = fmin(least, sqrt(x * x + y * y));
+    }
+    return least;
+}
+
+mk_result mk_cylinder_bind(const mk_cylinder_lattice *c, const mk_raw_mesh *mesh, double *stu, mk_error *err)
+{
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        const float *pf = mesh->positions + 3 * (size_t)v;
+        double p[3] = { pf[0], pf[1], pf[2] };
+        mk_error inner;
+        if (mk_cylinder_coordinates(c, p, stu + 3 * (size_t)v, NULL, &inner) != MK_OK)
+            return mk_error_set(err, inner.code, UINT64_MAX, "vertex %u (%g, %g, %g): %s", v, p[0], p[1], p[2],
+                                inner.message);
+    }
+    return MK_OK;
+}
