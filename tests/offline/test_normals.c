@@ -108,6 +108,36 @@ static void test_matches_recomputed_normals(void)
     mk_raw_free(&raw);
 }
 
+/* Authored tangent deltas are kept when normals are computed: each moved vertex keeps its
+ * own delta in the grown index set, and the neighbours that joined it get none. */
+static void test_authored_tangents_follow_their_vertex(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    grid_with_seam(&raw);
+    mk_raw_target *t = &raw.channels[0].targets[0];
+    static const float authored[9] = { 0.1f, 0, 0, 0, 0.2f, 0, 0, 0, 0.3f };   /* v7, v12, v25 */
+    t->tangents = mk_arena_array(&raw.arena, 9, sizeof(float));
+    memcpy(t->tangents, authored, sizeof authored);
+    mk_error err;
+    CHECK(mk_raw_compute_target_normals(&raw, 0, 0, 0, &err) == MK_OK);
+    t = &raw.channels[0].targets[0];
+    CHECK(t->count > 3 && t->tangents != NULL);
+    uint32_t found = 0;
+    for (uint32_t j = 0; j < t->count; j++) {
+        const uint32_t v = t->indices[j];
+        const int k = v == 7 ? 0 : v == 12 ? 1 : v == 25 ? 2 : -1;
+        found += k >= 0;
+        for (int d = 0; d < 3; d++) {
+            const float want = k >= 0 ? authored[3 * k + d] : 0.0f;
+            CHECK_MSG(t->tangents[3 * j + (uint32_t)d] == want, "vertex %u tangent delta[%d] = %g, expected %g", v, d,
+                      (double)t->tangents[3 * j + (uint32_t)d], (double)want);
+        }
+    }
+    CHECK_EQ_INT(found, 3);
+    mk_raw_free(&raw);
+}
+
 /* An L of two quads meeting at a right angle with a hard edge: the shared edge's control
  * points have one vertex per face (different normals). Moving a far vertex of the floor
  * must not change the wall's normals. */
@@ -217,5 +247,6 @@ static void test_same_result_for_any_thread_count(void)
     mk_raw_free(&many);
 }
 
-CHECK_MAIN(CASE(test_matches_recomputed_normals), CASE(test_hard_edge_stays_hard),
+CHECK_MAIN(CASE(test_matches_recomputed_normals), CASE(test_authored_tangents_follow_their_vertex),
+           CASE(test_hard_edge_stays_hard),
            CASE(test_same_result_for_any_thread_count))
