@@ -444,6 +444,67 @@ static void test_blender_full_weights(void)
     }
 }
 
+/* Blender's vertex-group reading of FullWeights is for a channel of one shape (Blender exports
+ * no in-betweens): a Blender file whose channel has two shapes and one FullWeights entry per
+ * shape gets in-betweens at those weights, with the deltas unscaled. */
+static void test_blender_inbetweens_keep_full_weights(void)
+{
+    static const int32_t idx[2] = { 0, 1 };
+    static const double half[6] = { 0, 0, 1, 0, 0, 1 }, full[6] = { 0, 0, 3, 0, 0, 3 };
+    static const double fw[2] = { 50, 100 };
+    static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
+    static const int32_t tri[3] = { 0, 1, ~2 };
+    fbxw_shape shapes[2] = { { "Half", 2, idx, half, NULL }, { "Full", 2, idx, full, NULL } };
+    fbxw_channel channel;
+    memset(&channel, 0, sizeof channel);
+    channel.name = "Key";
+    channel.deform_percent = 0;
+    channel.deform_as_field_only = 1;
+    channel.shape_count = 2;
+    channel.shapes = shapes;
+    channel.full_weight_count = 2;
+    channel.full_weights = fw;
+    fbxw_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.name = "Tri";
+    mesh.control_point_count = 3;
+    mesh.control_points = points;
+    mesh.polygon_vertex_count = 3;
+    mesh.polygon_vertex_index = tri;
+    mesh.channel_count = 1;
+    mesh.channels = &channel;
+    mesh.parent = -1;
+    fbxw_scene scene;
+    memset(&scene, 0, sizeof scene);
+    scene.version = 7400;
+    scene.binary = 1;
+    scene.creator = "Blender (stable FBX IO) - 4.4.1 - 5.12.7";
+    scene.mesh_count = 1;
+    scene.meshes = &mesh;
+    unsigned char *data;
+    size_t size;
+    CHECK(fbxw_write(&scene, &data, &size) == 0);
+    mk_raw_asset raw;
+    mk_error err;
+    CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
+    free(data);
+    CHECK_EQ_INT(raw.channel_count, 1);
+    if (raw.channel_count == 1 && raw.channels[0].target_count == 2) {
+        const mk_raw_channel *ch = &raw.channels[0];
+        for (uint32_t k = 0; k < 2; k++) {
+            const mk_raw_target *t = &ch->targets[k];
+            CHECK_NEAR(t->full_weight, k ? 1.0 : 0.5, 1e-7);
+            for (uint32_t i = 0; i < t->count; i++) {
+                uint32_t cp = raw.meshes[0].control_points[t->indices[i]];
+                CHECK_NEAR(t->positions[3 * i + 2], cp > 1 ? 0.0 : k ? 3.0 : 1.0, 1e-7);
+            }
+        }
+    } else {
+        CHECK_MSG(0, "expected one channel of two in-betweens");
+    }
+    mk_raw_free(&raw);
+}
+
 static void test_duplicate_full_weights(void)
 {
     static const int32_t idx[1] = { 0 };
@@ -1290,7 +1351,7 @@ static int write_seeds(const char *dir)
 }
 
 static const check_case cases[] = {
-    CASE(test_formats_roundtrip), CASE(test_stacking_option), CASE(test_curves), CASE(test_blender_full_weights),
+    CASE(test_formats_roundtrip), CASE(test_stacking_option), CASE(test_curves), CASE(test_blender_full_weights), CASE(test_blender_inbetweens_keep_full_weights),
     CASE(test_duplicate_full_weights), CASE(test_tiny_full_weights), CASE(test_hostile_constructs),
     CASE(test_allocation_failures), CASE(test_rotation_order), CASE(test_legacy_61_ascii), CASE(test_inherit_type),
     CASE(test_empty_mesh_skipped), CASE(test_skipped_mesh_warnings),

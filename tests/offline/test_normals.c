@@ -91,6 +91,62 @@ static void test_matches_recomputed_normals(void)
     mk_raw_free(&raw);
 }
 
+/* Authored tangent deltas are kept when normals are computed: each moved vertex keeps its
+ * own delta in the grown index set, and the neighbours that joined it get none. */
+static void test_authored_tangents_follow_their_vertex(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    grid_with_seam(&raw);
+    mk_raw_target *t = &raw.channels[0].targets[0];
+    static const float authored[9] = { 0.1f, 0, 0, 0, 0.2f, 0, 0, 0, 0.3f };   /* v7, v12, v25 */
+    t->tangents = mk_arena_array(&raw.arena, 9, sizeof(float));
+    memcpy(t->tangents, authored, sizeof authored);
+    mk_error err;
+    CHECK(mk_raw_compute_target_normals(&raw, 0, 0, 0, &err) == MK_OK);
+    t = &raw.channels[0].targets[0];
+    CHECK(t->count > 3 && t->tangents != NULL);
+    uint32_t found = 0;
+    for (uint32_t j = 0; j < t->count; j++) {
+        const uint32_t v = t->indices[j];
+        const int k = v == 7 ? 0 : v == 12 ? 1 : v == 25 ? 2 : -1;
+        found += k >= 0;
+        for (int d = 0; d < 3; d++) {
+            const float want = k >= 0 ? authored[3 * k + d] : 0.0f;
+            CHECK_MSG(t->tangents[3 * j + (uint32_t)d] == want, "vertex %u tangent delta[%d] = %g, expected %g", v, d,
+                      (double)t->tangents[3 * j + (uint32_t)d], (double)want);
+        }
+    }
+    CHECK_EQ_INT(found, 3);
+    mk_raw_free(&raw);
+}
+
+/* Two targets moving the same vertices on one worker thread: the second gets the same grown
+ * index set and normals as the first (the per-worker work arrays start clean for each target). */
+static void test_targets_in_turn_on_one_thread(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    grid_with_seam(&raw);
+    mk_raw_channel *ch = mk_raw_add_channels(&raw, 1);   /* may move the channels */
+    ch->name = "bump_again";
+    mk_raw_target *t = mk_raw_add_targets(&raw, ch, 1);
+    const mk_raw_target *first = &raw.channels[0].targets[0];
+    t->name = "bump_again";
+    t->count = first->count;
+    t->indices = first->indices;
+    t->positions = first->positions;
+    mk_error err;
+    CHECK(mk_raw_compute_target_normals(&raw, 0, 0, 1, &err) == MK_OK);
+    const mk_raw_target *a = &raw.channels[0].targets[0], *b = &raw.channels[1].targets[0];
+    CHECK_MSG(a->count > 3 && b->count == a->count, "index sets of %u and %u vertices", a->count, b->count);
+    if (b->count == a->count) {
+        CHECK(!memcmp(a->indices, b->indices, 4u * a->count));
+        CHECK(!memcmp(a->normals, b->normals, 12u * a->count));
+    }
+    mk_raw_free(&raw);
+}
+
 /* An L of two quads meeting at a right angle with a hard edge: the shared edge's control
  * points have one vertex per face (different normals). Moving a far vertex of the floor
  * must not change the wall's normals. */
@@ -157,5 +213,7 @@ static void test_same_result_for_any_thread_count(void)
     mk_raw_free(&many);
 }
 
-CHECK_MAIN(CASE(test_matches_recomputed_normals), CASE(test_hard_edge_stays_hard),
+CHECK_MAIN(CASE(test_matches_recomputed_normals), CASE(test_authored_tangents_follow_their_vertex),
+           CASE(test_targets_in_turn_on_one_thread),
+           CASE(test_hard_edge_stays_hard),
            CASE(test_same_result_for_any_thread_count))

@@ -95,6 +95,15 @@ static void test_quantization_tolerance(void)
         }
     }
     CHECK_MSG(worst <= rep.max_position_error + 1e-9, "worst %g > reported %g", worst, rep.max_position_error);
+    /* A tolerance below the worst quantized target's error: that target (at least) is stored as
+     * float now, and every target still quantized errs by no more than the tolerance. */
+    const double before = rep.max_position_error;
+    o.tolerance = (float)(0.75 * before);
+    CHECK(before > 0 && mk_write_blob(&raw, &o, &raw.arena, &blob, &size, &rep, &err) == MK_OK);
+    CHECK_MSG(rep.float_targets >= 2, "tolerance %g below the worst error %g: %u float targets", (double)o.tolerance,
+              before, rep.float_targets);
+    CHECK_MSG(rep.max_position_error <= o.tolerance, "a quantized target errs by %g, over the tolerance %g",
+              rep.max_position_error, (double)o.tolerance);
     mk_raw_free(&back);
     mk_raw_free(&raw);
 }

@@ -151,6 +151,38 @@ static void test_sample_job(void)
     mk_raw_free(&raw);
 }
 
+/* A looping clip wraps time into [start, start + duration) (docs/semantics.md): relative to its
+ * start, not to time 0. fixture_rich's clip "blink" starts at 0.5 and lasts 1; its track on
+ * channel 2 is linear from 0 at 0.5 to 1 at 1.5, so the weight at clip time t is t - 0.5. */
+static void test_loop_relative_to_start(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_rich(&raw);
+    size_t size;
+    void *blob = fixture_blob(&raw, MK_PRECISION_FLOAT, &raw.arena, &size);
+    mk_asset a;
+    mk_error err;
+    CHECK(mk_asset_open(blob, size, &a, &err) == MK_OK);
+    float w[16];
+    CHECK(a.channel_count <= 16);
+    static const struct { double time, expected; } cases[] = {
+        { 0.75, 0.25 },    /* inside the clip: no wrap */
+        { 2.75, 0.25 },    /* 2 durations on: 0.75 */
+        { 1.75, 0.25 },    /* one duration on (wrapped from 0, it would be 0.75) */
+        { 0.25, 0.75 },    /* before the start: wraps up to 1.25 */
+        { -3.0, 0.5 },     /* far before: 1.0 */
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        mk_sample_job job = { .asset = &a, .clip = 2, .time = cases[i].time, .weights = w,
+                              .weight_count = a.channel_count, .loop = 1 };
+        CHECK(mk_sample_run(&job, &err) == MK_OK);
+        CHECK_MSG(fabs(w[2] - cases[i].expected) <= 1e-6, "looping clip at time %g: weight %.9g, expected %g",
+                  cases[i].time, (double)w[2], cases[i].expected);
+    }
+    mk_raw_free(&raw);
+}
+
 CHECK_MAIN(CASE(test_constant_linear), CASE(test_clamp_outside), CASE(test_hermite), CASE(test_weighted_bezier),
            CASE(test_cursor_matches_search), CASE(test_steep_slopes_stay_finite),
-           CASE(test_span_without_targets), CASE(test_sample_job))
+           CASE(test_span_without_targets), CASE(test_sample_job), CASE(test_loop_relative_to_start))

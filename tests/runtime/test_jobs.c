@@ -79,6 +79,40 @@ static void test_invalid_eval_jobs(void)
     j = valid_eval(); j.scratch_size = mk_eval_scratch_size(&asset, 0); expect(j, MK_OK, "queried scratch size");
 }
 
+/* The runtime never writes past scratch_size bytes of the scratch: every size from 0 to
+ * mk_eval_scratch_size() is either refused with MK_ERROR_BUFFER_TOO_SMALL or enough, and then
+ * gives the frame the queried size gives. Canary bytes after the given size catch a write past
+ * it (a size check that lets a scratch a few bytes short through). */
+static void test_scratch_never_overrun(void)
+{
+    enum { CANARY = 64 };
+    mk_eval_job j = valid_eval();
+    const size_t needed = mk_eval_scratch_size(&asset, 0);
+    CHECK(needed > 0 && needed + CANARY <= sizeof scratch);
+    const float w[4] = { 0.75f, -0.5f, 0.5f, 1.0f };   /* every channel active */
+    memcpy(weights, w, sizeof w);
+    float expected[12];
+    j.normals = NULL;
+    j.tangents = NULL;
+    j.scratch_size = needed;
+    j.stacking = MK_STACKING_SEQUENTIAL;
+    mk_error err;
+    CHECK_MSG(mk_eval_run(&j, &err) == MK_OK, "queried size: %s", err.message);
+    memcpy(expected, pos, sizeof expected);
+    for (size_t n = 0; n <= needed; n++) {
+        memset(scratch, 0xa5, sizeof scratch);
+        memset(pos, 0, sizeof pos);
+        j.scratch_size = n;
+        mk_result r = mk_eval_run(&j, &err);
+        CHECK_MSG(r == MK_OK || r == MK_ERROR_BUFFER_TOO_SMALL, "scratch of %zu bytes: %s", n, mk_result_name(r));
+        int intact = 1;
+        for (size_t i = n; i < n + CANARY; i++) intact &= scratch[i] == 0xa5;
+        CHECK_MSG(intact, "scratch of %zu bytes (%s): written past its end", n, mk_result_name(r));
+        if (r == MK_OK) CHECK_MSG(!memcmp(pos, expected, sizeof expected), "scratch of %zu bytes: another frame", n);
+    }
+    memset(weights, 0, sizeof w);
+}
+
 /* vertex_count 0 is an empty range: it writes nothing, wherever it starts (a job splitter
  * that produces an empty slice must not evaluate the whole mesh); MK_VERTICES_TO_END from
  * the last vertex is empty too. */
@@ -152,5 +186,6 @@ static void test_queries_reject_bad_indices(void)
     CHECK(mk_eval_scratch_size(&asset, 9) == 0);
 }
 
-CHECK_MAIN(CASE(test_valid_job_runs), CASE(test_invalid_eval_jobs), CASE(test_empty_ranges_write_nothing), CASE(test_invalid_sample_jobs),
+CHECK_MAIN(CASE(test_valid_job_runs), CASE(test_invalid_eval_jobs), CASE(test_empty_ranges_write_nothing), CASE(test_scratch_never_overrun),
+           CASE(test_invalid_sample_jobs),
            CASE(test_queries_reject_bad_indices))

@@ -732,7 +732,7 @@ static void test_slerp_identical_and_opposite_ends(void)
  * slerp replaces a span end shorter than 1e-8 by normalize(B_n) (not B_n). Tangent deltas
  * likewise. Base normals +z except v3's (0, 0, 2); tangents (1, 0, 0, -1).
  *   "cancel" (f = 1): -B_n at v0, v2, v3; -B_n + (1e-5, 0, 0) at v1 (above 1e-8);
- *                     -B_n + (5e-9, 0, 0) at v4 (below 1e-8); tangent -(1, 0, 0) at v0.
+ *                     -B_n + (5e-9, 0, 0) at v4 (below 1e-8); tangent -(1, 0, 0) at v0 and v2.
  *   "turn" (f = 1): to +x at v2 and v4, to 45 degrees between +z and +x at v3.
  *   "cancel_below" (f = -1): -B_n at v3, so at w < 0 the vanishing end is span end a. */
 static void test_degenerate_normals(void)
@@ -745,7 +745,7 @@ static void test_degenerate_normals(void)
     mk_raw_asset raw;
     hand_mesh(&raw, 5, positions, normals, tangents);
     hand_target cancel[1] = { { 1.0f, 5, idx, zero, (const float[]){ 0, 0, -1, 1e-5f, 0, -1, 0, 0, -1, 0, 0, -2, 5e-9f, 0, -1 },
-                                (const float[]){ -1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0 } } };
+                                (const float[]){ -1, 0, 0, 0, 0, 0, -1, 0, 0, 0, 0, 0, 0, 0, 0 } } };
     hand_target turn[1] = { { 1.0f, 3, idx_turn, zero, (const float[]){ 1, 0, -1, 1, 0, -1, 1, 0, -1 }, NULL } };
     hand_target cancel_below[1] = { { -1.0f, 1, idx3, zero, (const float[]){ 0, 0, -2 }, NULL } };
     hand_channel(&raw, "cancel", 1, cancel);
@@ -770,6 +770,9 @@ static void test_degenerate_normals(void)
         CHECK(f.ref[0].tangent[k] == tangents[k]);
     }
     CHECK(f.tangents[3] == -1 && f.ref[0].tangent[3] == -1);   /* w is the base's */
+    for (int k = 0; k < 4; k++)   /* v2 too: its own base tangent (4 floats a vertex), not another's */
+        CHECK_MSG(f.tangents[8 + k] == tangents[8 + k], "tangent sum zero at v2: [%d] = %.9g, expected the base %.9g", k,
+                  (double)f.tangents[8 + k], (double)tangents[8 + k]);
     hand_eval(&raw, &asset, w, MK_STACKING_ASSET, MK_NORMALS_SLERP, &f);
     expect_normal(&f, 0, 0, 0, 1, tol, "slerp, vanishing end replaced by normalize(B_n)");
     expect_normal(&f, 1, 1, 0, 0, tol, "slerp, end of length 1e-5 is normalized");
