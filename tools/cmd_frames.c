@@ -11,6 +11,7 @@
 #include "asset.h"
 #include "cli.h"
 #include "frame.h"
+#include "frame_plan.h"
 #include "frame_write.h"
 #include "json_write.h"
 #include "weights_arg.h"
@@ -69,25 +70,6 @@ const cli_verb cli_verb_frames = {
     .run = run_frames,
 };
 
-/* One frame to write: a clip time, or a forced weight set. */
-typedef struct frame_plan {
-    double time;
-    const char *weights;   /* NAME=V,... or NULL */
-} frame_plan;
-
-/* Splits list at sep in place into up to max items; returns the count (0 when an item is empty). */
-static uint32_t split(char *list, char sep, char **items, uint32_t max)
-{
-    uint32_t n = 0;
-    for (char *p = list, *next; p && n < max; p = next) {
-        next = strchr(p, sep);
-        if (next) *next++ = 0;
-        if (!*p) return 0;
-        items[n++] = p;
-    }
-    return n;
-}
-
 static int write_text(cli_output *out, const cli_verb *verb, const char *dir, const char *name, const char *const *inputs,
                       char **text, size_t *size, FILE **f)
 {
@@ -106,7 +88,6 @@ static int run_frames(void *p)
 {
     frames_args *args = p;
     const cli_verb *verb = &cli_verb_frames;
-    if (args->times && args->weights) return cli_usage_error(verb, "--times and --weights contradict each other");
     struct stat st;
     if (stat(args->output, &st) == 0 && !S_ISDIR(st.st_mode))
         return cli_usage_error(verb, "-o %s: exists and is not a folder", args->output);
@@ -122,54 +103,14 @@ static int run_frames(void *p)
         return cli_fail(verb->name, &err);
     }
     const mk_asset *a = &l.asset;
-    int status = CLI_EXIT_FAILURE;
-    char *list_copy = NULL;
-    frame_plan plans[10000];
-    uint32_t plan_count = 0;
-    int32_t clip = -1;
-    if (args->weights) {
-        list_copy = strdup(args->weights);
-        char *items[10000];
-        plan_count = list_copy ? split(list_copy, ';', items, 10000) : 0;
-        if (!plan_count) { status = cli_usage_error(verb, "--weights: a set is empty (write NAME=V,...;NAME=V,...)"); goto done; }
-        for (uint32_t i = 0; i < plan_count; i++) plans[i] = (frame_plan){ 0.0, items[i] };
-    } else if (a->clip_count) {
-        clip = args->clip ? mk_find_clip(a, args->clip) : 0;
-        if (clip < 0) {
-            char *end;
-            long idx = strtol(args->clip, &end, 10);
-            if (*end || end == args->clip || idx < 0 || idx >= (long)a->clip_count) {
-                status = cli_usage_error(verb, "--clip: no clip '%s' (the asset has %u clips)", args->clip, a->clip_count);
-                goto done;
-            }
-            clip = (int32_t)idx;
-        }
-        mk_clip_info ci;
-        mk_clip_get(a, (uint32_t)clip, &ci);
-        if (args->times) {
-            list_copy = strdup(args->times);
-            char *items[10000];
-            plan_count = list_copy ? split(list_copy, ',', items, 10000) : 0;
-            for (uint32_t i = 0; i < plan_count; i++) {
-                char *end;
-                plans[i].time = strtod(items[i], &end);
-                plans[i].weights = NULL;
-                if (*end || !isfinite(plans[i].time)) {
-                    status = cli_usage_error(verb, "--times: \"%s\" is not a number of seconds", items[i]);
-                    goto done;
-                }
-            }
-            if (!plan_count) { status = cli_usage_error(verb, "--times: an item is empty"); goto done; }
-        } else {
-            plan_count = (uint32_t)args->frames;
-            for (uint32_t i = 0; i < plan_count; i++)
-                plans[i] = (frame_plan){ ci.start + ci.duration * (plan_count > 1 ? (double)i / (plan_count - 1) : 0.0), NULL };
-        }
-    } else {
-        if (args->clip || args->times) { status = cli_usage_error(verb, "%s has no clip; give --weights", args->input); goto done; }
-        plans[0] = (frame_plan){ 0.0, NULL };   /* the static state */
-        plan_count = 1;
-    }
+    cli_frame_plan fp;
+    int status = cli_frame_plan_make(verb, a, args->input, args->clip, args->times, args->weights,
+                                     (uint32_t)args->frames, &fp);
+    if (status >= 0) goto done;
+    status = CLI_EXIT_FAILURE;
+    const cli_frame *plans = fp.frames;
+    const uint32_t plan_count = fp.count;
+    const int32_t clip = fp.clip;
 
     /* Every output in one all-or-nothing set: the blob, the manifest, the list, 2 per frame. */
     uint32_t count = 3 + 2 * plan_count;
@@ -302,7 +243,7 @@ cleanup:
     free(texts);
     free(sizes);
 done:
-    free(list_copy);
+    cli_frame_plan_free(&fp);
     pb_asset_free(&l);
     return status;
 }
