@@ -14,7 +14,6 @@
 #include "frame_plan.h"
 #include "frame_write.h"
 #include "json_write.h"
-#include "weights_arg.h"
 
 typedef struct frames_args {
     const char *input, *output, *clip, *times, *weights;
@@ -183,20 +182,17 @@ static int run_frames(void *p)
     fputc('\n', manifest);
 
     for (uint32_t i = 0; i < plan_count; i++) {
-        pb_frame frame = { .asset = a, .clip = clip, .time = plans[i].time, .stacking = stacking,
-                           .normal_mode = args->normals ? MK_NORMALS_SLERP : MK_NORMALS_NLERP, .world = args->space };
-        frame.weights = calloc(a->channel_count + 1u, sizeof(float));
-        char why[1024];
-        mk_result r = frame.weights ? pb_frame_weights(a, clip, plans[i].time, frame.weights, &err) : mk_error_oom(&err, "weights");
-        if (r == MK_OK && plans[i].weights && weights_arg_apply(a, plans[i].weights, frame.weights, why, sizeof why) != 0) {
-            status = cli_usage_error(verb, "--weights: %s", why);
-            pb_frame_free(&frame);
-            free(frame.weights);
+        pb_frame frame = { .asset = a, .stacking = stacking, .normal_mode = args->normals ? MK_NORMALS_SLERP : MK_NORMALS_NLERP,
+                           .world = args->space };
+        int played = cli_frame_play(verb, args->input, &fp, i, &frame);
+        if (played >= 0) {
+            status = played;
+            cli_frame_clear(&frame);
             fclose(manifest);
             fclose(list);
             goto cleanup;
         }
-        if (r == MK_OK) r = pb_frame_evaluate(&frame, &err);
+        mk_result r = MK_OK;
         for (int k = 0; r == MK_OK && k < 2; k++) {
             char name[64];
             snprintf(name, sizeof name, "frame_%03u.%s", i, exts[k]);
@@ -211,8 +207,7 @@ static int run_frames(void *p)
             fclose(f);
             if (k) fprintf(list, "%s\n", name);
         }
-        pb_frame_free(&frame);
-        free(frame.weights);
+        cli_frame_clear(&frame);
         if (r != MK_OK) {
             fclose(manifest);
             fclose(list);

@@ -3,7 +3,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "cli.h"
+#include "frame.h"
 #include "frame_plan.h"
+#include "weights_arg.h"
 
 /* Largest frame count of a plan: far more than any sheet or golden set needs. */
 #define MAX_FRAMES 10000u
@@ -118,4 +121,31 @@ void cli_frame_plan_free(cli_frame_plan *plan)
     free(plan->frames);
     free(plan->storage);
     memset(plan, 0, sizeof *plan);
+}
+
+int cli_frame_play(const cli_verb *verb, const char *input, const cli_frame_plan *plan, uint32_t index, pb_frame *frame)
+{
+    const cli_frame *f = &plan->frames[index];
+    const mk_asset *a = frame->asset;
+    frame->clip = plan->clip;
+    frame->time = f->time;
+    frame->weights = calloc(a->channel_count + 1u, sizeof(float));
+    mk_error err;
+    if (!frame->weights) {
+        fprintf(stderr, "morphkit %s: out of memory\n", verb->name);
+        return CLI_EXIT_FAILURE;
+    }
+    if (pb_frame_weights(a, plan->clip, f->time, frame->weights, &err) != MK_OK) return cli_fail(verb->name, &err);
+    char why[1024];
+    if (f->weights && weights_arg_apply(a, f->weights, frame->weights, why, sizeof why) != 0)
+        return cli_usage_error(verb, "--weights: %s: %s", input, why);
+    if (pb_frame_evaluate(frame, &err) != MK_OK) return cli_fail(verb->name, &err);
+    return -1;
+}
+
+void cli_frame_clear(pb_frame *frame)
+{
+    pb_frame_free(frame);
+    free(frame->weights);
+    frame->weights = NULL;
 }

@@ -6,6 +6,7 @@
 #define MK_FRAME_PLAN_H
 
 #include "cli_args.h"
+#include "frame_write.h"
 #include "morphkit.h"
 
 /* One frame: a clip time, or a forced weight set. */
@@ -31,5 +32,15 @@ int32_t cli_find_clip(const cli_verb *verb, const mk_asset *asset, const char *a
 int cli_frame_plan_make(const cli_verb *verb, const mk_asset *asset, const char *input, const char *clip,
                         const char *times, const char *weights, uint32_t frames, cli_frame_plan *plan);
 void cli_frame_plan_free(cli_frame_plan *plan);
+
+/* Plays frame `index` of plan into frame, whose asset, stacking, normal_mode, world and
+ * skip_tangents the caller sets: the weights (allocated here) from the plan's clip at the
+ * frame's time, or the defaults, then the frame's forced set; then every mesh. Returns -1,
+ * else the exit status after printing the error (a forced set naming no channel of `input`
+ * is a usage error). Free with cli_frame_clear, also on error. */
+int cli_frame_play(const cli_verb *verb, const char *input, const cli_frame_plan *plan, uint32_t index,
+                   pb_frame *frame);
+/* Frees what cli_frame_play allocated (weights, positions, normals, tangents). */
+void cli_frame_clear(pb_frame *frame);
 
 #endif
