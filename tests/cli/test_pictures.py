@@ -142,5 +142,45 @@ check("a name not ending in .png is refused", rc == 2 and "must end in .png" in 
 rc, out, err = run("render", path("ex.morph"), "-o", path("ex.morph"))
 check("the input is not overwritten", rc == 2 and "refusing to overwrite the input" in err, err)
 
+# conform --report: golden frames of the example, plus a case whose reference is the moved copy
+# (so its frame fails); the page lists every frame, links only pictures that exist, shows the
+# failing frame first, and opens in headless Chromium without errors.
+import re, shutil
+rc, out, err = run("frames", path("ex.morph"), "--weights", "bulge=1;bend=0.5", "-o", path("golden"))
+rc, out, err = run("frames", path("moved.morph"), "--weights", "bulge=1", "-o", path("golden_moved"))
+manifest = json.load(open(path("golden/manifest.json")))
+bad = json.loads(json.dumps(manifest["cases"][0]))
+bad["name"] = "moved-reference"
+bad["reference"]["kind"] = "morphkit-json"
+bad["frames"] = [dict(bad["frames"][0], file="../golden_moved/frame_000.json")]
+manifest["cases"].append(bad)
+json.dump(manifest, open(path("golden/with_failure.json"), "w"))
+rc, out, err = run("conform", path("golden/with_failure.json"), "--report", path("report"))
+check("conform --report fails with the failing frame but writes the report",
+      rc == 1 and os.path.isfile(path("report/index.html")), (rc, out, err))
+html = open(path("report/index.html")).read() if os.path.isfile(path("report/index.html")) else ""
+rows = re.findall(r"<tr class=\"(ok|fail)\">", html)
+check("the table lists every frame (2 cases x 2 frames + 1)", len(rows) == 5 and rows.count("fail") == 1, rows)
+images = re.findall(r'<img src="([^"]+)"', html)
+check("one picture per frame, each one exists", len(images) == 5 and all(os.path.isfile(path("report/" + i)) for i in images),
+      images)
+check("nothing in the folder that the page does not link",
+      sorted(os.listdir(path("report"))) == sorted(images + ["index.html"]), os.listdir(path("report")))
+check("the failing frame's picture comes first", images and images[0] == "frame_0004.png", images[:2])
+check("the failing row says where", re.search(r'class="fail">.*?<td>tube v400</td>', html) is not None)
+if images:
+    w4, h4, px4 = read_png(path("report/" + images[0]))
+    check("frame pictures are modest", w4 <= 800 and h4 <= 400, (w4, h4))
+chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+if not chromium:
+    print("skip chromium: not installed (Debian package chromium)")
+else:
+    p = subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--enable-logging=stderr", "--v=0",
+                        "--dump-dom", "file://" + path("report/index.html")], capture_output=True, text=True, timeout=120)
+    errors = [l for l in p.stderr.splitlines() if "ERR_FILE_NOT_FOUND" in l or "Uncaught" in l or ":CONSOLE" in l]
+    check("headless Chromium opens the report (table and 5 images in its DOM, no console errors)",
+          p.returncode == 0 and "<table>" in p.stdout and p.stdout.count("<img") == 5 and not errors,
+          (p.returncode, errors[:3], p.stderr[-400:]))
+
 print("%d passed, %d failed" % (passed, failed))
 sys.exit(1 if failed else 0)
