@@ -130,7 +130,12 @@ static void compare_mesh(frame_state *s, uint32_t mi, const pb_ref_mesh *rm)
             uint32_t r = s->c->by_control_point ? m.control_points[v] : v;
             for (int d = 0; d < 3; d++) {
                 double ref = rm->positions[3 * r + (uint32_t)d], e = fabs((double)pos[3 * v + (uint32_t)d] - ref);
-                if (!(e <= res->position_error)) res->position_error = e; /* NaN propagates as failure */
+                if (!(e <= res->position_error)) { /* NaN propagates as failure */
+                    res->position_error = e;
+                    res->worst_known = 1;
+                    res->worst_mesh = mi;
+                    res->worst_vertex = v;
+                }
                 if (fabs(ref) > s->largest) s->largest = fabs(ref);
                 if (ref < s->lo[d]) s->lo[d] = ref;
                 if (ref > s->hi[d]) s->hi[d] = ref;
@@ -148,6 +153,11 @@ static void compare_mesh(frame_state *s, uint32_t mi, const pb_ref_mesh *rm)
             res->normals_compared = 1;
         }
         res->meshes_compared++;
+        if (s->o->mesh_compared) {
+            pb_compared_mesh cm = { mi, m.vertex_count, pos, nrm, rm->positions, rm->normals,
+                                    s->c->by_control_point ? m.control_points : NULL };
+            s->o->mesh_compared(s->o->user, &cm);
+        }
     }
     free(pos);
     free(nrm);

@@ -8,12 +8,26 @@
 #include "asset.h"
 #include "manifest.h"
 
+/* One compared mesh, both sides per render vertex in the space compared (for pictures); the
+ * arrays live only during the call. */
+typedef struct pb_compared_mesh {
+    uint32_t mesh;               /* the import's mesh */
+    uint32_t vertex_count;
+    const float *positions;      /* played: 3 per vertex */
+    const float *normals;        /* played: 3 per vertex, or NULL */
+    const double *reference;     /* 3 per reference point */
+    const double *reference_normals; /* 3 per reference point, or NULL */
+    const uint32_t *point;       /* the reference point of each vertex, or NULL: vertex v is point v */
+} pb_compared_mesh;
+
 typedef struct pb_conform_options {
     mk_stacking stacking;        /* 0: the case's "stacking" (else each mesh's stored one) */
     mk_normal_mode normal_mode;  /* with normal_mode_given; else the case's "normals" */
     int normal_mode_given;
     double normal_tolerance_deg; /* largest normal angle; 0 means 1 degree */
     double weight_tolerance;     /* largest |weight - reference weight|; 0 means 1e-5 */
+    void (*mesh_compared)(void *user, const pb_compared_mesh *mesh); /* may be NULL */
+    void *user;
 } pb_conform_options;
 
 typedef struct pb_frame_result {
@@ -24,6 +38,8 @@ typedef struct pb_frame_result {
     double normal_error_deg; /* largest angle to the reference's normals */
     double weight_error;     /* largest |sampled weight - reference weight| */
     int normals_compared, weights_compared, meshes_compared;
+    int worst_known;         /* worst_mesh / worst_vertex hold the largest position error */
+    uint32_t worst_mesh, worst_vertex;
     int passed;
     const char *passed_by; /* "tolerance", "relative_tolerance" or NULL */
     char failure[512];     /* why the frame could not be compared (empty when it was) */

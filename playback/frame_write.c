@@ -65,8 +65,8 @@ mk_result pb_frame_evaluate(pb_frame *f, mk_error *err)
         mk_mesh_get(a, i, &m);
         f->positions[i] = malloc(12u * (size_t)m.vertex_count + 12);
         f->normals[i] = m.has_normals ? malloc(12u * (size_t)m.vertex_count + 12) : NULL;
-        f->tangents[i] = m.has_tangents ? malloc(16u * (size_t)m.vertex_count + 16) : NULL;
-        if (!f->positions[i] || (m.has_normals && !f->normals[i]) || (m.has_tangents && !f->tangents[i]))
+        f->tangents[i] = m.has_tangents && !f->skip_tangents ? malloc(16u * (size_t)m.vertex_count + 16) : NULL;
+        if (!f->positions[i] || (m.has_normals && !f->normals[i]) || (m.has_tangents && !f->skip_tangents && !f->tangents[i]))
             return mk_error_oom(err, "frame");
         mk_result r = pb_eval_mesh(a, i, f->weights, f->stacking, f->normal_mode, f->positions[i], f->normals[i], err);
         if (r == MK_OK && f->tangents[i]) r = eval_tangents(f, i, f->tangents[i], err);

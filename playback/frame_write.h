@@ -16,6 +16,7 @@ typedef struct pb_frame {
     mk_stacking stacking;         /* as evaluated (MK_STACKING_ASSET: each mesh's own) */
     mk_normal_mode normal_mode;
     int world;                    /* positions and normals in world space (else mesh-local) */
+    int skip_tangents;            /* leave tangents out (pictures need none) */
     float *weights;               /* asset channel count, the weights played */
     float **positions;            /* per mesh: 3 floats per vertex */
     float **normals;              /* per mesh: 3 per vertex, or NULL where the mesh has none */

@@ -301,7 +301,12 @@ static mk_result render(const mkr_sheet_desc *desc, int diff, mkr_image *out, mk
         mkr_image_fill_rect(out, 0, l.height - l.legend_height, l.width, l.legend_height, title_background);
         int pad = 4 * s, width = l.width - 2 * pad;
         if (width > 640 * s) width = 640 * s;
-        int ticks = 1 + width / (64 * s);
+        int caption_width;
+        mkr_text_box(caption, s, &caption_width, NULL);
+        if (caption_width > width && diagonal > 0) /* a narrow sheet: the short form */
+            snprintf(caption, sizeof caption, "distance (%% of diagonal %.4g)", diagonal);
+        /* Labels like "0.000148%" are 9 characters: keep a tick per 80 font pixels. */
+        int ticks = 1 + width / (80 * s);
         if (ticks > 5) ticks = 5;
         mkr_legend legend = { .lo = 0, .hi = scale_max, .ticks = ticks, .caption = caption, .text_scale = s,
                               .second_scale = diagonal > 0 ? (float)(100.0 / diagonal) : 0, .second_suffix = "%" };

@@ -10,7 +10,7 @@
 #include "import.h"
 
 extern const cli_verb cli_verb_import, cli_verb_info, cli_verb_play, cli_verb_bake, cli_verb_export, cli_verb_conform,
-    cli_verb_bench, cli_verb_embed, cli_verb_frames;
+    cli_verb_bench, cli_verb_embed, cli_verb_frames, cli_verb_render;
 
 /* Prints the warnings of a raw model to stderr ("warning: ..."); nothing when there are none. */
 void cli_print_warnings(const mk_raw_asset *raw);

@@ -7,10 +7,11 @@
 #include <string.h>
 #include "cli.h"
 #include "conform.h"
+#include "conform_report.h"
 #include "json_write.h"
 
 typedef struct conform_args {
-    const char *manifest, *filter;
+    const char *manifest, *filter, *report;
     int precision, stacking, stacking_given, normals, normals_given, json;
     double normal_tolerance, weight_tolerance;
 } conform_args;
@@ -37,6 +38,11 @@ static const cli_option options[] = {
     { "--weight-tolerance", "W", CLI_NUMBER, offsetof(conform_args, weight_tolerance),
       "Largest difference between a sampled channel weight and the reference's (where the reference lists weights).",
       "1e-5", NULL, 1e-12, 1e6, 0, 0 },
+    { "--report", "DIR", CLI_STRING, offsetof(conform_args, report),
+      "Also write DIR/index.html (created if absent): a static page with every case and frame (pass/fail, error, "
+      "where) and one picture per compared frame, frame_NNNN.png: the played frame beside the reference and the "
+      "error heat map, failing frames first.",
+      NULL, NULL, 0, 0, 0, 0 },
     { "--json", NULL, CLI_FLAG, offsetof(conform_args, json),
       "Print one JSON object: every frame's errors and allowances, and the counts.", NULL, NULL, 0, 0, 0, 0 },
 };
@@ -121,8 +127,14 @@ static int run_conform(void *p)
     const cli_verb *verb = &cli_verb_conform;
     pb_manifest manifest;
     mk_error err;
+    cli_report *report = NULL;
+    if (args->report) {
+        int status = cli_report_begin(verb, args->report, args->manifest, &report);
+        if (status >= 0) return status;
+    }
     if (pb_manifest_read(args->manifest, &manifest, &err) != MK_OK) {
         pb_manifest_free(&manifest);
+        cli_report_free(report);
         return cli_fail(verb->name, &err);
     }
     int name_width = 8, frame_width = 8, matched = 0;
@@ -142,6 +154,7 @@ static int run_conform(void *p)
         else
             fprintf(stderr, "morphkit conform: %s has no cases\n", args->manifest);
         pb_manifest_free(&manifest);
+        cli_report_free(report);
         return CLI_EXIT_FAILURE;
     }
     pb_conform_options opt = {
@@ -153,6 +166,8 @@ static int run_conform(void *p)
         .normal_tolerance_deg = args->normal_tolerance,
         .weight_tolerance = args->weight_tolerance,
     };
+    if (report) cli_report_hook(report, &opt);
+    int report_status = -1;
     mk_write_options wo = { .precision = args->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16 };
     json_writer w;
     if (args->json) {
@@ -178,6 +193,8 @@ static int run_conform(void *p)
             } else {
                 pb_conform_frame(&manifest, c, &c->frames[k], &asset, &opt, &res);
             }
+            if (report && report_status < 0)
+                report_status = cli_report_frame(report, c, &c->frames[k], &res, r == MK_OK ? &asset.asset : NULL);
             if (args->json)
                 json_frame(&w, c, &c->frames[k], &res);
             else
@@ -199,5 +216,14 @@ static int run_conform(void *p)
         printf("%d passed, %d failed\n", passed, failed);
     }
     pb_manifest_free(&manifest);
+    if (report && report_status >= 0) {
+        cli_report_free(report);
+        return report_status;
+    }
+    if (report) {
+        int status = cli_report_finish(report);
+        if (status) return status;
+        fprintf(args->json ? stderr : stdout, "report: %s/index.html\n", args->report);
+    }
     return failed || passed == 0 ? CLI_EXIT_FAILURE : CLI_EXIT_OK;
 }

@@ -11,9 +11,9 @@
 #include "asset.h"
 #include "cli.h"
 #include "frame.h"
+#include "frame_plan.h"
 #include "frame_write.h"
 #include "json_write.h"
-#include "weights_arg.h"
 
 typedef struct frames_args {
     const char *input, *output, *clip, *times, *weights;
@@ -69,25 +69,6 @@ const cli_verb cli_verb_frames = {
     .run = run_frames,
 };
 
-/* One frame to write: a clip time, or a forced weight set. */
-typedef struct frame_plan {
-    double time;
-    const char *weights;   /* NAME=V,... or NULL */
-} frame_plan;
-
-/* Splits list at sep in place into up to max items; returns the count (0 when an item is empty). */
-static uint32_t split(char *list, char sep, char **items, uint32_t max)
-{
-    uint32_t n = 0;
-    for (char *p = list, *next; p && n < max; p = next) {
-        next = strchr(p, sep);
-        if (next) *next++ = 0;
-        if (!*p) return 0;
-        items[n++] = p;
-    }
-    return n;
-}
-
 static int write_text(cli_output *out, const cli_verb *verb, const char *dir, const char *name, const char *const *inputs,
                       char **text, size_t *size, FILE **f)
 {
@@ -106,7 +87,6 @@ static int run_frames(void *p)
 {
     frames_args *args = p;
     const cli_verb *verb = &cli_verb_frames;
-    if (args->times && args->weights) return cli_usage_error(verb, "--times and --weights contradict each other");
     struct stat st;
     if (stat(args->output, &st) == 0 && !S_ISDIR(st.st_mode))
         return cli_usage_error(verb, "-o %s: exists and is not a folder", args->output);
@@ -122,54 +102,14 @@ static int run_frames(void *p)
         return cli_fail(verb->name, &err);
     }
     const mk_asset *a = &l.asset;
-    int status = CLI_EXIT_FAILURE;
-    char *list_copy = NULL;
-    frame_plan plans[10000];
-    uint32_t plan_count = 0;
-    int32_t clip = -1;
-    if (args->weights) {
-        list_copy = strdup(args->weights);
-        char *items[10000];
-        plan_count = list_copy ? split(list_copy, ';', items, 10000) : 0;
-        if (!plan_count) { status = cli_usage_error(verb, "--weights: a set is empty (write NAME=V,...;NAME=V,...)"); goto done; }
-        for (uint32_t i = 0; i < plan_count; i++) plans[i] = (frame_plan){ 0.0, items[i] };
-    } else if (a->clip_count) {
-        clip = args->clip ? mk_find_clip(a, args->clip) : 0;
-        if (clip < 0) {
-            char *end;
-            long idx = strtol(args->clip, &end, 10);
-            if (*end || end == args->clip || idx < 0 || idx >= (long)a->clip_count) {
-                status = cli_usage_error(verb, "--clip: no clip '%s' (the asset has %u clips)", args->clip, a->clip_count);
-                goto done;
-            }
-            clip = (int32_t)idx;
-        }
-        mk_clip_info ci;
-        mk_clip_get(a, (uint32_t)clip, &ci);
-        if (args->times) {
-            list_copy = strdup(args->times);
-            char *items[10000];
-            plan_count = list_copy ? split(list_copy, ',', items, 10000) : 0;
-            for (uint32_t i = 0; i < plan_count; i++) {
-                char *end;
-                plans[i].time = strtod(items[i], &end);
-                plans[i].weights = NULL;
-                if (*end || !isfinite(plans[i].time)) {
-                    status = cli_usage_error(verb, "--times: \"%s\" is not a number of seconds", items[i]);
-                    goto done;
-                }
-            }
-            if (!plan_count) { status = cli_usage_error(verb, "--times: an item is empty"); goto done; }
-        } else {
-            plan_count = (uint32_t)args->frames;
-            for (uint32_t i = 0; i < plan_count; i++)
-                plans[i] = (frame_plan){ ci.start + ci.duration * (plan_count > 1 ? (double)i / (plan_count - 1) : 0.0), NULL };
-        }
-    } else {
-        if (args->clip || args->times) { status = cli_usage_error(verb, "%s has no clip; give --weights", args->input); goto done; }
-        plans[0] = (frame_plan){ 0.0, NULL };   /* the static state */
-        plan_count = 1;
-    }
+    cli_frame_plan fp;
+    int status = cli_frame_plan_make(verb, a, args->input, args->clip, args->times, args->weights,
+                                     (uint32_t)args->frames, &fp);
+    if (status >= 0) goto done;
+    status = CLI_EXIT_FAILURE;
+    const cli_frame *plans = fp.frames;
+    const uint32_t plan_count = fp.count;
+    const int32_t clip = fp.clip;
 
     /* Every output in one all-or-nothing set: the blob, the manifest, the list, 2 per frame. */
     uint32_t count = 3 + 2 * plan_count;
@@ -242,20 +182,17 @@ static int run_frames(void *p)
     fputc('\n', manifest);
 
     for (uint32_t i = 0; i < plan_count; i++) {
-        pb_frame frame = { .asset = a, .clip = clip, .time = plans[i].time, .stacking = stacking,
-                           .normal_mode = args->normals ? MK_NORMALS_SLERP : MK_NORMALS_NLERP, .world = args->space };
-        frame.weights = calloc(a->channel_count + 1u, sizeof(float));
-        char why[1024];
-        mk_result r = frame.weights ? pb_frame_weights(a, clip, plans[i].time, frame.weights, &err) : mk_error_oom(&err, "weights");
-        if (r == MK_OK && plans[i].weights && weights_arg_apply(a, plans[i].weights, frame.weights, why, sizeof why) != 0) {
-            status = cli_usage_error(verb, "--weights: %s", why);
-            pb_frame_free(&frame);
-            free(frame.weights);
+        pb_frame frame = { .asset = a, .stacking = stacking, .normal_mode = args->normals ? MK_NORMALS_SLERP : MK_NORMALS_NLERP,
+                           .world = args->space };
+        int played = cli_frame_play(verb, args->input, &fp, i, &frame);
+        if (played >= 0) {
+            status = played;
+            cli_frame_clear(&frame);
             fclose(manifest);
             fclose(list);
             goto cleanup;
         }
-        if (r == MK_OK) r = pb_frame_evaluate(&frame, &err);
+        mk_result r = MK_OK;
         for (int k = 0; r == MK_OK && k < 2; k++) {
             char name[64];
             snprintf(name, sizeof name, "frame_%03u.%s", i, exts[k]);
@@ -270,8 +207,7 @@ static int run_frames(void *p)
             fclose(f);
             if (k) fprintf(list, "%s\n", name);
         }
-        pb_frame_free(&frame);
-        free(frame.weights);
+        cli_frame_clear(&frame);
         if (r != MK_OK) {
             fclose(manifest);
             fclose(list);
@@ -302,7 +238,7 @@ cleanup:
     free(texts);
     free(sizes);
 done:
-    free(list_copy);
+    cli_frame_plan_free(&fp);
     pb_asset_free(&l);
     return status;
 }

@@ -7,6 +7,7 @@
 #include "asset.h"
 #include "cli.h"
 #include "frame.h"
+#include "frame_plan.h"
 #include "frame_write.h"
 #include "weights_arg.h"
 
@@ -62,27 +63,6 @@ const cli_verb cli_verb_play = {
     .run = run_play,
 };
 
-/* The clip named or numbered by arg, or -1 after printing the error. */
-static int32_t find_clip(const cli_verb *verb, const mk_asset *a, const char *arg)
-{
-    int32_t clip = mk_find_clip(a, arg);
-    if (clip >= 0) return clip;
-    char *end;
-    long idx = strtol(arg, &end, 10);
-    if (!*end && end != arg && idx >= 0 && idx < (long)a->clip_count) return (int32_t)idx;
-    char names[600] = "";
-    for (uint32_t c = 0; c < a->clip_count; c++) {
-        mk_clip_info ci;
-        mk_clip_get(a, c, &ci);
-        size_t n = strlen(names);
-        if (n + strlen(ci.name) + 8 < sizeof names)
-            snprintf(names + n, sizeof names - n, "%s'%s'", n ? ", " : "", ci.name);
-    }
-    cli_usage_error(verb, "--clip: no clip '%s'; the clips are %s", arg,
-                    a->clip_count ? names : "(none: no animation)");
-    return -1;
-}
-
 static int run_play(void *p)
 {
     play_args *args = p;
@@ -112,7 +92,7 @@ static int run_play(void *p)
     const mk_asset *a = &l.asset;
     int32_t clip = -1;
     if (args->clip) {
-        clip = find_clip(verb, a, args->clip);
+        clip = cli_find_clip(verb, a, args->clip);
         if (clip < 0) {
             pb_asset_free(&l);
             return CLI_EXIT_USAGE;

@@ -5,7 +5,7 @@
 
 static const cli_verb *const verbs[] = {
     &cli_verb_import, &cli_verb_info, &cli_verb_play, &cli_verb_bake,
-    &cli_verb_export, &cli_verb_embed, &cli_verb_frames, &cli_verb_conform, &cli_verb_bench,
+    &cli_verb_export, &cli_verb_embed, &cli_verb_frames, &cli_verb_render, &cli_verb_conform, &cli_verb_bench,
 };
 #define VERB_COUNT (sizeof verbs / sizeof verbs[0])
 
