@@ -4,21 +4,12 @@ tube is, a shaded (not flat) surface, a diff that lights up only the cell and th
 one vertex of one target was moved, and bad sizes, paths and inputs refused without output.
 
 usage: test_pictures.py MORPHKIT MAKE_EXAMPLE"""
-import base64, json, os, struct, subprocess, sys, tempfile, zlib
+import base64, json, os, struct, subprocess, sys, zlib
 
 mk, make_example = sys.argv[1], sys.argv[2]
-work = tempfile.mkdtemp(prefix="mk_pictures_")
-passed = failed = 0
+from cli_check import check, finish, scratch, skip
 
-
-def check(name, cond, detail=""):
-    global passed, failed
-    if cond:
-        passed += 1
-        print("ok   " + name)
-    else:
-        failed += 1
-        print("FAIL " + name + ("\n     " + str(detail) if detail else ""))
+work = scratch("mk_pictures_")
 
 
 def run(*args):
@@ -173,7 +164,7 @@ if images:
     check("frame pictures are modest", w4 <= 800 and h4 <= 400, (w4, h4))
 chromium = shutil.which("chromium") or shutil.which("chromium-browser")
 if not chromium:
-    print("skip chromium: not installed (Debian package chromium)")
+    skip("chromium", "not installed (Debian package chromium)")
 else:
     p = subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--enable-logging=stderr", "--v=0",
                         "--dump-dom", "file://" + path("report/index.html")], capture_output=True, text=True, timeout=120)
@@ -182,5 +173,4 @@ else:
           p.returncode == 0 and "<table>" in p.stdout and p.stdout.count("<img") == 5 and not errors,
           (p.returncode, errors[:3], p.stderr[-400:]))
 
-print("%d passed, %d failed" % (passed, failed))
-sys.exit(1 if failed else 0)
+finish()
