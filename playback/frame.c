@@ -48,7 +48,8 @@ mk_result pb_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weight
     return r;
 }
 
-mk_result pb_surface_normals(const mk_asset *asset, uint32_t mesh, const float *positions, float *normals, mk_error *err)
+mk_result pb_surface_normals(const mk_asset *asset, uint32_t mesh, const float *positions, float *normals,
+                             float *tangents, mk_error *err)
 {
     size_t size = mk_surface_topology_size(asset, mesh), scratch_size = mk_surface_scratch_size(asset, mesh);
     void *topology = size ? aligned_alloc(16, (size + 15) & ~(size_t)15) : NULL;
@@ -71,6 +72,8 @@ mk_result pb_surface_normals(const mk_asset *asset, uint32_t mesh, const float *
         .vertex_count = MK_VERTICES_TO_END,
         .normals = normals,
         .normals_size = (size_t)m.vertex_count * 12,
+        .tangents = tangents,
+        .tangents_size = (size_t)m.vertex_count * 16,
         .scratch = scratch,
         .scratch_size = scratch_size,
     };

@@ -15,9 +15,11 @@ mk_result pb_frame_weights(const mk_asset *asset, int32_t clip, double time, flo
 mk_result pb_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
                        mk_normal_mode normals_mode, float *positions, float *normals, mk_error *err);
 
-/* Surface normals (mk_surface_run) of a whole mesh from its evaluated positions; the topology
- * is built and freed here (tools may allocate). */
-mk_result pb_surface_normals(const mk_asset *asset, uint32_t mesh, const float *positions, float *normals, mk_error *err);
+/* Surface normals (mk_surface_run) of a whole mesh from its evaluated positions, and its
+ * tangents when tangents is non-NULL; the topology is built and freed here (tools may
+ * allocate). */
+mk_result pb_surface_normals(const mk_asset *asset, uint32_t mesh, const float *positions, float *normals,
+                             float *tangents, mk_error *err);
 
 /* mk_channel_span for asset channel `channel` at weight w (any number of in-betweens): the
  * two contributing targets as indices into the channel's targets (-1 = implicit zero key). */

@@ -20,7 +20,7 @@ void pb_frame_free(pb_frame *f)
     f->positions = f->normals = f->tangents = NULL;
 }
 
-/* Tangents of one mesh into out (4 per vertex), world transformed when asked. */
+/* Tangents of one mesh into out (4 per vertex, mesh-local). */
 static mk_result eval_tangents(const pb_frame *f, uint32_t mesh, float *out, mk_error *err)
 {
     mk_mesh_info m;
@@ -39,18 +39,22 @@ static mk_result eval_tangents(const pb_frame *f, uint32_t mesh, float *out, mk_
                         .scratch_size = scratch_size, .positions = pos, .positions_size = 12 * (size_t)m.vertex_count,
                         .tangents = out, .tangents_size = 16 * (size_t)m.vertex_count };
     mk_result r = mk_eval_run(&job, err);
-    if (r == MK_OK && f->world)
-        for (uint32_t v = 0; v < m.vertex_count; v++) {   /* directions: the upper 3x3, normalized */
-            float *t = out + 4 * (size_t)v, x = t[0], y = t[1], z = t[2];
-            double o[3];
-            for (int k = 0; k < 3; k++) o[k] = (double)m.world[k] * x + (double)m.world[4 + k] * y + (double)m.world[8 + k] * z;
-            double len = o[0] * o[0] + o[1] * o[1] + o[2] * o[2];
-            if (len > 0)
-                for (int k = 0; k < 3; k++) t[k] = (float)(o[k] / sqrt(len));
-        }
     free(scratch);
     free(pos);
     return r;
+}
+
+/* Tangent directions to world space: the upper 3x3, normalized (w kept). */
+static void tangents_to_world(const float world[16], float *tangents, uint32_t count)
+{
+    for (uint32_t v = 0; v < count; v++) {
+        float *t = tangents + 4 * (size_t)v, x = t[0], y = t[1], z = t[2];
+        double o[3];
+        for (int k = 0; k < 3; k++) o[k] = (double)world[k] * x + (double)world[4 + k] * y + (double)world[8 + k] * z;
+        double len = o[0] * o[0] + o[1] * o[1] + o[2] * o[2];
+        if (len > 0)
+            for (int k = 0; k < 3; k++) t[k] = (float)(o[k] / sqrt(len));
+    }
 }
 
 mk_result pb_frame_evaluate(pb_frame *f, mk_error *err)
@@ -70,8 +74,11 @@ mk_result pb_frame_evaluate(pb_frame *f, mk_error *err)
             return mk_error_oom(err, "frame");
         mk_result r = pb_eval_mesh(a, i, f->weights, f->stacking, f->normal_mode, f->positions[i], f->normals[i], err);
         if (r == MK_OK && f->tangents[i]) r = eval_tangents(f, i, f->tangents[i], err);
+        if (r == MK_OK && f->surface_normals && f->normals[i] && mk_surface_topology_size(a, i))
+            r = pb_surface_normals(a, i, f->positions[i], f->normals[i], f->tangents[i], err);
         if (r != MK_OK) return r;
         if (f->world) pb_to_world(m.world, f->positions[i], f->normals[i], m.vertex_count);
+        if (f->world && f->tangents[i]) tangents_to_world(m.world, f->tangents[i], m.vertex_count);
     }
     return MK_OK;
 }
@@ -111,7 +118,7 @@ void pb_frame_write_json(FILE *file, const pb_frame *f, const char *producer)
     }
     json_string(&w, "coordinates", f->world ? "world" : "mesh-local");
     json_string(&w, "stacking", stacking_name(f->stacking));
-    json_string(&w, "normals", f->normal_mode == MK_NORMALS_SLERP ? "slerp" : "nlerp");
+    json_string(&w, "normals", f->surface_normals ? "surface" : f->normal_mode == MK_NORMALS_SLERP ? "slerp" : "nlerp");
     json_array(&w, "meshes");
     for (uint32_t i = 0; i < a->mesh_count; i++) {
         mk_mesh_info m;

@@ -15,6 +15,8 @@ typedef struct pb_frame {
     double time;                  /* its time (seconds) when clip >= 0 */
     mk_stacking stacking;         /* as evaluated (MK_STACKING_ASSET: each mesh's own) */
     mk_normal_mode normal_mode;
+    int surface_normals;          /* normals (and tangents) recomputed from the evaluated surface
+                                   * (mk_surface_run) where a mesh has triangles and normals */
     int world;                    /* positions and normals in world space (else mesh-local) */
     int skip_tangents;            /* leave tangents out (pictures need none) */
     float *weights;               /* asset channel count, the weights played */

@@ -101,7 +101,7 @@ mk_result pb_normal_quality_add(pb_normal_quality *q, const mk_asset *asset, con
         for (int mode = 0; r == MK_OK && mode < PB_QUALITY_MODES; mode++) {
             if (mode == PB_QUALITY_SLERP)
                 r = pb_eval_mesh(asset, mi, weights, stacking, MK_NORMALS_SLERP, positions, normals, err);
-            if (mode == PB_QUALITY_SURFACE) r = pb_surface_normals(asset, mi, positions, normals, err);
+            if (mode == PB_QUALITY_SURFACE) r = pb_surface_normals(asset, mi, positions, normals, NULL, err);
             if (r != MK_OK) break;
             size_t at = q->count;
             for (size_t v = 0; v < n; v++) {

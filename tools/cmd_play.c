@@ -38,8 +38,9 @@ static const cli_option options[] = {
     { "--stacking", "MODE", CLI_CHOICE, offsetof(play_args, stacking),
       "Channel stacking. Default: each mesh's stored stacking.", NULL, "additive|sequential", 0, 0, 0,
       offsetof(play_args, stacking_given) },
-    { "--normals", "MODE", CLI_CHOICE, offsetof(play_args, normals), "How normal changes combine (docs/semantics.md).",
-      "nlerp", "nlerp|slerp", 0, 0, 0, 0 },
+    { "--normals", "MODE", CLI_CHOICE, offsetof(play_args, normals),
+      "How normal changes combine (docs/semantics.md); surface: recomputed from the evaluated surface.",
+      "nlerp", "nlerp|slerp|surface", 0, 0, 0, 0 },
     { "--space", "S", CLI_CHOICE, offsetof(play_args, space),
       "Coordinates of the output: world (each mesh's node transform at rest applied) or local (mesh space).", "world",
       "world|local", 0, 0, 0, 0 },
@@ -81,7 +82,7 @@ static int run_play(void *p)
     mk_stacking stacking = !args->stacking_given ? MK_STACKING_ASSET
                            : args->stacking      ? MK_STACKING_SEQUENTIAL
                                                  : MK_STACKING_ADDITIVE;
-    mk_normal_mode nmode = args->normals ? MK_NORMALS_SLERP : MK_NORMALS_NLERP;
+    mk_normal_mode nmode = args->normals == 1 ? MK_NORMALS_SLERP : MK_NORMALS_NLERP;
 
     pb_asset l;
     mk_error err;
@@ -107,7 +108,7 @@ static int run_play(void *p)
     char *text = NULL, why[1024];
     size_t text_size = 0;
     pb_frame frame = { .asset = a, .clip = clip, .time = args->time, .stacking = stacking, .normal_mode = nmode,
-                       .world = !args->space };
+                       .surface_normals = args->normals == 2, .world = !args->space };
     frame.weights = calloc(a->channel_count + 1u, sizeof(float));
     if (!frame.weights) { fprintf(stderr, "morphkit play: out of memory\n"); status = 1; goto done; }
     if (pb_frame_weights(a, clip, args->time, frame.weights, &err)) { status = cli_fail(verb->name, &err); goto done; }

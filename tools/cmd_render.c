@@ -49,8 +49,9 @@ static const cli_option options[] = {
     { "--stacking", "MODE", CLI_CHOICE, offsetof(render_args, stacking),
       "Channel stacking. Default: each mesh's stored stacking.", NULL, "additive|sequential", 0, 0, 0,
       offsetof(render_args, stacking_given) },
-    { "--normals", "MODE", CLI_CHOICE, offsetof(render_args, normals), "How normal changes combine.", "nlerp",
-      "nlerp|slerp", 0, 0, 0, 0 },
+    { "--normals", "MODE", CLI_CHOICE, offsetof(render_args, normals),
+      "How normal changes combine; surface: recomputed from the evaluated surface.", "nlerp", "nlerp|slerp|surface", 0,
+      0, 0, 0 },
 };
 
 const cli_verb cli_verb_render = {
@@ -175,13 +176,16 @@ static int run_render(void *p)
         goto done;
     }
     mk_stacking stacking = !args->stacking_given ? MK_STACKING_ASSET : args->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
-    mk_normal_mode normals = args->normals ? MK_NORMALS_SLERP : MK_NORMALS_NLERP;
+    mk_normal_mode normals = args->normals == 1 ? MK_NORMALS_SLERP : MK_NORMALS_NLERP;
+    int surface = args->normals == 2;
     for (uint32_t i = 0; i < n; i++) {
-        frames[i] = (pb_frame){ .asset = a, .stacking = stacking, .normal_mode = normals, .world = 1, .skip_tangents = 1 };
+        frames[i] = (pb_frame){ .asset = a, .stacking = stacking, .normal_mode = normals, .surface_normals = surface,
+                                .world = 1, .skip_tangents = 1 };
         int played = cli_frame_play(verb, args->input, &plan, i, &frames[i]);
         if (played >= 0) { status = played; goto done; }
         if (b) {
-            frames_b[i] = (pb_frame){ .asset = b, .stacking = stacking, .normal_mode = normals, .world = 1, .skip_tangents = 1 };
+            frames_b[i] = (pb_frame){ .asset = b, .stacking = stacking, .normal_mode = normals,
+                                      .surface_normals = surface, .world = 1, .skip_tangents = 1 };
             played = cli_frame_play(verb, args->diff, &plan_b, i, &frames_b[i]);
             if (played >= 0) { status = played; goto done; }
         }

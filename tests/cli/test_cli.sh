@@ -23,6 +23,7 @@ assert m['name'] == 'tube' and len(m['positions']) == 3 * 800 and len(m['normals
 assert abs(m['channels'][0]['weight'] - 1) < 1e-6 and abs(m['channels'][1]['weight'] - 0.5) < 1e-6"
 check "play obj" sh -c "'$mk' play '$dir/ex.morph' --time 0.5 -o '$dir/f.obj' && grep -c '^v ' '$dir/f.obj' | grep -qx 800 && grep -c '^f ' '$dir/f.obj' | grep -qx 1536"
 check "play weights by name" "$mk" play "$dir/ex.morph" --weights bend=1,bulge=0.25 --stacking sequential --normals slerp --space local -o "$dir/w.json"
+check "play --normals surface: unit normals from the surface, not the blended ones" sh -c "'$mk' play '$dir/ex.morph' --time 1 --normals surface -o '$dir/s.json' && '$mk' play '$dir/ex.morph' --time 1 -o '$dir/n.json' && python3 -c 'import json,math; s=json.load(open(\"$dir/s.json\")); n=json.load(open(\"$dir/n.json\")); a=s[\"meshes\"][0][\"normals\"]; b=n[\"meshes\"][0][\"normals\"]; assert s[\"normals\"] == \"surface\"; assert all(abs(math.sqrt(a[i]**2+a[i+1]**2+a[i+2]**2)-1) < 1e-4 for i in range(0,len(a),3)); assert max(abs(x-y) for x,y in zip(a,b)) > 1e-3; assert s[\"meshes\"][0][\"positions\"] == n[\"meshes\"][0][\"positions\"]'"
 check "weights applied" python3 -c "
 import json; d = json.load(open('$dir/w.json'))
 w = {c['name']: c['weight'] for c in d['meshes'][0]['channels']}
