@@ -29,6 +29,13 @@ typedef struct mk_bake_channel_report {
     int error_measured_on_grid;/* 1: max over every sampled weight; 0: estimated at span midpoints */
     uint32_t moved_vertices;   /* vertices moved by the last target */
     uint32_t inverted_vertices;/* FFD/Barr: vertices where det J <= 0 (normals from the surface) */
+    /* The playback error at every sampled weight k / curve_samples (k = 0..curve_samples,
+     * fraction of the diagonal) when measured on the grid, the targets' full weights and the
+     * tolerance aimed at (0 for a fixed count); valid during the channel_done call. */
+    const double *error_curve;
+    uint32_t curve_samples;
+    const float *key_weights;
+    double tolerance;
     uint32_t factorizations;   /* Laplacian/ARAP: sparse Cholesky factorizations (1 expected) */
     double factor_seconds;     /* Laplacian/ARAP: analyze + factorize wall time */
     double solve_seconds;      /* Laplacian/ARAP: total time of all triangular solves */

@@ -132,9 +132,10 @@ static double span_error(sampler *s, uint32_t a, uint32_t c, double limit, mk_er
  * error. */
 static double verify_grid(sampler *s, const float *full, float *const *key_deltas,
                           uint32_t key_count, void (*progress)(void *, const char *, double),
-                          void *user, const char *name, mk_error *err)
+                          void *user, const char *name, double *curve, mk_error *err)
 {
     double worst = 0;
+    if (curve) curve[0] = 0;
     for (uint32_t k = 1; k <= s->samples; k++) {
         int32_t ia, ib;
         float ca, cb, t;
@@ -155,6 +156,7 @@ static double verify_grid(sampler *s, const float *full, float *const *key_delta
             if (e2 > worst2) worst2 = e2;
         }
         if (sqrt(worst2) > worst) worst = sqrt(worst2);
+        if (curve) curve[k] = sqrt(worst2);
         if (progress && (k & 15) == 0) progress(user, name, (double)k / s->samples);
     }
     return worst;
@@ -328,6 +330,8 @@ static mk_result bake_channel(mk_raw_asset *raw, uint32_t mesh_index, const char
 
     float *key_deltas[256];
     memset(key_deltas, 0, sizeof key_deltas);
+    double *grid_curve = NULL;      /* the error at every sampled weight, when measured */
+    float *grid_weights = NULL;
     if (s.cache) {
         /* Measure at every grid weight with the runtime's span coefficients. In fixed mode the
          * keys k/count are generally off the grid: evaluate them separately. */
@@ -343,7 +347,15 @@ static mk_result bake_channel(mk_raw_asset *raw, uint32_t mesh_index, const char
             mk_result r = eval_deltas(&s, key_weight[i], key_deltas[i], err);
             if (r != MK_OK) return r;
         }
-        error = verify_grid(&s, full, key_deltas, key_count, progress, user, stage_check, err);
+        double *curve = mk_arena_array(&raw->arena, (size_t)s.samples + 1, sizeof(double));
+        float *weights = mk_arena_array(&raw->arena, key_count ? key_count : 1, sizeof(float));
+        if (!curve || !weights) return mk_error_oom(err, "in-between error curve");
+        error = verify_grid(&s, full, key_deltas, key_count, progress, user, stage_check, curve, err);
+        if (error >= 0) {
+            memcpy(weights, full, key_count * sizeof(float));
+            grid_curve = curve;
+            grid_weights = weights;
+        }
         if (error < 0) return err ? err->code : MK_ERROR_OUT_OF_MEMORY;
     } else if (fixed) {
         /* Expensive deformer with a fixed count: estimate at the midpoint of every span. */
@@ -403,6 +415,13 @@ static mk_result bake_channel(mk_raw_asset *raw, uint32_t mesh_index, const char
         result->evaluations = evaluations;
         result->max_error = error / diagonal;
         result->error_on_grid = on_grid;
+        result->tolerance = fixed ? 0 : tol;
+        if (grid_curve) {
+            for (uint32_t k = 0; k <= s.samples; k++) grid_curve[k] /= diagonal;
+            result->error_curve = grid_curve;
+            result->curve_samples = s.samples;
+            result->key_weights = grid_weights;
+        }
         result->moved_vertices = moved;
         result->inverted_vertices = inverted;
     }

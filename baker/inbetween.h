@@ -39,6 +39,13 @@ typedef struct mk_inbetween_result {
     int error_on_grid;          /* 1: measured at every sampled weight; 0: at span midpoints */
     uint32_t moved_vertices;    /* vertices stored in the last target */
     uint32_t inverted_vertices; /* max over targets of the deformer's inverted count */
+    /* With error_on_grid: the playback error at every sampled weight k / curve_samples,
+     * k = 0..curve_samples (fraction of the bbox diagonal), and the targets' full weights;
+     * from raw's arena (they live as long as raw). NULL / 0 otherwise. */
+    const double *error_curve;
+    uint32_t curve_samples;
+    const float *key_weights;
+    double tolerance;           /* the tolerance the placement aimed at (adaptive), or 0 */
 } mk_inbetween_result;
 
 /* Adds one channel named `name` (origin: recipe JSON or NULL) to `mesh` of raw, holding the

@@ -1054,6 +1054,10 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
     cr.error_measured_on_grid = res.error_on_grid;
     cr.moved_vertices = res.moved_vertices;
     cr.inverted_vertices = res.inverted_vertices;
+    cr.error_curve = res.error_curve;
+    cr.curve_samples = res.curve_samples;
+    cr.key_weights = res.key_weights;
+    cr.tolerance = res.tolerance;
     cr.seconds = bake_now() - t0;
     if (o && o->channel_done) o->channel_done(o->user, &cr);
     report->channels_added++;

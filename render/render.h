@@ -17,6 +17,7 @@
 #include "colormap.h"
 #include "font.h"
 #include "image.h"
+#include "plot.h"
 #include "png.h"
 #include "raster.h"
 #include "sheet.h"

@@ -6,9 +6,11 @@
 #include <string.h>
 #include "bake.h"
 #include "cli.h"
+#include "pictures.h"
+#include "render.h"
 
 typedef struct bake_args {
-    const char *input, *output, *recipe, *depfile;
+    const char *input, *output, *recipe, *depfile, *plot;
     int precision, quiet, all_meshes;
 } bake_args;
 
@@ -27,6 +29,10 @@ static const cli_option options[] = {
     { "--depfile", "PATH", CLI_STRING, offsetof(bake_args, depfile),
       "Also write a depfile for build systems (make syntax, as ninja and meson read it): the blob and every file the bake "
       "read (the input, the recipe, the cages it names).",
+      NULL, NULL, 0, 0, 0, 0 },
+    { "--plot", "FILE.png", CLI_STRING, offsetof(bake_args, plot),
+      "Also draw each baked channel's playback error against its weight, with the tolerance and the in-between "
+      "weights marked (one panel per channel).",
       NULL, NULL, 0, 0, 0, 0 },
     { "--quiet", NULL, CLI_FLAG, offsetof(bake_args, quiet),
       "No progress lines and no solver details (results are still printed).", NULL, NULL, 0, 0, 0, 0 },
@@ -50,11 +56,76 @@ const cli_verb cli_verb_bake = {
     .run = run_bake,
 };
 
+/* One channel's error curve, kept for --plot. */
+typedef struct plot_channel {
+    char title[160];
+    double *curve;
+    uint32_t samples, key_count;
+    float *keys;
+    double tolerance;
+} plot_channel;
+
 typedef struct bake_ui {
     int quiet;
     cli_progress progress;
     cli_depfile deps;
+    int plot;                      /* keep the curves */
+    plot_channel *channels;
+    uint32_t channel_count;
+    int out_of_memory;
 } bake_ui;
+
+static void keep_curve(bake_ui *ui, const mk_bake_channel_report *c)
+{
+    plot_channel *grown = realloc(ui->channels, (ui->channel_count + 1) * sizeof *grown);
+    if (!grown) { ui->out_of_memory = 1; return; }
+    ui->channels = grown;
+    plot_channel *pc = &ui->channels[ui->channel_count++];
+    memset(pc, 0, sizeof *pc);
+    snprintf(pc->title, sizeof pc->title, "%s (%s, mesh %u): %u target%s, max %.3g%% of the diagonal", c->name, c->op,
+             c->mesh, c->targets, c->targets == 1 ? "" : "s", 100 * c->max_error);
+    pc->tolerance = c->tolerance;
+    pc->key_count = c->targets;
+    pc->keys = c->key_weights ? malloc((c->targets + 1) * sizeof(float)) : NULL;
+    if (pc->keys) memcpy(pc->keys, c->key_weights, c->targets * sizeof(float));
+    if (c->error_curve) {
+        pc->curve = malloc((c->curve_samples + 1) * sizeof(double));
+        if (pc->curve) memcpy(pc->curve, c->error_curve, (c->curve_samples + 1) * sizeof(double));
+        pc->samples = c->curve_samples;
+    }
+    if ((c->key_weights && !pc->keys) || (c->error_curve && !pc->curve)) ui->out_of_memory = 1;
+}
+
+static void free_curves(bake_ui *ui)
+{
+    for (uint32_t i = 0; i < ui->channel_count; i++) {
+        free(ui->channels[i].curve);
+        free(ui->channels[i].keys);
+    }
+    free(ui->channels);
+}
+
+/* One 720 x 200 panel per channel, stacked. Returns -1 when fine, else the exit status. */
+static int draw_plot(const cli_verb *verb, const bake_ui *ui, mkr_image *img, mkr_png *png, cli_output *out)
+{
+    mk_error err;
+    uint32_t n = ui->channel_count ? ui->channel_count : 1;
+    if (n > 80) n = 80;   /* a picture people can read; more channels are left out (said below) */
+    if (mkr_image_create(img, 720, 200 * (int)n, &err) != MK_OK) return cli_fail(verb->name, &err);
+    static const uint8_t background[4] = { 20, 20, 24, 255 };
+    mkr_image_clear(img, background);
+    for (uint32_t i = 0; i < n && i < ui->channel_count; i++) {
+        const plot_channel *pc = &ui->channels[i];
+        mkr_plot plot = { .title = pc->title, .values = pc->curve, .count = pc->curve ? pc->samples + 1 : 0,
+                          .limit = pc->tolerance, .marks = pc->keys, .mark_count = pc->keys ? pc->key_count : 0,
+                          .label_scale = 100, .unit = "%",
+                          .note = "no error curve: a fixed count of an expensive deformer is checked at span midpoints" };
+        mkr_plot_draw(img, 0, 200 * (int)i, 720, 198, &plot);
+    }
+    if (ui->channel_count > n)
+        fprintf(stderr, "morphkit bake: --plot shows the first %u of %u channels\n", n, ui->channel_count);
+    return cli_png_encode(verb, img, png, out);
+}
 
 static void on_file_read(void *user, const char *path)
 {
@@ -71,6 +142,7 @@ static void on_progress(void *user, const char *stage, double fraction)
 static void on_channel(void *user, const mk_bake_channel_report *c)
 {
     bake_ui *ui = user;
+    if (ui->plot) keep_curve(ui, c);
     printf("channel \"%s\" (%s, mesh %u): %u target%s, %u evaluations, playback error %.3g x diagonal%s, "
            "%u vertices moved, %.3f s\n",
            c->name, c->op, c->mesh, c->targets, c->targets == 1 ? "" : "s", c->evaluations, c->max_error,
@@ -107,13 +179,26 @@ static int run_bake(void *p)
     const cli_verb *verb = &cli_verb_bake;
     static const char *const extensions[] = { ".morph", NULL };
     const char *inputs[] = { a->input, a->recipe };
-    cli_output outs[2];
+    static const char *const png_extensions[] = { ".png", NULL };
+    cli_output outs[3];
+    uint32_t out_count = 1, depfile_out = 0, plot_out = 0;
     int status = cli_output_check(verb, &outs[0], "-o", a->output, extensions, "a .morph blob", 0, inputs, 2);
     if (status >= 0) return status;
-    if (a->depfile && (status = cli_output_check(verb, &outs[1], "--depfile", a->depfile, NULL, "a depfile", 0, inputs, 2)) >= 0)
-        return status;
+    if (a->depfile) {
+        depfile_out = out_count++;
+        if ((status = cli_output_check(verb, &outs[depfile_out], "--depfile", a->depfile, NULL, "a depfile", 0, inputs, 2)) >= 0)
+            return status;
+    }
+    if (a->plot) {
+        plot_out = out_count++;
+        if ((status = cli_output_check(verb, &outs[plot_out], "--plot", a->plot, png_extensions, "a PNG picture", 0, inputs,
+                                       2)) >= 0)
+            return status;
+    }
 
-    bake_ui ui = { .quiet = a->quiet };
+    bake_ui ui = { .quiet = a->quiet, .plot = a->plot != NULL };
+    mkr_image img = { 0 };
+    mkr_png png = { 0 };
     cli_progress_init(&ui.progress, a->quiet);
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
@@ -145,11 +230,15 @@ static int run_bake(void *p)
     outs[0].file.data = blob;
     outs[0].file.size = size;
     if (a->depfile) {
-        dep_text = cli_depfile_text(&ui.deps, a->output, &outs[1].file.size);
-        outs[1].file.data = dep_text;
+        dep_text = cli_depfile_text(&ui.deps, a->output, &outs[depfile_out].file.size);
+        outs[depfile_out].file.data = dep_text;
         if (!dep_text) { fprintf(stderr, "morphkit bake: out of memory\n"); status = CLI_EXIT_FAILURE; goto done; }
     }
-    status = cli_write_outputs(verb, outs, a->depfile ? 2 : 1);
+    if (a->plot) {
+        if (ui.out_of_memory) { fprintf(stderr, "morphkit bake: out of memory for --plot\n"); status = CLI_EXIT_FAILURE; goto done; }
+        if ((status = draw_plot(verb, &ui, &img, &png, &outs[plot_out])) >= 0) goto done;
+    }
+    status = cli_write_outputs(verb, outs, out_count);
     if (status == 0) {
         printf("%s -> %s: %u channels baked, %u targets, max playback error %.3g x diagonal, %zu bytes\n", a->input,
                a->output, report.channels_added, report.targets_added, report.max_error, size);
@@ -158,6 +247,9 @@ static int run_bake(void *p)
     }
 done:
     free(dep_text);
+    free_curves(&ui);
+    mkr_png_free(&png);
+    mkr_image_destroy(&img);
     cli_depfile_free(&ui.deps);
     mk_raw_free(&raw);
     return status;

@@ -4,7 +4,7 @@ tube is, a shaded (not flat) surface, a diff that lights up only the cell and th
 one vertex of one target was moved, and bad sizes, paths and inputs refused without output.
 
 usage: test_pictures.py MORPHKIT MAKE_EXAMPLE"""
-import base64, json, os, struct, subprocess, sys, zlib
+import base64, json, os, re, struct, subprocess, sys, zlib
 
 mk, make_example = sys.argv[1], sys.argv[2]
 from cli_check import check, finish, scratch, skip
@@ -132,6 +132,35 @@ rc, out, err = run("render", path("ex.morph"), "-o", path("sheet.txt"))
 check("a name not ending in .png is refused", rc == 2 and "must end in .png" in err, err)
 rc, out, err = run("render", path("ex.morph"), "-o", path("ex.morph"))
 check("the input is not overwritten", rc == 2 and "refusing to overwrite the input" in err, err)
+
+# bake --plot: one panel per channel, the error curve drawn, the tolerance line where the
+# recipe is adaptive, one mark per in-between; written with the blob or not at all.
+recipes = os.path.join(os.environ.get("MORPHKIT_SOURCE_ROOT", os.path.join(os.path.dirname(__file__), "..", "..")),
+                       "samples", "recipes")
+rc, out, err = run("bake", path("ex.morph"), "--recipe", os.path.join(recipes, "barr.json"), "-o", path("baked.morph"),
+                   "--plot", path("plot.png"), "--quiet")
+check("bake --plot writes the blob and the plot", rc == 0 and os.path.isfile(path("baked.morph")), err)
+channels = [l for l in out.splitlines() if l.startswith("channel ")]
+targets = [int(re.search(r": (\d+) targets?,", l).group(1)) for l in channels]
+pw, ph, pp = read_png(path("plot.png"))
+check("one 720x200 panel per channel", (pw, ph) == (720, 200 * len(channels)) and len(channels) == 3, (pw, ph, channels))
+CURVE, LIMIT, MARK = (250, 220, 90), (235, 110, 80), (120, 160, 230)
+def panel_columns(i, color):
+    return sorted({x for y in range(200 * i + 22, 200 * i + 180) for x in range(64, 711) if pp[y][x] == color})
+def runs(cols):
+    return sum(1 for k, x in enumerate(cols) if k == 0 or x != cols[k - 1] + 1)
+for i, t in enumerate(targets):
+    check("panel %d: the curve spans the weights" % i, len(panel_columns(i, CURVE)) > 500)
+    check("panel %d: one mark per target (%d)" % (i, t), runs(panel_columns(i, MARK)) == t, runs(panel_columns(i, MARK)))
+adaptive = [i for i, l in enumerate(channels) if "bend" in l]
+check("the adaptive channel shows its tolerance line", adaptive and len(panel_columns(adaptive[0], LIMIT)) > 200)
+rc, out, err = run("bake", path("ex.morph"), "--recipe", os.path.join(recipes, "barr.json"), "-o", path("baked2.morph"),
+                   "--plot", path("plot.jpg"))
+check("--plot must name a .png", rc == 2 and not os.path.exists(path("baked2.morph")), err)
+os.mkdir(path("plot_dir.png"))
+rc, out, err = run("bake", path("ex.morph"), "--recipe", os.path.join(recipes, "barr.json"), "-o", path("baked3.morph"),
+                   "--plot", path("plot_dir.png"))
+check("an impossible --plot leaves no blob behind", rc != 0 and not os.path.exists(path("baked3.morph")), err)
 
 # conform --report: golden frames of the example, plus a case whose reference is the moved copy
 # (so its frame fails); the page lists every frame, links only pictures that exist, shows the

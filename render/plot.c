@@ -1,0 +1,87 @@
+/* SPDX-License-Identifier: MIT */
+#include "plot.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include "font.h"
+
+void mkr_draw_line(mkr_image *img, int x0, int y0, int x1, int y1, const uint8_t rgba[4], int dash)
+{
+    int dx = abs(x1 - x0), dy = -abs(y1 - y0), sx = x0 < x1 ? 1 : -1, sy = y0 < y1 ? 1 : -1, e = dx + dy;
+    for (int step = 0;; step++) {
+        uint8_t *p = mkr_image_pixel(img, x0, y0);
+        if (p && (dash <= 0 || (step / dash) % 2 == 0))
+            for (int c = 0; c < 4; c++) p[c] = rgba[c];
+        if (x0 == x1 && y0 == y1) break;
+        int e2 = 2 * e;
+        if (e2 >= dy) { e += dy; x0 += sx; }
+        if (e2 <= dx) { e += dx; y0 += sy; }
+    }
+}
+
+static void label(mkr_image *img, int x, int y, const char *text, const uint8_t fg[4], const uint8_t bg[4])
+{
+    mkr_draw_text(img, x, y, text, 1, fg, bg);
+}
+
+void mkr_plot_draw(mkr_image *img, int x, int y, int width, int height, const mkr_plot *p)
+{
+    static const uint8_t panel[4] = { 32, 34, 40, 255 }, axis[4] = { 170, 170, 170, 255 },
+                         text[4] = { 230, 230, 230, 255 }, limit_color[4] = { 235, 110, 80, 255 },
+                         mark_color[4] = { 120, 160, 230, 255 }, curve_color[4] = { 250, 220, 90, 255 };
+    mkr_image_fill_rect(img, x, y, width, height, panel);
+    label(img, x + 6, y + 4, p->title ? p->title : "", text, panel);
+    /* Plot area: room for y labels on the left, x labels below. */
+    const int left = x + 64, right = x + width - 10, top = y + 22, bottom = y + height - 20;
+    if (right - left < 10 || bottom - top < 10) return;
+    double top_value = p->limit > 0 ? p->limit : 0;
+    for (uint32_t k = 0; p->values && k < p->count; k++)
+        if (isfinite(p->values[k]) && p->values[k] > top_value) top_value = p->values[k];
+    if (!(top_value > 0)) top_value = 1;
+    top_value *= 1.1;
+    mkr_draw_line(img, left, bottom, right, bottom, axis, 0);
+    mkr_draw_line(img, left, top, left, bottom, axis, 0);
+    char s[64];
+    for (int t = 0; t <= 2; t++) {   /* x ticks */
+        int px = left + (int)lround((right - left) * t / 2.0);
+        mkr_draw_line(img, px, bottom, px, bottom + 3, axis, 0);
+        snprintf(s, sizeof s, t == 0 ? "0" : t == 1 ? "0.5" : "1");
+        int w, h;
+        mkr_text_box(s, 1, &w, &h);
+        label(img, px - w / 2, bottom + 5, s, text, panel);
+    }
+    const char *unit = p->unit ? p->unit : "";
+    double scale = p->label_scale > 0 ? p->label_scale : 1;
+    double ticks[3] = { 0, p->limit, top_value };
+    for (int t = 0; t < 3; t++) {    /* y ticks: 0, the limit, the top */
+        if (t == 1 && !(p->limit > 0)) continue;
+        int py = bottom - (int)lround((bottom - top) * ticks[t] / top_value);
+        mkr_draw_line(img, left - 3, py, left, py, axis, 0);
+        snprintf(s, sizeof s, "%.3g%s", ticks[t] * scale, unit);
+        int w, h;
+        mkr_text_box(s, 1, &w, &h);
+        label(img, left - 5 - w, py - h / 2, s, t == 1 ? limit_color : text, panel);
+    }
+    if (p->limit > 0) {
+        int py = bottom - (int)lround((bottom - top) * p->limit / top_value);
+        mkr_draw_line(img, left + 1, py, right, py, limit_color, 4);
+    }
+    for (uint32_t k = 0; k < p->mark_count; k++) {
+        double m = p->marks[k] < 0 ? 0 : p->marks[k] > 1 ? 1 : p->marks[k];
+        int px = left + (int)lround((right - left) * m);
+        mkr_draw_line(img, px, top, px, bottom - 1, mark_color, 2);
+    }
+    if (!p->values || p->count < 2) {
+        if (p->note) label(img, left + 8, top + 8, p->note, text, panel);
+        return;
+    }
+    int px0 = 0, py0 = 0;
+    for (uint32_t k = 0; k < p->count; k++) {
+        double v = isfinite(p->values[k]) ? p->values[k] : top_value;
+        int px = left + (int)lround((right - left) * (double)k / (double)(p->count - 1));
+        int py = bottom - (int)lround((bottom - top) * v / top_value);
+        if (k) mkr_draw_line(img, px0, py0, px, py, curve_color, 0);
+        px0 = px;
+        py0 = py;
+    }
+}
