@@ -31,7 +31,7 @@ typedef struct mk_bake_channel_report {
     uint32_t inverted_vertices;/* FFD/Barr: vertices where det J <= 0 (normals from the surface) */
     /* The playback error at every sampled weight k / curve_samples (k = 0..curve_samples,
      * fraction of the diagonal) when measured on the grid, the targets' full weights and the
-     * tolerance aimed at (0 for a fixed count); valid during the channel_done call. */
+     * tolerance aimed at (0 for a fixed count); the arrays live in the raw asset's arena. */
     const double *error_curve;
     uint32_t curve_samples;
     const float *key_weights;

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include "surface.h"
 #include <stdlib.h>
+#include "frame.h"
 #include "timing.h"
 
 void bench_surface_frames(const pb_asset *l, const float *weight_sets, uint32_t frames, double *ns_nlerp,
@@ -12,16 +13,13 @@ void bench_surface_frames(const pb_asset *l, const float *weight_sets, uint32_t 
     for (uint32_t mi = 0; mi < a->mesh_count; mi++) {
         mk_mesh_info m;
         mk_mesh_get(a, mi, &m);
-        size_t topology_size = mk_surface_topology_size(a, mi), scratch_size = mk_eval_scratch_size(a, mi);
-        if (!topology_size) continue;
-        void *topology = aligned_alloc(16, (topology_size + 15) & ~(size_t)15);
-        void *scratch = aligned_alloc(16, (scratch_size + 31) & ~(size_t)15);
-        size_t surface_size = mk_surface_scratch_size(a, mi);
-        void *surface_scratch = aligned_alloc(16, (surface_size + 31) & ~(size_t)15);
-        float *positions = malloc(12 * (size_t)m.vertex_count + 16), *normals = malloc(12 * (size_t)m.vertex_count + 16);
+        pb_surface surf;
         mk_error err;
-        int ok = topology && scratch && surface_scratch && positions && normals
-              && mk_surface_topology_build(a, mi, topology, topology_size, &err) == MK_OK;
+        if (!mk_surface_topology_size(a, mi) || pb_surface_prepare(&surf, a, mi, &err) != MK_OK) continue;
+        size_t scratch_size = mk_eval_scratch_size(a, mi);
+        void *scratch = aligned_alloc(16, (scratch_size + 31) & ~(size_t)15);
+        float *positions = malloc(12 * (size_t)m.vertex_count + 16), *normals = malloc(12 * (size_t)m.vertex_count + 16);
+        int ok = scratch && positions && normals;
         double mesh_best[2] = { 0, 0 };
         for (int pass = 0; ok && pass < 2 * BENCH_PASSES; pass++) {
             int surface = pass & 1;
@@ -33,20 +31,14 @@ void bench_surface_frames(const pb_asset *l, const float *weight_sets, uint32_t 
                                     .positions = positions, .positions_size = 12 * (size_t)m.vertex_count,
                                     .normals = surface ? NULL : normals, .normals_size = 12 * (size_t)m.vertex_count };
                 ok = mk_eval_run(&job, &err) == MK_OK;
-                mk_surface_job sj = { .asset = a, .mesh = mi, .topology = topology, .topology_size = topology_size,
-                                      .positions = positions, .positions_size = 12 * (size_t)m.vertex_count,
-                                      .vertex_count = MK_VERTICES_TO_END, .normals = normals,
-                                      .normals_size = 12 * (size_t)m.vertex_count, .scratch = surface_scratch,
-                                      .scratch_size = surface_size };
-                if (ok && surface) ok = mk_surface_run(&sj, &err) == MK_OK;
+                if (ok && surface) ok = pb_surface_run(&surf, positions, normals, NULL, &err) == MK_OK;
             }
             double ns = (bench_now_ns() - t0) / frames;
             if (mesh_best[surface] == 0 || ns < mesh_best[surface]) mesh_best[surface] = ns;
         }
         if (ok) { best[0] += mesh_best[0]; best[1] += mesh_best[1]; }
-        free(topology);
+        pb_surface_free(&surf);
         free(scratch);
-        free(surface_scratch);
         free(positions);
         free(normals);
     }

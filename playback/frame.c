@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 #include "alloc.h"
 #include "frame.h"
 
@@ -48,25 +49,35 @@ mk_result pb_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weight
     return r;
 }
 
-mk_result pb_surface_normals(const mk_asset *asset, uint32_t mesh, const float *positions, float *normals,
-                             float *tangents, mk_error *err)
+mk_result pb_surface_prepare(pb_surface *s, const mk_asset *asset, uint32_t mesh, mk_error *err)
 {
-    size_t size = mk_surface_topology_size(asset, mesh), scratch_size = mk_surface_scratch_size(asset, mesh);
-    void *topology = size ? aligned_alloc(16, (size + 15) & ~(size_t)15) : NULL;
-    void *scratch = size ? aligned_alloc(16, (scratch_size + 15) & ~(size_t)15) : NULL;
-    if (size && (!topology || !scratch)) {
-        free(topology);
-        free(scratch);
-        return mk_error_oom(err, "surface topology");
+    memset(s, 0, sizeof *s);
+    s->asset = asset;
+    s->mesh = mesh;
+    s->topology_size = mk_surface_topology_size(asset, mesh);
+    s->scratch_size = mk_surface_scratch_size(asset, mesh);
+    if (s->topology_size) {
+        s->topology = aligned_alloc(16, (s->topology_size + 15) & ~(size_t)15);
+        s->scratch = aligned_alloc(16, (s->scratch_size + 15) & ~(size_t)15);
+        if (!s->topology || !s->scratch) {
+            pb_surface_free(s);
+            return mk_error_oom(err, "surface topology");
+        }
     }
-    mk_result r = mk_surface_topology_build(asset, mesh, topology, size, err);
+    mk_result r = mk_surface_topology_build(asset, mesh, s->topology, s->topology_size, err);
+    if (r != MK_OK) pb_surface_free(s);
+    return r;
+}
+
+mk_result pb_surface_run(const pb_surface *s, const float *positions, float *normals, float *tangents, mk_error *err)
+{
     mk_mesh_info m;
-    mk_mesh_get(asset, mesh, &m);
+    mk_mesh_get(s->asset, s->mesh, &m);
     mk_surface_job job = {
-        .asset = asset,
-        .mesh = mesh,
-        .topology = topology,
-        .topology_size = size,
+        .asset = s->asset,
+        .mesh = s->mesh,
+        .topology = s->topology,
+        .topology_size = s->topology_size,
         .positions = positions,
         .positions_size = (size_t)m.vertex_count * 12,
         .vertex_count = MK_VERTICES_TO_END,
@@ -74,12 +85,26 @@ mk_result pb_surface_normals(const mk_asset *asset, uint32_t mesh, const float *
         .normals_size = (size_t)m.vertex_count * 12,
         .tangents = tangents,
         .tangents_size = (size_t)m.vertex_count * 16,
-        .scratch = scratch,
-        .scratch_size = scratch_size,
+        .scratch = s->scratch,
+        .scratch_size = s->scratch_size,
     };
-    if (r == MK_OK) r = mk_surface_run(&job, err);
-    free(topology);
-    free(scratch);
+    return mk_surface_run(&job, err);
+}
+
+void pb_surface_free(pb_surface *s)
+{
+    free(s->topology);
+    free(s->scratch);
+    s->topology = s->scratch = NULL;
+}
+
+mk_result pb_surface_normals(const mk_asset *asset, uint32_t mesh, const float *positions, float *normals,
+                             float *tangents, mk_error *err)
+{
+    pb_surface s;
+    mk_result r = pb_surface_prepare(&s, asset, mesh, err);
+    if (r == MK_OK) r = pb_surface_run(&s, positions, normals, tangents, err);
+    pb_surface_free(&s);
     return r;
 }
 

@@ -15,9 +15,22 @@ mk_result pb_frame_weights(const mk_asset *asset, int32_t clip, double time, flo
 mk_result pb_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
                        mk_normal_mode normals_mode, float *positions, float *normals, mk_error *err);
 
-/* Surface normals (mk_surface_run) of a whole mesh from its evaluated positions, and its
- * tangents when tangents is non-NULL; the topology is built and freed here (tools may
- * allocate). */
+/* A mesh's surface-normal topology and scratch (mk_surface_*), built once and used for any
+ * number of frames. */
+typedef struct pb_surface {
+    const mk_asset *asset;
+    uint32_t mesh;
+    void *topology, *scratch;
+    size_t topology_size, scratch_size;
+} pb_surface;
+
+/* Builds s for mesh (MK_ERROR_UNSUPPORTED without normals or triangles); s is freed on error. */
+mk_result pb_surface_prepare(pb_surface *s, const mk_asset *asset, uint32_t mesh, mk_error *err);
+/* Surface normals (and tangents when non-NULL) of the whole mesh from its evaluated positions. */
+mk_result pb_surface_run(const pb_surface *s, const float *positions, float *normals, float *tangents, mk_error *err);
+void pb_surface_free(pb_surface *s);
+
+/* prepare + run + free, for one frame. */
 mk_result pb_surface_normals(const mk_asset *asset, uint32_t mesh, const float *positions, float *normals,
                              float *tangents, mk_error *err);
 

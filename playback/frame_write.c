@@ -72,10 +72,12 @@ mk_result pb_frame_evaluate(pb_frame *f, mk_error *err)
         f->tangents[i] = m.has_tangents && !f->skip_tangents ? malloc(16u * (size_t)m.vertex_count + 16) : NULL;
         if (!f->positions[i] || (m.has_normals && !f->normals[i]) || (m.has_tangents && !f->skip_tangents && !f->tangents[i]))
             return mk_error_oom(err, "frame");
-        mk_result r = pb_eval_mesh(a, i, f->weights, f->stacking, f->normal_mode, f->positions[i], f->normals[i], err);
-        if (r == MK_OK && f->tangents[i]) r = eval_tangents(f, i, f->tangents[i], err);
-        if (r == MK_OK && f->surface_normals && f->normals[i] && mk_surface_topology_size(a, i))
-            r = pb_surface_normals(a, i, f->positions[i], f->normals[i], f->tangents[i], err);
+        /* Surface normals and tangents come from the positions: nothing blended is needed. */
+        int surface = f->surface_normals && f->normals[i] && mk_surface_topology_size(a, i);
+        mk_result r = pb_eval_mesh(a, i, f->weights, f->stacking, f->normal_mode, f->positions[i],
+                                   surface ? NULL : f->normals[i], err);
+        if (r == MK_OK && surface) r = pb_surface_normals(a, i, f->positions[i], f->normals[i], f->tangents[i], err);
+        else if (r == MK_OK && f->tangents[i]) r = eval_tangents(f, i, f->tangents[i], err);
         if (r != MK_OK) return r;
         if (f->world) pb_to_world(m.world, f->positions[i], f->normals[i], m.vertex_count);
         if (f->world && f->tangents[i]) tangents_to_world(m.world, f->tangents[i], m.vertex_count);

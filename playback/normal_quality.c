@@ -64,44 +64,73 @@ static int reserve(pb_normal_quality *q, size_t more)
     return 1;
 }
 
+/* What a mesh's frames share: its smoothing groups and rest normals, its surface topology. */
+typedef struct pb_quality_mesh {
+    int ready, measured;               /* built; has normals and triangles */
+    mk_arena arena;
+    mk_normal_groups groups;
+    double *rest;                      /* N(P0), 3 per vertex */
+    pb_surface surface;
+} pb_quality_mesh;
+
+static mk_result prepare_mesh(pb_quality_mesh *qm, const mk_asset *asset, const mk_raw_mesh *m, uint32_t mi,
+                              mk_error *err)
+{
+    mk_mesh_info info;
+    mk_mesh_get(asset, mi, &info);
+    qm->ready = 1;
+    mk_arena_init(&qm->arena, NULL);
+    if (!m->normals || !m->triangle_count || !info.has_normals) return MK_OK;
+    if (info.vertex_count != m->vertex_count)
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
+                            "normal quality: mesh %u has %u vertices in the raw model, %u in the asset", mi,
+                            m->vertex_count, info.vertex_count);
+    const size_t n = m->vertex_count;
+    double *rest_p = mk_arena_array(&qm->arena, 3 * n + 3, sizeof(double));
+    qm->rest = mk_arena_array(&qm->arena, 3 * n + 3, sizeof(double));
+    if (!rest_p || !qm->rest) return mk_error_oom(err, "normal quality");
+    mk_result r = mk_normal_groups_build(m, MK_GROUP_BY_CONTROL_POINT, &qm->arena, &qm->groups, err);
+    for (size_t i = 0; r == MK_OK && i < 3 * n; i++) rest_p[i] = m->positions[i];
+    if (r == MK_OK) r = mk_normal_groups_smooth(&qm->groups, m, rest_p, NULL, qm->rest, &qm->arena, err);
+    mk_arena_release(&qm->arena, rest_p);
+    if (r == MK_OK) r = pb_surface_prepare(&qm->surface, asset, mi, err);
+    qm->measured = r == MK_OK;
+    return r;
+}
+
 mk_result pb_normal_quality_add(pb_normal_quality *q, const mk_asset *asset, const mk_raw_asset *raw,
                                 const float *weights, mk_stacking stacking, mk_error *err)
 {
-    if (raw->mesh_count != asset->mesh_count)
+    if (raw->mesh_count != asset->mesh_count || (q->meshes && q->mesh_count != asset->mesh_count))
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
                             "normal quality: the raw model has %u meshes, the asset %u", raw->mesh_count,
                             asset->mesh_count);
+    if (!q->meshes) {
+        q->meshes = calloc(asset->mesh_count + 1u, sizeof *q->meshes);
+        if (!q->meshes) return mk_error_oom(err, "normal quality");
+        q->mesh_count = asset->mesh_count;
+    }
     mk_result r = MK_OK;
     for (uint32_t mi = 0; mi < asset->mesh_count && r == MK_OK; mi++) {
         const mk_raw_mesh *m = &raw->meshes[mi];
-        mk_mesh_info info;
-        mk_mesh_get(asset, mi, &info);
-        if (!m->normals || !m->triangle_count || !info.has_normals) continue;
-        if (info.vertex_count != m->vertex_count)
-            return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
-                                "normal quality: mesh %u has %u vertices in the raw model, %u in the asset", mi,
-                                m->vertex_count, info.vertex_count);
+        pb_quality_mesh *qm = &q->meshes[mi];
+        if (!qm->ready && (r = prepare_mesh(qm, asset, m, mi, err)) != MK_OK) break;
+        if (!qm->measured) continue;
         const size_t n = m->vertex_count;
         mk_arena arena;
         mk_arena_init(&arena, NULL);
-        mk_normal_groups groups;
-        double *rest = mk_arena_array(&arena, 3 * n + 3, sizeof(double));
-        double *rest_p = mk_arena_array(&arena, 3 * n + 3, sizeof(double));
         double *reference = mk_arena_array(&arena, 3 * n + 3, sizeof(double));
         float *positions = mk_arena_array(&arena, 3 * n + 3, sizeof(float));
         float *normals = mk_arena_array(&arena, 3 * n + 3, sizeof(float));
         unsigned char *moved = mk_arena_array(&arena, n + 1, 1);
-        if (!rest || !rest_p || !reference || !positions || !normals || !moved) r = mk_error_oom(err, "normal quality");
-        if (r == MK_OK) r = mk_normal_groups_build(m, MK_GROUP_BY_CONTROL_POINT, &arena, &groups, err);
-        for (size_t i = 0; r == MK_OK && i < 3 * n; i++) rest_p[i] = m->positions[i];
-        if (r == MK_OK) r = mk_normal_groups_smooth(&groups, m, rest_p, NULL, rest, &arena, err);
+        if (!reference || !positions || !normals || !moved) r = mk_error_oom(err, "normal quality");
         if (r == MK_OK) r = pb_eval_mesh(asset, mi, weights, stacking, MK_NORMALS_NLERP, positions, normals, err);
-        long count = r == MK_OK ? pb_reference_normals(m, &groups, rest, positions, reference, moved, &arena) : 0;
+        long count = r == MK_OK ? pb_reference_normals(m, &qm->groups, qm->rest, positions, reference, moved, &arena) : 0;
         if (count < 0 || (r == MK_OK && !reserve(q, (size_t)count))) r = mk_error_oom(err, "normal quality");
         for (int mode = 0; r == MK_OK && mode < PB_QUALITY_MODES; mode++) {
             if (mode == PB_QUALITY_SLERP)
                 r = pb_eval_mesh(asset, mi, weights, stacking, MK_NORMALS_SLERP, positions, normals, err);
-            if (mode == PB_QUALITY_SURFACE) r = pb_surface_normals(asset, mi, positions, normals, NULL, err);
+            if (mode == PB_QUALITY_SURFACE) r = pb_surface_run(&qm->surface, positions, normals, NULL, err);
             if (r != MK_OK) break;
             size_t at = q->count;
             for (size_t v = 0; v < n; v++) {
@@ -143,5 +172,10 @@ pb_normal_stats pb_normal_quality_stats(const pb_normal_quality *q, int mode)
 void pb_normal_quality_free(pb_normal_quality *q)
 {
     for (int k = 0; k < PB_QUALITY_MODES; k++) free(q->angles[k]);
+    for (uint32_t mi = 0; q->meshes && mi < q->mesh_count; mi++) {
+        pb_surface_free(&q->meshes[mi].surface);
+        if (q->meshes[mi].ready) mk_arena_free_all(&q->meshes[mi].arena);
+    }
+    free(q->meshes);
     memset(q, 0, sizeof *q);
 }

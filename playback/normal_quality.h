@@ -18,11 +18,17 @@
  * base normals left as they are. */
 enum { PB_QUALITY_NLERP, PB_QUALITY_SLERP, PB_QUALITY_SURFACE, PB_QUALITY_BASE, PB_QUALITY_MODES };
 
-/* Angles (degrees) collected over frames, per mode. */
+struct pb_quality_mesh;
+
+/* Angles (degrees) collected over frames, per mode. Zero-initialize; every call adds a frame of
+ * the same asset (the per-mesh groups, rest normals and surface topology are built on the
+ * first). */
 typedef struct pb_normal_quality {
     double *angles[PB_QUALITY_MODES];
     size_t count, capacity;            /* the same count for every mode */
     uint32_t frames;
+    struct pb_quality_mesh *meshes;    /* per asset mesh, built on the first call */
+    uint32_t mesh_count;
 } pb_normal_quality;
 
 typedef struct pb_normal_stats {

@@ -19,18 +19,13 @@ void mkr_draw_line(mkr_image *img, int x0, int y0, int x1, int y1, const uint8_t
     }
 }
 
-static void label(mkr_image *img, int x, int y, const char *text, const uint8_t fg[4], const uint8_t bg[4])
-{
-    mkr_draw_text(img, x, y, text, 1, fg, bg);
-}
-
 void mkr_plot_draw(mkr_image *img, int x, int y, int width, int height, const mkr_plot *p)
 {
     static const uint8_t panel[4] = { 32, 34, 40, 255 }, axis[4] = { 170, 170, 170, 255 },
                          text[4] = { 230, 230, 230, 255 }, limit_color[4] = { 235, 110, 80, 255 },
                          mark_color[4] = { 120, 160, 230, 255 }, curve_color[4] = { 250, 220, 90, 255 };
     mkr_image_fill_rect(img, x, y, width, height, panel);
-    label(img, x + 6, y + 4, p->title ? p->title : "", text, panel);
+    mkr_draw_text(img, x + 6, y + 4, p->title ? p->title : "", 1, text, panel);
     /* Plot area: room for y labels on the left, x labels below. */
     const int left = x + 64, right = x + width - 10, top = y + 22, bottom = y + height - 20;
     if (right - left < 10 || bottom - top < 10) return;
@@ -41,15 +36,14 @@ void mkr_plot_draw(mkr_image *img, int x, int y, int width, int height, const mk
     top_value *= 1.1;
     mkr_draw_line(img, left, bottom, right, bottom, axis, 0);
     mkr_draw_line(img, left, top, left, bottom, axis, 0);
-    char s[64];
-    for (int t = 0; t <= 2; t++) {   /* x ticks */
-        int px = left + (int)lround((right - left) * t / 2.0);
+    static const char *const x_ticks[3] = { "0", "0.5", "1" };
+    for (int t = 0; t <= 2; t++) {
+        int px = left + (int)lround((right - left) * t / 2.0), w, h;
         mkr_draw_line(img, px, bottom, px, bottom + 3, axis, 0);
-        snprintf(s, sizeof s, t == 0 ? "0" : t == 1 ? "0.5" : "1");
-        int w, h;
-        mkr_text_box(s, 1, &w, &h);
-        label(img, px - w / 2, bottom + 5, s, text, panel);
+        mkr_text_box(x_ticks[t], 1, &w, &h);
+        mkr_draw_text(img, px - w / 2, bottom + 5, x_ticks[t], 1, text, panel);
     }
+    char s[64];
     const char *unit = p->unit ? p->unit : "";
     double scale = p->label_scale > 0 ? p->label_scale : 1;
     double ticks[3] = { 0, p->limit, top_value };
@@ -60,7 +54,7 @@ void mkr_plot_draw(mkr_image *img, int x, int y, int width, int height, const mk
         snprintf(s, sizeof s, "%.3g%s", ticks[t] * scale, unit);
         int w, h;
         mkr_text_box(s, 1, &w, &h);
-        label(img, left - 5 - w, py - h / 2, s, t == 1 ? limit_color : text, panel);
+        mkr_draw_text(img, left - 5 - w, py - h / 2, s, 1, t == 1 ? limit_color : text, panel);
     }
     if (p->limit > 0) {
         int py = bottom - (int)lround((bottom - top) * p->limit / top_value);
@@ -72,7 +66,7 @@ void mkr_plot_draw(mkr_image *img, int x, int y, int width, int height, const mk
         mkr_draw_line(img, px, top, px, bottom - 1, mark_color, 2);
     }
     if (!p->values || p->count < 2) {
-        if (p->note) label(img, left + 8, top + 8, p->note, text, panel);
+        if (p->note) mkr_draw_text(img, left + 8, top + 8, p->note, 1, text, panel);
         return;
     }
     int px0 = 0, py0 = 0;

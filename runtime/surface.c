@@ -21,7 +21,7 @@
 
 typedef struct topology_header {
     uint32_t magic, mesh;
-    uint32_t vertex_count, triangle_count, control_point_count, group_count;
+    uint32_t vertex_count, triangle_count, group_count, reserved;
     uint64_t size;                 /* bytes the topology was built for */
     uint64_t checksum;             /* the blob's, to refuse another asset's topology */
     uint64_t group_of, group_tri_first, group_tris, rest; /* array offsets in the topology */
@@ -147,20 +147,10 @@ mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *
     for (uint32_t g = 0; g < groups; g++)
         group_normal(group_tris, tri_first[g], tri_first[g + 1], triangles, asset->data + m->positions, 12, none,
                      &rest[3u * g]);
-    topology_header h;
-    memset(&h, 0, sizeof h);
-    h.magic = TOPOLOGY_MAGIC;
-    h.mesh = mesh;
-    h.vertex_count = n;
-    h.triangle_count = tri_count;
-    h.control_point_count = cps;
-    h.group_count = groups;
-    h.size = l.size;
-    h.checksum = asset->header->checksum;
-    h.group_of = l.group_of;
-    h.group_tri_first = l.group_tri_first;
-    h.group_tris = l.group_tris;
-    h.rest = l.rest;
+    topology_header h = { .magic = TOPOLOGY_MAGIC, .mesh = mesh, .vertex_count = n, .triangle_count = tri_count,
+                          .group_count = groups, .size = l.size, .checksum = asset->header->checksum,
+                          .group_of = l.group_of, .group_tri_first = l.group_tri_first, .group_tris = l.group_tris,
+                          .rest = l.rest };
     memcpy(base, &h, sizeof h);
     return MK_OK;
 }
@@ -206,14 +196,32 @@ mk_result mk_surface_validate(const mk_surface_job *job, mk_error *err)
     return MK_OK;
 }
 
-/* Per triangle, in the job's scratch: its face normal at the evaluated positions and whether a
- * corner moved, computed once per job however many groups use it. A job first clears the
- * marks of the triangles its range reaches, so the scratch needs no initialization and any
- * job may use any scratch. */
+/* Per triangle, in the job's scratch: whether a corner moved and, once a moved group needs
+ * it, its face normal at the evaluated positions; each computed at most once per job however
+ * many groups use the triangle. A job first clears the states of the triangles its range
+ * reaches, so the scratch needs no initialization and any job may use any scratch. */
+enum { FACE_UNKNOWN, FACE_CHECKED, FACE_NORMAL };
+
 typedef struct face_cache {
     double normal[3];
-    uint32_t done, moved;
+    uint32_t state, moved;
 } face_cache;
+
+/* Whether a corner of tri is not where it rests (-0 and +0 are the same place), checked once. */
+static uint32_t face_moved(face_cache *f, const uint32_t *tri, const uint8_t *p, size_t stride, const float *p0)
+{
+    if (f->state == FACE_UNKNOWN) {
+        uint32_t any = 0;
+        for (int c = 0; c < 3; c++) {
+            const float *q = (const float *)(const void *)(p + stride * tri[c]);
+            const float *o = &p0[3u * tri[c]];
+            any |= (uint32_t)(q[0] != o[0]) | (uint32_t)(q[1] != o[1]) | (uint32_t)(q[2] != o[2]);
+        }
+        f->moved = any;
+        f->state = FACE_CHECKED;
+    }
+    return f->moved;
+}
 
 size_t mk_surface_scratch_size(const mk_asset *asset, uint32_t mesh)
 {
@@ -245,29 +253,24 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
     uint32_t n = job->vertex_count == MK_VERTICES_TO_END ? m->vertex_count - job->first_vertex : job->vertex_count;
     for (uint32_t i = 0; i < n; i++) {
         uint32_t g = group_of[job->first_vertex + i];
-        for (uint32_t k = tri_first[g]; k < tri_first[g + 1]; k++) faces[group_tris[k]].done = 0;
+        for (uint32_t k = tri_first[g]; k < tri_first[g + 1]; k++) faces[group_tris[k]].state = FACE_UNKNOWN;
     }
     for (uint32_t i = 0; i < n; i++) {
         uint32_t v = job->first_vertex + i, g = group_of[v];
         const float *b = &normals[3u * v];
+        /* Moved: a corner of one of the group's triangles is not where it rests. Unmoved groups
+         * keep their base normal without any face normal. */
         uint32_t moved = 0;
+        for (uint32_t k = tri_first[g]; k < tri_first[g + 1] && !moved; k++)
+            moved = face_moved(&faces[group_tris[k]], &triangles[3u * group_tris[k]], p, ps, p0);
         double sum[3] = { 0, 0, 0 };
-        for (uint32_t k = tri_first[g]; k < tri_first[g + 1]; k++) {
+        for (uint32_t k = tri_first[g]; moved && k < tri_first[g + 1]; k++) {
             face_cache *f = &faces[group_tris[k]];
-            if (!f->done) {
-                /* Moved: a corner is not where it rests (-0 and +0 are the same place). */
-                const uint32_t *tri = &triangles[3u * group_tris[k]];
-                uint32_t any = 0;
-                for (int c = 0; c < 3; c++) {
-                    const float *q = (const float *)(const void *)(p + ps * tri[c]);
-                    const float *o = &p0[3u * tri[c]];
-                    any |= (uint32_t)(q[0] != o[0]) | (uint32_t)(q[1] != o[1]) | (uint32_t)(q[2] != o[2]);
-                }
-                face_normal(tri, p, ps, f->normal);
-                f->moved = any;
-                f->done = 1;
+            if (f->state != FACE_NORMAL) {
+                face_moved(f, &triangles[3u * group_tris[k]], p, ps, p0);   /* a later group may ask */
+                face_normal(&triangles[3u * group_tris[k]], p, ps, f->normal);
+                f->state = FACE_NORMAL;
             }
-            moved |= f->moved;
             sum[0] += f->normal[0]; sum[1] += f->normal[1]; sum[2] += f->normal[2];
         }
         float out[3] = { b[0], b[1], b[2] };

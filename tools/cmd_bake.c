@@ -56,12 +56,12 @@ const cli_verb cli_verb_bake = {
     .run = run_bake,
 };
 
-/* One channel's error curve, kept for --plot. */
+/* One channel's error curve, kept for --plot (the arrays live in the raw asset). */
 typedef struct plot_channel {
     char title[160];
-    double *curve;
+    const double *curve;
+    const float *keys;
     uint32_t samples, key_count;
-    float *keys;
     double tolerance;
 } plot_channel;
 
@@ -81,28 +81,13 @@ static void keep_curve(bake_ui *ui, const mk_bake_channel_report *c)
     if (!grown) { ui->out_of_memory = 1; return; }
     ui->channels = grown;
     plot_channel *pc = &ui->channels[ui->channel_count++];
-    memset(pc, 0, sizeof *pc);
     snprintf(pc->title, sizeof pc->title, "%s (%s, mesh %u): %u target%s, max %.3g%% of the diagonal", c->name, c->op,
              c->mesh, c->targets, c->targets == 1 ? "" : "s", 100 * c->max_error);
+    pc->curve = c->error_curve;
+    pc->keys = c->key_weights;
+    pc->samples = c->curve_samples;
+    pc->key_count = c->key_weights ? c->targets : 0;
     pc->tolerance = c->tolerance;
-    pc->key_count = c->targets;
-    pc->keys = c->key_weights ? malloc((c->targets + 1) * sizeof(float)) : NULL;
-    if (pc->keys) memcpy(pc->keys, c->key_weights, c->targets * sizeof(float));
-    if (c->error_curve) {
-        pc->curve = malloc((c->curve_samples + 1) * sizeof(double));
-        if (pc->curve) memcpy(pc->curve, c->error_curve, (c->curve_samples + 1) * sizeof(double));
-        pc->samples = c->curve_samples;
-    }
-    if ((c->key_weights && !pc->keys) || (c->error_curve && !pc->curve)) ui->out_of_memory = 1;
-}
-
-static void free_curves(bake_ui *ui)
-{
-    for (uint32_t i = 0; i < ui->channel_count; i++) {
-        free(ui->channels[i].curve);
-        free(ui->channels[i].keys);
-    }
-    free(ui->channels);
 }
 
 /* One 720 x 200 panel per channel, stacked. Returns -1 when fine, else the exit status. */
@@ -117,7 +102,7 @@ static int draw_plot(const cli_verb *verb, const bake_ui *ui, mkr_image *img, mk
     for (uint32_t i = 0; i < n && i < ui->channel_count; i++) {
         const plot_channel *pc = &ui->channels[i];
         mkr_plot plot = { .title = pc->title, .values = pc->curve, .count = pc->curve ? pc->samples + 1 : 0,
-                          .limit = pc->tolerance, .marks = pc->keys, .mark_count = pc->keys ? pc->key_count : 0,
+                          .limit = pc->tolerance, .marks = pc->keys, .mark_count = pc->key_count,
                           .label_scale = 100, .unit = "%",
                           .note = "no error curve: a fixed count of an expensive deformer is checked at span midpoints" };
         mkr_plot_draw(img, 0, 200 * (int)i, 720, 198, &plot);
@@ -247,7 +232,7 @@ static int run_bake(void *p)
     }
 done:
     free(dep_text);
-    free_curves(&ui);
+    free(ui.channels);
     mkr_png_free(&png);
     mkr_image_destroy(&img);
     cli_depfile_free(&ui.deps);
