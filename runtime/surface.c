@@ -5,10 +5,13 @@
  * The topology, built once per mesh into caller memory, holds the smoothing groups (vertices
  * with the same control point and the same base normal within 1e-5 per component, numbered in
  * control-point order, then vertex order), each group's triangles (a triangle once per
- * distinct corner group, in triangle order) and each group's rest normal. The rules and the
- * order of every sum are those of the offline importer's target normals, so a single target at
- * its full weight reproduces the normal deltas the importer computed for it. A vertex's normal
- * depends only on the positions and the topology, never on the job's range. */
+ * distinct corner group, in triangle order), each triangle's distinct corner groups and each
+ * group's rest normal. The rules and the order of every sum are those of the offline
+ * importer's target normals (which sums in double precision; here single precision keeps the
+ * per-frame pass small), so a single target at its full weight reproduces the normal deltas
+ * the importer computed for it up to float rounding. A job sums each needed triangle's face
+ * normal into its corner groups in one pass in triangle order, then finishes its vertices. A
+ * vertex's normal depends only on the positions and the topology, never on the job's range. */
 #include <math.h>
 #include <string.h>
 #include "format.h"
@@ -18,35 +21,37 @@
 #include "determinism.h"
 
 #define TOPOLOGY_MAGIC 0x54534b4du /* "MKST" */
+#define NO_GROUP UINT32_MAX
 
 typedef struct topology_header {
     uint32_t magic, mesh;
     uint32_t vertex_count, triangle_count, group_count, reserved;
     uint64_t size;                 /* bytes the topology was built for */
     uint64_t checksum;             /* the blob's, to refuse another asset's topology */
-    uint64_t group_of, group_tri_first, group_tris, rest; /* array offsets in the topology */
-} topology_header;                 /* 64 bytes */
+    uint64_t group_of, group_tri_first, group_tris, rest, tri_groups; /* array offsets */
+} topology_header;
 
 static size_t align16(size_t n) { return (n + 15u) & ~(size_t)15u; }
 
 typedef struct layout {
-    size_t group_of, group_tri_first, group_tris, rest, size;
+    size_t group_of, group_tri_first, group_tris, tri_groups, rest, size;
 } layout;
 
 /* Offsets of the arrays; size 0 when the mesh cannot have a topology. The rest-normal region
- * (3 doubles per possible group) first serves as the build's scratch (control point lists). */
+ * (3 floats per possible group) first serves as the build's scratch (control point lists). */
 static layout topology_layout(const mk_blob_mesh *m)
 {
-    layout l = { 0, 0, 0, 0, 0 };
+    layout l = { 0, 0, 0, 0, 0, 0 };
     if (!(m->flags & MK_MESH_HAS_NORMALS) || m->triangle_count == 0 || m->vertex_count == 0) return l;
     size_t v = m->vertex_count, t = m->triangle_count, c = m->control_point_count;
     if (v > SIZE_MAX / 64 || t > SIZE_MAX / 64 || c > SIZE_MAX / 64) return l;
     size_t scratch = 4 * (2 * c + v + 1);
-    size_t rest = 24 * v > scratch ? 24 * v : scratch;
+    size_t rest = 12 * v > scratch ? 12 * v : scratch;
     l.group_of = align16(sizeof(topology_header));
     l.group_tri_first = l.group_of + align16(4 * v);
     l.group_tris = l.group_tri_first + align16(4 * (v + 1));
-    l.rest = l.group_tris + align16(12 * t);
+    l.tri_groups = l.group_tris + align16(12 * t);
+    l.rest = l.tri_groups + align16(12 * t);
     l.size = l.rest + align16(rest);
     return l;
 }
@@ -63,29 +68,28 @@ static int same_normal(const float *a, const float *b)
 }
 
 /* Area-weighted face normal (cross product) of triangle tri at positions p (stride bytes). */
-static void face_normal(const uint32_t *tri, const uint8_t *p, size_t stride, double out[3])
+static void face_normal(const uint32_t *tri, const uint8_t *p, size_t stride, float out[3])
 {
     const float *a = (const float *)(const void *)(p + stride * tri[0]);
     const float *b = (const float *)(const void *)(p + stride * tri[1]);
     const float *c = (const float *)(const void *)(p + stride * tri[2]);
-    double e1[3] = { (double)b[0] - a[0], (double)b[1] - a[1], (double)b[2] - a[2] };
-    double e2[3] = { (double)c[0] - a[0], (double)c[1] - a[1], (double)c[2] - a[2] };
+    float e1[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+    float e2[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
     out[0] = e1[1] * e2[2] - e1[2] * e2[1];
     out[1] = e1[2] * e2[0] - e1[0] * e2[2];
     out[2] = e1[0] * e2[1] - e1[1] * e2[0];
 }
 
-/* The normalized sum of a group's face normals at positions p; fallback where it has no area. */
-static void group_normal(const uint32_t *tris, uint32_t first, uint32_t end, const uint32_t *triangles,
-                         const uint8_t *p, size_t stride, const float *fallback, double out[3])
+/* N: a group's summed face normals, normalized; the fallback where the sum is zero. */
+static void normalize_sum(const float sum[3], const float fallback[3], float out[3])
 {
-    double sum[3] = { 0, 0, 0 }, f[3];
-    for (uint32_t k = first; k < end; k++) {
-        face_normal(&triangles[3u * tris[k]], p, stride, f);
-        sum[0] += f[0]; sum[1] += f[1]; sum[2] += f[2];
+    float len = sqrtf(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+    if (len > 0) {
+        float inv = 1.0f / len;
+        for (int d = 0; d < 3; d++) out[d] = sum[d] * inv;
+    } else {
+        for (int d = 0; d < 3; d++) out[d] = fallback[d];
     }
-    double len = sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
-    for (int d = 0; d < 3; d++) out[d] = len > 0 ? sum[d] / len : (double)fallback[d];
 }
 
 mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *topology, size_t size, mk_error *err)
@@ -108,6 +112,7 @@ mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *
     uint32_t *group_of = (uint32_t *)(void *)(base + l.group_of);
     uint32_t *tri_first = (uint32_t *)(void *)(base + l.group_tri_first);
     uint32_t *group_tris = (uint32_t *)(void *)(base + l.group_tris);
+    uint32_t *tri_groups = (uint32_t *)(void *)(base + l.tri_groups);
     /* Scratch in the rest-normal region: control point -> its vertices (CSR), a fill cursor. */
     uint32_t *cp_first = (uint32_t *)(void *)(base + l.rest), *cp_verts = cp_first + cps + 1, *fill = cp_verts + n;
     memset(cp_first, 0, 4 * ((size_t)cps + 1));
@@ -139,18 +144,27 @@ mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *
         group_tris[fill[g0]++] = t;
         if (g1 != g0) group_tris[fill[g1]++] = t;
         if (g2 != g0 && g2 != g1) group_tris[fill[g2]++] = t;
+        /* Triangle -> its distinct corner groups (NO_GROUP for a repeated one). */
+        tri_groups[3u * t] = g0;
+        tri_groups[3u * t + 1] = g1 != g0 ? g1 : NO_GROUP;
+        tri_groups[3u * t + 2] = g2 != g0 && g2 != g1 ? g2 : NO_GROUP;
     }
     /* Rest normals (the scratch is no longer needed); (0,0,0) for a group without area, whose
      * vertices then take their own base normal as the rest normal. */
-    double *rest = (double *)(void *)(base + l.rest);
+    float *rest = (float *)(void *)(base + l.rest);
     static const float none[3] = { 0, 0, 0 };
-    for (uint32_t g = 0; g < groups; g++)
-        group_normal(group_tris, tri_first[g], tri_first[g + 1], triangles, asset->data + m->positions, 12, none,
-                     &rest[3u * g]);
+    for (uint32_t g = 0; g < groups; g++) {
+        float sum[3] = { 0, 0, 0 }, f[3];
+        for (uint32_t k = tri_first[g]; k < tri_first[g + 1]; k++) {
+            face_normal(&triangles[3u * group_tris[k]], asset->data + m->positions, 12, f);
+            sum[0] += f[0]; sum[1] += f[1]; sum[2] += f[2];
+        }
+        normalize_sum(sum, none, &rest[3u * g]);
+    }
     topology_header h = { .magic = TOPOLOGY_MAGIC, .mesh = mesh, .vertex_count = n, .triangle_count = tri_count,
                           .group_count = groups, .size = l.size, .checksum = asset->header->checksum,
                           .group_of = l.group_of, .group_tri_first = l.group_tri_first, .group_tris = l.group_tris,
-                          .rest = l.rest };
+                          .tri_groups = l.tri_groups, .rest = l.rest };
     memcpy(base, &h, sizeof h);
     return MK_OK;
 }
@@ -196,37 +210,33 @@ mk_result mk_surface_validate(const mk_surface_job *job, mk_error *err)
     return MK_OK;
 }
 
-/* Per triangle, in the job's scratch: whether a corner moved and, once a moved group needs
- * it, its face normal at the evaluated positions; each computed at most once per job however
- * many groups use the triangle. A job first clears the states of the triangles its range
- * reaches, so the scratch needs no initialization and any job may use any scratch. */
-enum { FACE_UNKNOWN, FACE_CHECKED, FACE_NORMAL };
+/* A job's scratch: one mark byte per triangle (whether the job needs it), one per vertex
+ * (whether it moved), then one
+ * accumulator per possible group (the sum of its face normals at the evaluated positions and
+ * whether a corner of its triangles moved). A job fills what it reads, so the scratch needs no
+ * initialization and any job may use any scratch. */
+typedef struct group_sum {
+    float normal[3];
+    uint32_t moved;
+} group_sum;
 
-typedef struct face_cache {
-    double normal[3];
-    uint32_t state, moved;
-} face_cache;
-
-/* Whether a corner of tri is not where it rests (-0 and +0 are the same place), checked once. */
-static uint32_t face_moved(face_cache *f, const uint32_t *tri, const uint8_t *p, size_t stride, const float *p0)
-{
-    if (f->state == FACE_UNKNOWN) {
-        uint32_t any = 0;
-        for (int c = 0; c < 3; c++) {
-            const float *q = (const float *)(const void *)(p + stride * tri[c]);
-            const float *o = &p0[3u * tri[c]];
-            any |= (uint32_t)(q[0] != o[0]) | (uint32_t)(q[1] != o[1]) | (uint32_t)(q[2] != o[2]);
-        }
-        f->moved = any;
-        f->state = FACE_CHECKED;
-    }
-    return f->moved;
-}
+static size_t marks_size(const mk_blob_mesh *m) { return align16(m->triangle_count) + align16(m->vertex_count); }
 
 size_t mk_surface_scratch_size(const mk_asset *asset, uint32_t mesh)
 {
     if (!mk_surface_topology_size(asset, mesh)) return 0;
-    return sizeof(face_cache) * (size_t)asset->meshes[mesh].triangle_count;
+    const mk_blob_mesh *m = &asset->meshes[mesh];
+    return marks_size(m) + sizeof(group_sum) * (size_t)m->vertex_count;
+}
+
+/* Whether vertices [lo, hi) are not where they rest (-0 and +0 are the same place). */
+static void vertices_moved(uint8_t *moved, uint32_t lo, uint32_t hi, const uint8_t *p, size_t stride, const float *p0)
+{
+    for (uint32_t v = lo; v < hi; v++) {
+        const float *q = (const float *)(const void *)(p + stride * v);
+        const float *o = &p0[3u * v];
+        moved[v] = (uint8_t)((q[0] != o[0]) | (q[1] != o[1]) | (q[2] != o[2]));
+    }
 }
 
 mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
@@ -241,7 +251,8 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
     const uint32_t *group_of = (const uint32_t *)(const void *)(base + h.group_of);
     const uint32_t *tri_first = (const uint32_t *)(const void *)(base + h.group_tri_first);
     const uint32_t *group_tris = (const uint32_t *)(const void *)(base + h.group_tris);
-    const double *rest = (const double *)(const void *)(base + h.rest);
+    const uint32_t *tri_groups = (const uint32_t *)(const void *)(base + h.tri_groups);
+    const float *rest = (const float *)(const void *)(base + h.rest);
     const uint32_t *triangles = (const uint32_t *)(const void *)(a->data + m->triangles);
     const float *p0 = (const float *)(const void *)(a->data + m->positions);
     const float *normals = (const float *)(const void *)(a->data + m->normals);
@@ -249,42 +260,73 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
     const uint8_t *p = (const uint8_t *)job->positions;
     const size_t ps = mk_stride_or(job->positions_stride, 12), ns = mk_stride_or(job->normals_stride, 12),
                  ts = mk_stride_or(job->tangents_stride, 16);
-    face_cache *faces = job->scratch;
-    uint32_t n = job->vertex_count == MK_VERTICES_TO_END ? m->vertex_count - job->first_vertex : job->vertex_count;
-    for (uint32_t i = 0; i < n; i++) {
-        uint32_t g = group_of[job->first_vertex + i];
-        for (uint32_t k = tri_first[g]; k < tri_first[g + 1]; k++) faces[group_tris[k]].state = FACE_UNKNOWN;
+    uint8_t *mark = job->scratch, *vmoved = mark + align16(m->triangle_count);
+    group_sum *sums = (group_sum *)(void *)((uint8_t *)job->scratch + marks_size(m));
+    const uint32_t n = job->vertex_count == MK_VERTICES_TO_END ? m->vertex_count - job->first_vertex : job->vertex_count;
+    const uint32_t tri_count = m->triangle_count;
+    /* The triangles the range needs: those with a corner in a group of one of its vertices
+     * (all of them for the whole mesh), in [t_lo, t_hi). */
+    uint32_t t_lo = 0, t_hi = tri_count, v_lo = 0, v_hi = m->vertex_count;
+    if (n == m->vertex_count) {
+        memset(mark, 1, tri_count);
+        memset(sums, 0, sizeof(group_sum) * (size_t)h.group_count);
+    } else {
+        memset(mark, 0, tri_count);
+        t_lo = tri_count; t_hi = 0;
+        for (uint32_t i = 0; i < n; i++) {
+            uint32_t g = group_of[job->first_vertex + i];
+            memset(&sums[g], 0, sizeof(group_sum));   /* a group without triangles stays unmoved */
+            for (uint32_t k = tri_first[g]; k < tri_first[g + 1]; k++) {
+                uint32_t t = group_tris[k];
+                mark[t] = 1;
+                if (t < t_lo) t_lo = t;
+                if (t + 1 > t_hi) t_hi = t + 1;
+            }
+        }
+        v_lo = m->vertex_count; v_hi = 0;
+        for (uint32_t t = t_lo; t < t_hi; t++)
+            if (mark[t])
+                for (int c = 0; c < 3; c++) {
+                    uint32_t v = triangles[3u * t + c];
+                    if (tri_groups[3u * t + c] != NO_GROUP) memset(&sums[tri_groups[3u * t + c]], 0, sizeof(group_sum));
+                    if (v < v_lo) v_lo = v;
+                    if (v + 1 > v_hi) v_hi = v + 1;
+                }
+    }
+    vertices_moved(vmoved, v_lo, v_hi, p, ps, p0);
+    /* One pass over those triangles in triangle order: each adds its face normal once to each
+     * distinct corner group (the order of every group's sum is the triangle order, as in
+     * docs/semantics.md) and marks the groups moved when a corner moved. */
+    for (uint32_t t = t_lo; t < t_hi; t++) {
+        if (!mark[t]) continue;
+        const uint32_t *tri = &triangles[3u * t];
+        const uint32_t *g = &tri_groups[3u * t];
+        float f[3];
+        face_normal(tri, p, ps, f);
+        uint32_t moved_corners = (uint32_t)vmoved[tri[0]] + vmoved[tri[1]] + vmoved[tri[2]];
+        for (int c = 0; c < 3; c++)
+            if (g[c] != NO_GROUP) {
+                group_sum *gs = &sums[g[c]];
+                gs->normal[0] += f[0]; gs->normal[1] += f[1]; gs->normal[2] += f[2]; gs->moved |= moved_corners != 0;
+            }
     }
     for (uint32_t i = 0; i < n; i++) {
         uint32_t v = job->first_vertex + i, g = group_of[v];
         const float *b = &normals[3u * v];
         /* Moved: a corner of one of the group's triangles is not where it rests. Unmoved groups
-         * keep their base normal without any face normal. */
-        uint32_t moved = 0;
-        for (uint32_t k = tri_first[g]; k < tri_first[g + 1] && !moved; k++)
-            moved = face_moved(&faces[group_tris[k]], &triangles[3u * group_tris[k]], p, ps, p0);
-        double sum[3] = { 0, 0, 0 };
-        for (uint32_t k = tri_first[g]; moved && k < tri_first[g + 1]; k++) {
-            face_cache *f = &faces[group_tris[k]];
-            if (f->state != FACE_NORMAL) {
-                face_moved(f, &triangles[3u * group_tris[k]], p, ps, p0);   /* a later group may ask */
-                face_normal(&triangles[3u * group_tris[k]], p, ps, f->normal);
-                f->state = FACE_NORMAL;
-            }
-            sum[0] += f->normal[0]; sum[1] += f->normal[1]; sum[2] += f->normal[2];
-        }
+         * keep their base normal. */
+        uint32_t moved = sums[g].moved;
         float out[3] = { b[0], b[1], b[2] };
         if (moved) {
-            double now[3], s[3], area = sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
-            double inv = area > 0 ? 1.0 / area : 0.0;
-            for (int d = 0; d < 3; d++) now[d] = area > 0 ? sum[d] * inv : (double)b[d];
-            const double *r0 = &rest[3u * g];
+            float now[3], d[3];
+            normalize_sum(sums[g].normal, b, now);
+            const float *r0 = &rest[3u * g];
             int flat = r0[0] == 0 && r0[1] == 0 && r0[2] == 0;
-            for (int d = 0; d < 3; d++) s[d] = (double)b[d] + now[d] - (flat ? (double)b[d] : r0[d]);
-            double len = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-            if (len > 1e-8) {
-                double inv_len = 1.0 / len;
-                for (int d = 0; d < 3; d++) out[d] = (float)(s[d] * inv_len);
+            for (int c = 0; c < 3; c++) d[c] = flat ? now[c] : b[c] + (now[c] - r0[c]);
+            float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            if (len > 1e-8f) {
+                float inv = 1.0f / len;
+                for (int c = 0; c < 3; c++) out[c] = d[c] * inv;
             }
         }
         memcpy((uint8_t *)job->normals + ns * i, out, sizeof out);
