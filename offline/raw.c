@@ -37,14 +37,12 @@ static void *grow(mk_raw_asset *raw, void **array, uint32_t *count, uint32_t add
 
 mk_raw_mesh *mk_raw_add_meshes(mk_raw_asset *raw, uint32_t count)
 {
-    uint32_t before = raw->mesh_count;
     mk_raw_mesh *m = grow(raw, (void **)&raw->meshes, &raw->mesh_count, count, sizeof *m);
     for (uint32_t i = 0; m && i < count; i++) {
         mk_mat4_identity(m[i].world);
         m[i].gltf_node = m[i].gltf_mesh = m[i].gltf_primitive = -1;
         m[i].stacking = MK_STACKING_ADDITIVE;
     }
-    (void)before;
     return m;
 }
 

@@ -90,10 +90,11 @@ static const char *stacking_name(mk_stacking s)
     return s == MK_STACKING_SEQUENTIAL ? "sequential" : s == MK_STACKING_ADDITIVE ? "additive" : "asset";
 }
 
-void pb_json_mesh_identity(json_writer *w, const mk_asset *a, uint32_t mesh)
+void pb_json_mesh_begin(json_writer *w, const mk_asset *a, uint32_t mesh, mk_mesh_info *info)
 {
-    mk_mesh_info m;
-    mk_mesh_get(a, mesh, &m);
+    mk_mesh_get(a, mesh, info);
+    const mk_mesh_info m = *info;
+    json_object(w, NULL);
     json_string(w, "name", m.name);
     json_string(w, "node", m.name);
     json_int(w, "mesh_index", mesh);
@@ -124,9 +125,7 @@ void pb_frame_write_json(FILE *file, const pb_frame *f, const char *producer)
     json_array(&w, "meshes");
     for (uint32_t i = 0; i < a->mesh_count; i++) {
         mk_mesh_info m;
-        mk_mesh_get(a, i, &m);
-        json_object(&w, NULL);
-        pb_json_mesh_identity(&w, a, i);
+        pb_json_mesh_begin(&w, a, i, &m);
         json_array(&w, "channels");
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
             mk_channel_info ch;

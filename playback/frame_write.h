@@ -31,10 +31,11 @@ void pb_frame_free(pb_frame *frame);
 
 void pb_frame_write_json(FILE *f, const pb_frame *frame, const char *producer);
 struct json_writer;
-/* The fields that identify a mesh in every JSON morphkit writes (frames, `info --json`):
- * name, node, mesh_index, gltf_node/gltf_mesh/gltf_primitive (glTF meshes only), vertices,
- * control_points (the count) and world. */
-void pb_json_mesh_identity(struct json_writer *w, const mk_asset *asset, uint32_t mesh);
+/* Opens a mesh's object in every JSON morphkit writes (frames, `info --json`) with the fields
+ * that identify it: name, node, mesh_index, gltf_node/gltf_mesh/gltf_primitive (glTF meshes
+ * only), vertices, control_point_count and world; *info receives the mesh's facts. The caller
+ * adds its own fields and closes the object. */
+void pb_json_mesh_begin(struct json_writer *w, const mk_asset *asset, uint32_t mesh, mk_mesh_info *info);
 void pb_frame_write_obj(FILE *f, const pb_frame *frame, const char *producer);
 void pb_frame_write_mkf(FILE *f, const pb_frame *frame);
 

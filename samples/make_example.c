@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdio.h>
 #include "blob_io.h"
+#include "primitives.h"
 
 #define SEGMENTS 32
 #define RINGS 24
@@ -32,30 +33,9 @@ int main(int argc, char **argv)
     if (argc != 2) { fprintf(stderr, "usage: make_example OUT.morph\n"); return 2; }
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
-    mk_raw_mesh *m = mk_raw_add_meshes(&raw, 1);
-    const uint32_t n = SEGMENTS * (RINGS + 1);
-    m->name = "tube";
-    m->vertex_count = n;
-    m->positions = mk_arena_array(&raw.arena, 3 * n, sizeof(float));
-    m->normals = mk_arena_array(&raw.arena, 3 * n, sizeof(float));
-    m->triangles = mk_arena_array(&raw.arena, 6 * SEGMENTS * RINGS, sizeof(uint32_t));
-    for (uint32_t r = 0; r <= RINGS; r++)
-        for (uint32_t s = 0; s < SEGMENTS; s++) {
-            uint32_t v = r * SEGMENTS + s;
-            float a = 2 * PI * (float)s / SEGMENTS;
-            m->positions[3 * v] = 0.5f * cosf(a);
-            m->positions[3 * v + 1] = 2.0f * (float)r / RINGS;
-            m->positions[3 * v + 2] = 0.5f * sinf(a);
-            m->normals[3 * v] = cosf(a);
-            m->normals[3 * v + 2] = sinf(a);
-        }
-    for (uint32_t r = 0, t = 0; r < RINGS; r++)
-        for (uint32_t s = 0; s < SEGMENTS; s++, t++) {
-            uint32_t a = r * SEGMENTS + s, b = r * SEGMENTS + (s + 1) % SEGMENTS, c = a + SEGMENTS, d = b + SEGMENTS;
-            uint32_t *tri = &m->triangles[6 * t];
-            tri[0] = a; tri[1] = c; tri[2] = b; tri[3] = b; tri[4] = c; tri[5] = d;
-        }
-    m->triangle_count = 2 * SEGMENTS * RINGS;
+    mk_raw_mesh *m = mk_raw_add_tube(&raw, "tube", SEGMENTS, RINGS);
+    if (!m) { fprintf(stderr, "make_example: out of memory\n"); return 1; }
+    const uint32_t n = m->vertex_count;
 
     float deformed[3 * SEGMENTS * (RINGS + 1)];
     mk_raw_channel *ch = mk_raw_add_channels(&raw, 2);

@@ -105,9 +105,7 @@ static void print_json(FILE *f, const pb_asset *l, const char *path)
     json_array(&w, "meshes");
     for (uint32_t i = 0; i < a->mesh_count; i++) {
         mk_mesh_info m;
-        mk_mesh_get(a, i, &m);
-        json_object(&w, NULL);
-        pb_json_mesh_identity(&w, a, i);
+        pb_json_mesh_begin(&w, a, i, &m);
         json_int(&w, "triangles", m.triangle_count);
         json_bool(&w, "normals", m.has_normals);
         json_bool(&w, "tangents", m.has_tangents);

@@ -20,7 +20,7 @@
 #include "check.h"
 #include "fixtures.h"
 #include "import.h"
-#include "mat4.h"
+#include "primitives.h"
 
 #define MAX_SEED (1u << 20)
 #define SMALL_SEED (64u << 10)     /* float and sequential variants only up to this size */
@@ -116,34 +116,7 @@ static int fixtures(const char *dir)
  * samples/make_example's, coarser). */
 static void make_tube(mk_raw_asset *raw)
 {
-    enum { SEGMENTS = 12, RINGS = 10, N = SEGMENTS * (RINGS + 1) };
-    mk_raw_mesh *m = mk_raw_add_meshes(raw, 1);
-    m->name = mk_arena_strdup(&raw->arena, "tube");
-    m->vertex_count = N;
-    m->positions = mk_arena_array(&raw->arena, 3 * N, sizeof(float));
-    m->normals = mk_arena_array(&raw->arena, 3 * N, sizeof(float));
-    m->triangles = mk_arena_array(&raw->arena, 6 * SEGMENTS * RINGS, sizeof(uint32_t));
-    if (!m->name || !m->positions || !m->normals || !m->triangles) { fprintf(stderr, "make_seeds: out of memory\n"); exit(1); }
-    for (uint32_t r = 0; r <= RINGS; r++)
-        for (uint32_t s = 0; s < SEGMENTS; s++) {
-            uint32_t v = r * SEGMENTS + s;
-            float a = 6.2831853f * (float)s / SEGMENTS;
-            m->positions[3 * v] = 0.5f * cosf(a);
-            m->positions[3 * v + 1] = 2.0f * (float)r / RINGS;
-            m->positions[3 * v + 2] = 0.5f * sinf(a);
-            m->normals[3 * v] = cosf(a);
-            m->normals[3 * v + 2] = sinf(a);
-        }
-    for (uint32_t r = 0, t = 0; r < RINGS; r++)
-        for (uint32_t s = 0; s < SEGMENTS; s++, t++) {
-            uint32_t a = r * SEGMENTS + s, b = r * SEGMENTS + (s + 1) % SEGMENTS, c = a + SEGMENTS, d = b + SEGMENTS;
-            uint32_t *tri = &m->triangles[6 * t];
-            tri[0] = a; tri[1] = c; tri[2] = b; tri[3] = b; tri[4] = c; tri[5] = d;
-        }
-    m->triangle_count = 2 * SEGMENTS * RINGS;
-    mk_mat4_identity(m->world);
-    m->gltf_node = m->gltf_mesh = m->gltf_primitive = -1;
-    m->stacking = MK_STACKING_ADDITIVE;
+    if (!mk_raw_add_tube(raw, "tube", 12, 10)) { fprintf(stderr, "make_seeds: out of memory\n"); exit(1); }
 }
 
 static const char *source_root(void)

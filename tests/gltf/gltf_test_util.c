@@ -122,3 +122,10 @@ char *gt_base64(const unsigned char *in, size_t n)
     out[o] = 0;
     return out;
 }
+
+mk_result gt_import_text(const char *json, const mk_import_options *options, mk_raw_asset *raw, mk_error *err)
+{
+    mk_raw_init(raw, NULL);
+    memset(err, 0, sizeof *err);
+    return mk_import_gltf(json, strlen(json), options, raw, err);
+}

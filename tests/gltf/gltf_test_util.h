@@ -37,6 +37,10 @@ void gt_to_world(const gt_model *m, uint32_t mesh, const float *local, uint32_t 
 void gt_check_case(const pb_manifest *manifest, const pb_case *c, gt_model *loaded, double *worst_pos,
                    double *worst_normal_deg, int *frames_done);
 
+/* Imports glTF JSON text (options may be NULL) into a freshly initialized raw, err cleared
+ * first. */
+mk_result gt_import_text(const char *json, const mk_import_options *options, mk_raw_asset *raw, mk_error *err);
+
 /* n bytes as base64 (for data: URIs), malloc'ed; NULL when out of memory. */
 char *gt_base64(const unsigned char *in, size_t n);
 

@@ -487,10 +487,8 @@ static void test_import_quantized_sparse(void)
         "\"indices\":{\"bufferView\":1,\"componentType\":5121},\"values\":{\"bufferView\":1,\"byteOffset\":4}}}]";
     char *json = gltf_text(bin, sizeof bin, rest);
     mk_raw_asset raw;
-    mk_raw_init(&raw, NULL);
     mk_error err;
-    memset(&err, 0, sizeof err);
-    mk_result r = mk_import_gltf(json, strlen(json), NULL, &raw, &err);
+    mk_result r = gt_import_text(json, NULL, &raw, &err);
     free(json);
     CHECK_MSG(r == MK_OK, "%s", err.message);
     if (r == MK_OK && raw.mesh_count == 1 && raw.channel_count == 1) {

@@ -95,9 +95,7 @@ static char *edit(char *json, const char *from, const char *to)
 
 static mk_result import_text(const char *json, mk_raw_asset *raw, mk_error *err)
 {
-    mk_raw_init(raw, NULL);
-    memset(err, 0, sizeof *err);
-    return mk_import_gltf(json, strlen(json), NULL, raw, err);
+    return gt_import_text(json, NULL, raw, err);
 }
 
 /* Imports json, expects `code` and a message containing `needle`; frees json. */
@@ -447,10 +445,8 @@ static void test_structure_errors(void)
 /* The channel sidecar: a valid one groups targets; broken ones fail naming the JSON path. */
 static mk_result import_with_sidecar(const char *json, const char *sidecar, mk_raw_asset *raw, mk_error *err)
 {
-    mk_raw_init(raw, NULL);
-    memset(err, 0, sizeof *err);
     mk_import_options o = { .channels_sidecar_text = sidecar, .channels_sidecar_size = strlen(sidecar) };
-    return mk_import_gltf(json, strlen(json), &o, raw, err);
+    return gt_import_text(json, &o, raw, err);
 }
 
 static void test_sidecar(void)

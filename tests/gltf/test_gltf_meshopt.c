@@ -193,10 +193,8 @@ static void test_import_filtered_normals(void)
             48 + clen, b64, clen);
     free(b64);
     mk_raw_asset raw;
-    mk_raw_init(&raw, NULL);
     mk_error err;
-    memset(&err, 0, sizeof err);
-    mk_result r = mk_import_gltf(json, strlen(json), NULL, &raw, &err);
+    mk_result r = gt_import_text(json, NULL, &raw, &err);
     free(json);
     CHECK_MSG(r == MK_OK, "%s", err.message);
     if (r == MK_OK && raw.mesh_count == 1 && raw.meshes[0].normals && raw.meshes[0].vertex_count == 3) {
