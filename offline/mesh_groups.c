@@ -72,11 +72,6 @@ static int build_csr(mk_arena *arena, const uint32_t *key, uint32_t items, uint3
     return 1;
 }
 
-static int same_normal(const float *a, const float *b)
-{
-    return fabsf(a[0] - b[0]) <= 1e-5f && fabsf(a[1] - b[1]) <= 1e-5f && fabsf(a[2] - b[2]) <= 1e-5f;
-}
-
 mk_result mk_normal_groups_build(const mk_raw_mesh *m, mk_grouping grouping, mk_arena *arena, mk_normal_groups *g,
                                  mk_error *err)
 {
@@ -93,26 +88,10 @@ mk_result mk_normal_groups_build(const mk_raw_mesh *m, mk_grouping grouping, mk_
         if (!welded) return mk_error_oom(err, "smoothing groups");
         key = welded;
     }
-    uint32_t *key_first, *key_verts;
-    if (!build_csr(arena, key, n, key_count, &key_first, &key_verts)) return mk_error_oom(err, "smoothing groups");
-    for (uint32_t k = 0; k < key_count; k++) {
-        uint32_t start = g->group_count;
-        for (uint32_t i = key_first[k]; i < key_first[k + 1]; i++) {
-            uint32_t v = key_verts[i], found = UINT32_MAX;
-            if (m->normals) {
-                for (uint32_t j = key_first[k]; j < i; j++)
-                    if (same_normal(&m->normals[3u * key_verts[j]], &m->normals[3u * v])) {
-                        found = g->group_of[key_verts[j]];
-                        break;
-                    }
-            } else if (i > key_first[k]) {
-                found = start;
-            }
-            g->group_of[v] = found != UINT32_MAX ? found : g->group_count++;
-        }
-    }
-    mk_arena_release(arena, key_first);
-    mk_arena_release(arena, key_verts);
+    void *scratch = mk_arena_alloc(arena, mk_smoothing_groups_scratch_size(key_count, n));
+    if (!scratch) return mk_error_oom(err, "smoothing groups");
+    g->group_count = mk_smoothing_groups(key, key_count, m->normals, n, g->group_of, scratch);
+    mk_arena_release(arena, scratch);
     if (welded) mk_arena_release(arena, welded);
     if (!build_csr(arena, g->group_of, n, g->group_count, &g->group_vert_first, &g->group_verts))
         return mk_error_oom(err, "smoothing groups");

@@ -7,7 +7,8 @@
  * or the same base position bit for bit) and the same base normal (within 1e-5 per
  * component): vertices split only for UVs share a normal, vertices split for a hard edge keep
  * theirs. A group's normal is the normalized sum of the area-weighted face normals (cross
- * products) of the triangles around it. */
+ * products) of the triangles around it. The grouping itself is the runtime's
+ * mk_smoothing_groups, so surface normals at run time group exactly as the importer does. */
 #ifndef MK_MESH_GROUPS_H
 #define MK_MESH_GROUPS_H
 

@@ -45,7 +45,7 @@ static layout topology_layout(const mk_blob_mesh *m)
     if (!(m->flags & MK_MESH_HAS_NORMALS) || m->triangle_count == 0 || m->vertex_count == 0) return l;
     size_t v = m->vertex_count, t = m->triangle_count, c = m->control_point_count;
     if (v > SIZE_MAX / 64 || t > SIZE_MAX / 64 || c > SIZE_MAX / 64) return l;
-    size_t scratch = 4 * (2 * c + v + 1);
+    size_t scratch = mk_smoothing_groups_scratch_size((uint32_t)c, (uint32_t)v);
     size_t rest = 12 * v > scratch ? 12 * v : scratch;
     l.group_of = align16(sizeof(topology_header));
     l.group_tri_first = l.group_of + align16(4 * v);
@@ -65,6 +65,33 @@ size_t mk_surface_topology_size(const mk_asset *asset, uint32_t mesh)
 static int same_normal(const float *a, const float *b)
 {
     return fabsf(a[0] - b[0]) <= 1e-5f && fabsf(a[1] - b[1]) <= 1e-5f && fabsf(a[2] - b[2]) <= 1e-5f;
+}
+
+size_t mk_smoothing_groups_scratch_size(uint32_t key_count, uint32_t vertex_count)
+{
+    return 4 * (2 * (size_t)key_count + vertex_count + 1);
+}
+
+uint32_t mk_smoothing_groups(const uint32_t *keys, uint32_t key_count, const float *normals, uint32_t vertex_count,
+                             uint32_t *group_of, void *scratch)
+{
+    /* Key -> its vertices (CSR, vertex order), then per key: a vertex joins the first earlier
+     * vertex with its normal (without normals, the key's first vertex). */
+    uint32_t *key_first = scratch, *key_verts = key_first + key_count + 1, *fill = key_verts + vertex_count;
+    memset(key_first, 0, 4 * ((size_t)key_count + 1));
+    for (uint32_t v = 0; v < vertex_count; v++) key_first[keys[v] + 1]++;
+    for (uint32_t k = 0; k < key_count; k++) key_first[k + 1] += key_first[k];
+    memcpy(fill, key_first, 4 * (size_t)key_count);
+    for (uint32_t v = 0; v < vertex_count; v++) key_verts[fill[keys[v]]++] = v;
+    uint32_t groups = 0;
+    for (uint32_t k = 0; k < key_count; k++)
+        for (uint32_t i = key_first[k]; i < key_first[k + 1]; i++) {
+            uint32_t v = key_verts[i], found = UINT32_MAX;
+            for (uint32_t j = key_first[k]; j < i && found == UINT32_MAX; j++)
+                if (!normals || same_normal(&normals[3u * key_verts[j]], &normals[3u * v])) found = group_of[key_verts[j]];
+            group_of[v] = found != UINT32_MAX ? found : groups++;
+        }
+    return groups;
 }
 
 /* Area-weighted face normal (cross product) of triangle tri at positions p (stride bytes). */
@@ -113,22 +140,9 @@ mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *
     uint32_t *tri_first = (uint32_t *)(void *)(base + l.group_tri_first);
     uint32_t *group_tris = (uint32_t *)(void *)(base + l.group_tris);
     uint32_t *tri_groups = (uint32_t *)(void *)(base + l.tri_groups);
-    /* Scratch in the rest-normal region: control point -> its vertices (CSR), a fill cursor. */
-    uint32_t *cp_first = (uint32_t *)(void *)(base + l.rest), *cp_verts = cp_first + cps + 1, *fill = cp_verts + n;
-    memset(cp_first, 0, 4 * ((size_t)cps + 1));
-    for (uint32_t v = 0; v < n; v++) cp_first[cp[v] + 1]++;
-    for (uint32_t k = 0; k < cps; k++) cp_first[k + 1] += cp_first[k];
-    memcpy(fill, cp_first, 4 * (size_t)cps);
-    for (uint32_t v = 0; v < n; v++) cp_verts[fill[cp[v]]++] = v;
-    /* Groups: per control point, a vertex joins the first earlier vertex with its normal. */
-    uint32_t groups = 0;
-    for (uint32_t k = 0; k < cps; k++)
-        for (uint32_t i = cp_first[k]; i < cp_first[k + 1]; i++) {
-            uint32_t v = cp_verts[i], found = UINT32_MAX;
-            for (uint32_t j = cp_first[k]; j < i && found == UINT32_MAX; j++)
-                if (same_normal(&normals[3u * cp_verts[j]], &normals[3u * v])) found = group_of[cp_verts[j]];
-            group_of[v] = found != UINT32_MAX ? found : groups++;
-        }
+    /* The groups, with the rest-normal region as scratch; then a fill cursor there. */
+    uint32_t *fill = (uint32_t *)(void *)(base + l.rest);
+    uint32_t groups = mk_smoothing_groups(cp, cps, normals, n, group_of, fill);
     /* Group -> triangles: each triangle once per distinct corner group, in triangle order. */
     memset(tri_first, 0, 4 * ((size_t)groups + 1));
     for (uint32_t t = 0; t < tri_count; t++) {

@@ -273,6 +273,16 @@ uint64_t mk_eval_traffic(const mk_eval_job *job);
  * mk_surface_topology_build, and read-only afterwards (share it between threads). Every
  * vertex's result is the same whichever range computes it. */
 
+/* Smoothing groups by the rule above, for any vertex data (the offline tools group target
+ * normals and deformed surfaces with it): vertices with the same key (keys[v] < key_count, e.g.
+ * the control point) and the same normal within 1e-5 per component (normals NULL: the same key
+ * is enough) share a group. Groups are numbered in key order, then vertex order; returns the
+ * count and fills group_of (one per vertex). scratch: mk_smoothing_groups_scratch_size bytes,
+ * 4-byte aligned. Allocates nothing. */
+size_t mk_smoothing_groups_scratch_size(uint32_t key_count, uint32_t vertex_count);
+uint32_t mk_smoothing_groups(const uint32_t *keys, uint32_t key_count, const float *normals, uint32_t vertex_count,
+                             uint32_t *group_of, void *scratch);
+
 /* Bytes of a mesh's surface topology; 0 when the mesh has no normals or no triangles (or the
  * mesh index is invalid). */
 size_t mk_surface_topology_size(const mk_asset *asset, uint32_t mesh);
