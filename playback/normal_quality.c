@@ -101,6 +101,15 @@ static mk_result prepare_mesh(pb_quality_mesh *qm, const mk_asset *asset, const 
 mk_result pb_normal_quality_add(pb_normal_quality *q, const mk_asset *asset, const mk_raw_asset *raw,
                                 const float *weights, mk_stacking stacking, mk_error *err)
 {
+    if ((!raw || raw->mesh_count == 0) && asset->mesh_count > 0) {
+        if (!q->read_back) {
+            if (!(q->read_back = malloc(sizeof *q->read_back))) return mk_error_oom(err, "normal quality");
+            mk_raw_init(q->read_back, NULL);
+            mk_result r = mk_read_blob(asset, q->read_back, err);
+            if (r != MK_OK) return r;
+        }
+        raw = q->read_back;
+    }
     if (raw->mesh_count != asset->mesh_count || (q->meshes && q->mesh_count != asset->mesh_count))
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
                             "normal quality: the raw model has %u meshes, the asset %u", raw->mesh_count,
@@ -152,6 +161,18 @@ static int compare_double(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+const char *pb_quality_name(int mode)
+{
+    static const char *const names[PB_QUALITY_MODES] = { "nlerp", "slerp", "surface", "base" };
+    return mode >= 0 && mode < PB_QUALITY_MODES ? names[mode] : "";
+}
+
+const char *pb_quality_label(int mode)
+{
+    static const char *const labels[PB_QUALITY_MODES] = { "nlerp", "slerp", "surface", "base normals kept" };
+    return mode >= 0 && mode < PB_QUALITY_MODES ? labels[mode] : "";
+}
+
 pb_normal_stats pb_normal_quality_stats(const pb_normal_quality *q, int mode)
 {
     pb_normal_stats s = { q->count, 0, 0, 0 };
@@ -177,5 +198,7 @@ void pb_normal_quality_free(pb_normal_quality *q)
         if (q->meshes[mi].ready) mk_arena_free_all(&q->meshes[mi].arena);
     }
     free(q->meshes);
+    if (q->read_back) mk_raw_free(q->read_back);
+    free(q->read_back);
     memset(q, 0, sizeof *q);
 }

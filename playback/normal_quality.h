@@ -29,6 +29,7 @@ typedef struct pb_normal_quality {
     uint32_t frames;
     struct pb_quality_mesh *meshes;    /* per asset mesh, built on the first call */
     uint32_t mesh_count;
+    mk_raw_asset *read_back;           /* the blob's meshes, when the caller has no raw model */
 } pb_normal_quality;
 
 typedef struct pb_normal_stats {
@@ -37,10 +38,15 @@ typedef struct pb_normal_stats {
 } pb_normal_stats;
 
 /* Adds the moved vertices of every mesh with normals and triangles of `asset` (opened from
- * `raw`, which holds its meshes in the same order: an import, or mk_read_blob of the blob)
- * for asset-wide `weights`, evaluated with `stacking` (0 = the blob's). */
+ * `raw`, which holds its meshes in the same order; NULL or a raw model without meshes, as for a
+ * .morph input: the blob's meshes are read back once) for asset-wide `weights`, evaluated
+ * with `stacking` (0 = the blob's). */
 mk_result pb_normal_quality_add(pb_normal_quality *q, const mk_asset *asset, const mk_raw_asset *raw,
                                 const float *weights, mk_stacking stacking, mk_error *err);
+
+/* A mode's name in JSON keys ("nlerp", "slerp", "surface", "base") and its label in text. */
+const char *pb_quality_name(int mode);
+const char *pb_quality_label(int mode);
 
 /* Mean, 99th percentile and largest angle of one mode (zeros when nothing was measured). */
 pb_normal_stats pb_normal_quality_stats(const pb_normal_quality *q, int mode);

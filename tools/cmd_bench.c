@@ -88,32 +88,22 @@ const cli_verb cli_verb_bench = {
     .run = run_bench,
 };
 
-static const char *const quality_names[PB_QUALITY_MODES] = { "nlerp", "slerp", "surface", "base" };
-static const char *const quality_labels[PB_QUALITY_MODES] = { "nlerp", "slerp", "surface", "base normals kept" };
 
 /* Normal quality (playback/normal_quality.h) over up to 20 of the frames, evenly spread. */
 static mk_result measure_normals(const pb_asset *l, const float *weights, uint32_t frames,
                                  pb_normal_stats out[PB_QUALITY_MODES], mk_error *err)
 {
     const mk_asset *a = &l->asset;
-    mk_raw_asset read;
-    mk_raw_init(&read, NULL);
-    const mk_raw_asset *raw = &l->raw;
     mk_result r = MK_OK;
-    if (l->raw.mesh_count == 0) {  /* a .morph input: its meshes read back */
-        r = mk_read_blob(a, &read, err);
-        raw = &read;
-    }
     pb_normal_quality q;
     memset(&q, 0, sizeof q);
     uint32_t measured = frames < 20 ? frames : 20;
     for (uint32_t k = 0; k < measured && r == MK_OK; k++) {
         uint32_t f = measured > 1 ? (uint32_t)((uint64_t)k * (frames - 1) / (measured - 1)) : 0;
-        r = pb_normal_quality_add(&q, a, raw, weights + (size_t)f * a->channel_count, MK_STACKING_ASSET, err);
+        r = pb_normal_quality_add(&q, a, &l->raw, weights + (size_t)f * a->channel_count, MK_STACKING_ASSET, err);
     }
     for (int m = 0; m < PB_QUALITY_MODES; m++) out[m] = pb_normal_quality_stats(&q, m);
     pb_normal_quality_free(&q);
-    mk_raw_free(&read);
     return r;
 }
 
@@ -270,7 +260,7 @@ static int run_bench(void *p)
             printf(", \"normals_measured\": %zu", quality[0].count);
             for (int k = 0; k < PB_QUALITY_MODES; k++)
                 printf(", \"normals_%s_mean_deg\": %.4f, \"normals_%s_p99_deg\": %.4f, \"normals_%s_max_deg\": %.4f",
-                       quality_names[k], quality[k].mean, quality_names[k], quality[k].p99, quality_names[k], quality[k].max);
+                       pb_quality_name(k), quality[k].mean, pb_quality_name(k), quality[k].p99, pb_quality_name(k), quality[k].max);
         }
         if (ns_surface > 0)
             printf(", \"ns_per_frame_surface\": %.0f, \"surface_over_nlerp\": %.3f", ns_surface,
@@ -303,7 +293,7 @@ static int run_bench(void *p)
             printf("normal error vs the evaluated surface (degrees over %zu moved vertex-frames: mean / p99 / max):\n",
                    quality[0].count);
             for (int k = 0; k < PB_QUALITY_MODES; k++)
-                printf("  %-22s %9.4f / %9.4f / %9.4f\n", quality_labels[k], quality[k].mean, quality[k].p99, quality[k].max);
+                printf("  %-22s %9.4f / %9.4f / %9.4f\n", pb_quality_label(k), quality[k].mean, quality[k].p99, quality[k].max);
         }
         if (ns_one > 0) {
             printf("thread_scaling           %12.2f  (1 thread %.0f ns, %u threads %.0f ns; passes alternating)\n",

@@ -9,10 +9,11 @@
 #include "conform.h"
 #include "conform_report.h"
 #include "json_write.h"
+#include "normal_quality.h"
 
 typedef struct conform_args {
     const char *manifest, *filter, *report;
-    int precision, stacking, stacking_given, normals, normals_given, json;
+    int precision, stacking, stacking_given, normals, normals_given, json, normal_quality;
     double normal_tolerance, weight_tolerance;
 } conform_args;
 
@@ -42,6 +43,11 @@ static const cli_option options[] = {
       "Also write DIR/index.html (created if absent): a static page with every case and frame (pass/fail, error, "
       "where) and one picture per compared frame, frame_NNNN.png: the played frame beside the reference and the "
       "error heat map, failing frames first.",
+      NULL, NULL, 0, 0, 0, 0 },
+    { "--normal-quality", NULL, CLI_FLAG, offsetof(conform_args, normal_quality),
+      "Also measure, per case over its frames, how far each normal mode (nlerp, slerp, surface, base normals kept) "
+      "is from the normals of the evaluated surface: mean, 99th percentile and largest angle over the moved vertices "
+      "(docs/semantics.md, Normal quality).",
       NULL, NULL, 0, 0, 0, 0 },
     { "--json", NULL, CLI_FLAG, offsetof(conform_args, json),
       "Print one JSON object: every frame's errors and allowances, and the counts.", NULL, NULL, 0, 0, 0, 0 },
@@ -121,6 +127,69 @@ static void json_frame(json_writer *w, const pb_case *c, const pb_frame_spec *f,
     json_end_object(w);
 }
 
+/* One case's normal quality (--normal-quality), kept for the JSON written after the frames. */
+typedef struct case_quality {
+    const char *name;
+    pb_normal_stats stats[PB_QUALITY_MODES];
+    char failure[256];
+} case_quality;
+
+/* Every frame of case c played on a through the normal-quality measure. */
+static void measure_case(const pb_case *c, const pb_asset *a, mk_stacking stacking, case_quality *out)
+{
+    memset(out, 0, sizeof *out);
+    out->name = c->name;
+    pb_normal_quality q;
+    memset(&q, 0, sizeof q);
+    float *weights = malloc(((size_t)a->asset.channel_count + 1) * sizeof(float));
+    mk_error err;
+    mk_result r = weights ? MK_OK : mk_error_oom(&err, "normal quality");
+    for (uint32_t k = 0; k < c->frame_count && r == MK_OK; k++) {
+        r = pb_conform_weights(c, &c->frames[k], &a->asset, weights, &err);
+        if (r == MK_OK) r = pb_normal_quality_add(&q, &a->asset, &a->raw, weights, stacking, &err);
+    }
+    if (r != MK_OK) snprintf(out->failure, sizeof out->failure, "%.200s", err.message);
+    for (int m = 0; m < PB_QUALITY_MODES && r == MK_OK; m++) out->stats[m] = pb_normal_quality_stats(&q, m);
+    pb_normal_quality_free(&q);
+    free(weights);
+}
+
+static void print_quality(const case_quality *q)
+{
+    if (q->failure[0]) {
+        printf("%s: normal quality not measured: %s\n", q->name, q->failure);
+        return;
+    }
+    if (!q->stats[0].count) {
+        printf("%s: normal quality: no moved vertex with normals and triangles in its frames\n", q->name);
+        return;
+    }
+    printf("%s: normal quality over %zu moved vertex-frames (degrees, mean / p99 / max):", q->name, q->stats[0].count);
+    for (int m = 0; m < PB_QUALITY_MODES; m++)
+        printf("%s %s %.4g / %.4g / %.4g", m ? "," : "", pb_quality_label(m), q->stats[m].mean, q->stats[m].p99,
+               q->stats[m].max);
+    printf("\n");
+}
+
+static void json_quality(json_writer *w, const case_quality *q)
+{
+    json_object(w, NULL);
+    json_string(w, "case", q->name);
+    if (q->failure[0]) {
+        json_string(w, "failure", q->failure);
+    } else {
+        json_int(w, "measured", (long long)q->stats[0].count);
+        for (int m = 0; m < PB_QUALITY_MODES; m++) {
+            json_object(w, pb_quality_name(m));
+            json_number(w, "mean_deg", q->stats[m].mean);
+            json_number(w, "p99_deg", q->stats[m].p99);
+            json_number(w, "max_deg", q->stats[m].max);
+            json_end_object(w);
+        }
+    }
+    json_end_object(w);
+}
+
 static int run_conform(void *p)
 {
     conform_args *args = p;
@@ -178,6 +247,14 @@ static int run_conform(void *p)
         json_array(&w, "frames");
     }
     int passed = 0, failed = 0;
+    case_quality *quality = NULL;
+    uint32_t quality_count = 0;
+    if (args->normal_quality && !(quality = calloc(manifest.case_count, sizeof *quality))) {
+        fprintf(stderr, "morphkit conform: out of memory\n");
+        pb_manifest_free(&manifest);
+        cli_report_free(report);
+        return CLI_EXIT_FAILURE;
+    }
     for (uint32_t i = 0; i < manifest.case_count; i++) {
         const pb_case *c = &manifest.cases[i];
         if (!case_matches(c, args->filter)) continue;
@@ -204,10 +281,20 @@ static int run_conform(void *p)
             else
                 failed++;
         }
+        if (quality && r == MK_OK) {
+            case_quality *q = &quality[quality_count++];
+            measure_case(c, &asset, opt.stacking, q);
+            if (!args->json) print_quality(q);
+        }
         pb_asset_free(&asset);
     }
     if (args->json) {
         json_end_array(&w);
+        if (quality) {
+            json_array(&w, "normal_quality");
+            for (uint32_t k = 0; k < quality_count; k++) json_quality(&w, &quality[k]);
+            json_end_array(&w);
+        }
         json_int(&w, "passed", passed);
         json_int(&w, "failed", failed);
         json_end_object(&w);
@@ -215,6 +302,7 @@ static int run_conform(void *p)
     } else {
         printf("%d passed, %d failed\n", passed, failed);
     }
+    free(quality);
     pb_manifest_free(&manifest);
     if (report && report_status >= 0) {
         cli_report_free(report);

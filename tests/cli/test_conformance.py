@@ -154,6 +154,21 @@ check("a copy with one vertex moved by 1e-3 fails both tolerances", rc == 1 and 
 rc, o, e = run(mk, "conform", manifest("largest", "large_ref.json", 0, 1e-6), "--precision", "float")
 check("relative_to defaults to the diagonal; relative_tolerance alone is a valid case", rc == 0, o + e)
 
+# ---- normal quality of the example's golden frames (bulge and bend combined) ----
+golden_example = os.path.join(work, "golden_0", "manifest.json")
+rc, o, e = run(mk, "conform", golden_example, "--normal-quality", "--json")
+d = json.loads(o) if o.strip().startswith("{") else {}
+q = (d.get("normal_quality") or [{}])[0]
+print("example normal quality:", json.dumps(q))
+check("conform --normal-quality measures every mode over the moved vertices of the frames",
+      rc == 0 and q.get("measured", 0) > 0 and all(m in q for m in ("nlerp", "slerp", "surface", "base")), o + e)
+check("surface normals meet the evaluated surface (max < 1e-3 deg); nlerp does not where shapes combine",
+      q.get("surface", {}).get("max_deg", 1) < 1e-3 and q.get("nlerp", {}).get("mean_deg", 0) > 0.1
+      and q.get("base", {}).get("mean_deg", 0) > q.get("nlerp", {}).get("mean_deg", 1), json.dumps(q))
+rc, o, e = run(mk, "conform", golden_example, "--normal-quality")
+check("conform --normal-quality prints one line per case",
+      rc == 0 and o.count("normal quality over") == len(d.get("normal_quality", [])) > 0, o + e)
+
 # ---- manifests are checked ----
 bad_manifest = os.path.join(work, "bad.json")
 json.dump({"version": 1, "cases": [{"name": "x", "source": "large.gltf", "format": "gltf",
