@@ -181,10 +181,10 @@ static double outside_by(const double q[3])
     return fmax(fmax(-q[0], -q[1]), fmax(fmax(q[0] + q[1] - 1, -q[2]), q[2] - 1));
 }
 
-/* Newton in wedge w from the affine map through its corner points; returns the residual, or 0
- * with q from the affine map alone when that puts p further than 1/2 outside the block. */
+/* Newton in wedge w from the affine map through its corner points. Returns the residual |F(q) - p|,
+ * or 0 with q from the corner map alone (*far set) when that puts p more than 1/2 outside. */
 static double locate_in_wedge(const mk_prism_lattice *c, uint32_t w, const double p[3], double target, double q[3],
-                              uint32_t *iterations)
+                              uint32_t *iterations, int *far)
 {
     double o0[3], a[3], b[3], o1[3], J[9], rel[3];
     wedge_map map = { c, w };
@@ -202,7 +202,8 @@ static double locate_in_wedge(const mk_prism_lattice *c, uint32_t w, const doubl
     vec3_sub(rel, p, o0);
     if (!bake_solve3(J, rel, q)) { q[0] = q[1] = 1.0 / 3; q[2] = 0.5; }
     *iterations = 0;
-    if (outside_by(q) > 0.5) return 0;
+    *far = outside_by(q) > 0.5;
+    if (*far) return 0;
     bake_newton newton = { rest_map, &map, { -0.5, -0.5, -0.5 }, { 1.5, 1.5, 1.5 }, -1, target, 50 };
     return bake_newton_solve(&newton, p, q, iterations);
 }
@@ -215,34 +216,39 @@ mk_result mk_prism_coordinates(const mk_prism_lattice *c, const double p[3], dou
     double angle = atan2(vec3_dot(rel, c->frame[1]), vec3_dot(rel, c->frame[0]));
     if (angle < 0) angle += 2 * PI;
     uint32_t first = (uint32_t)floor(angle / (2 * PI) * c->sides) % c->sides;
-    double best_q[3] = { 0, 0, 0 }, best_out = INFINITY, best_res = INFINITY;
-    uint32_t best_w = first, best_it = 0, converged = 0;
+    /* The wedge that owns p, else the located wedge p is least outside of, and the wedge where
+     * Newton failed with the smallest residual. */
+    double best_q[3] = { 0, 0, 0 }, best_out = INFINITY, failed_res = INFINITY;
+    uint32_t best_w = first, best_it = 0, failed_w = UINT32_MAX;
     for (uint32_t tried = 0; tried < c->sides; tried++) {
         /* first, first + 1, first - 1, first + 2, ... */
         uint32_t step = (tried + 1) / 2, w = tried % 2 ? (first + step) % c->sides : (first + c->sides - step) % c->sides;
         double q[3];
         uint32_t it = 0;
-        double res = locate_in_wedge(c, w, p, target, q, &it);
-        int ok = res <= target;
-        converged += (uint32_t)ok;
-        double out = ok ? outside_by(q) : INFINITY;
-        if (ok ? out < best_out : !converged && res < best_res) {
-            best_out = out; best_res = res; best_w = w; best_it = it;
+        int far = 0;
+        double res = locate_in_wedge(c, w, p, target, q, &it, &far);
+        if (!(res <= target)) {
+            if (res < failed_res || failed_w == UINT32_MAX) { failed_res = res; failed_w = w; }
+            continue;
+        }
+        double out = outside_by(q);
+        if (out < best_out) {
+            best_out = out; best_w = w; best_it = it;
             memcpy(best_q, q, sizeof q);
         }
-        if (ok && out <= 1e-9) break;
+        if (out <= 1e-9) break;
     }
     coords[0] = best_w;
     memcpy(coords + 1, best_q, sizeof best_q);
     if (iterations) *iterations = best_it;
-    if (!converged)
+    if (best_out <= 1e-9) return MK_OK;
+    if (failed_w != UINT32_MAX)
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
-                            "Newton did not converge in any wedge (residual %.3g of the lattice size)", best_res / size);
-    if (best_out > 1e-9)
-        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
-                            "outside the lattice (nearest wedge %u: barycentric (%.4g, %.4g, %.4g), u = %.4g; all must be in [0, 1])",
-                            best_w, 1 - best_q[0] - best_q[1], best_q[0], best_q[1], best_q[2]);
-    return MK_OK;
+                            "in no wedge: Newton did not converge in wedge %u (residual %.3g of the lattice size; "
+                            "the rest lattice may fold there)", failed_w, failed_res / size);
+    return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
+                        "outside the lattice (nearest wedge %u: barycentric (%.4g, %.4g, %.4g), u = %.4g; all must be in [0, 1])",
+                        best_w, 1 - best_q[0] - best_q[1], best_q[0], best_q[1], best_q[2]);
 }
 
 void mk_prism_eval(const mk_prism_lattice *c, double amplitude, const double coords[4], const double p[3], double out[3])

@@ -1376,6 +1376,55 @@ static void prism_lattice_inverts_moves_affinely_and_is_seamless(void)
     mk_raw_free(&raw);
 }
 
+/* One linear target of the affine map M p + t, played at weight w: p + w (M p + t - p). */
+typedef struct affine_map { double M[9], t[3]; } affine_map;
+
+static void affine_blend(const void *user, double w, const double p[3], double q[3], double J[9])
+{
+    const affine_map *a = user;
+    double m[3];
+    mat3_mul_vec(m, a->M, p);
+    for (int c = 0; c < 3; c++) q[c] = p[c] + w * (m[c] + a->t[c] - p[c]);
+    memcpy(J, a->M, sizeof a->M);
+}
+
+static void ffd_prism_recipe_moved_rigidly_or_affinely_plays_that_map(void)
+{
+    /* Every control point turned 40 degrees about x through (0, 0, 2) and moved by (0.3, 0, -0.2)
+     * (turn_blend), or scaled by (1.2, 0.8, 1.1) about the origin, turned 25 degrees about z and
+     * moved by (0.1, 0.2, 0.3): through the runtime, the tube at every weight is the tube blended
+     * towards that map. */
+    const char *recipes[2] = {
+        "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"turn\", \"op\": \"ffd_prism\", \"axis\": \"z\","
+        " \"center\": [0, 0, 2], \"sides\": 5, \"degree\": 2, \"layers\": 3, \"moves\": [{\"translate\": [0.3, 0, -0.2],"
+        " \"rotate\": {\"axis\": [1, 0, 0], \"degrees\": 40, \"pivot\": [0, 0, 2]}}]}]}",
+        "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"shear\", \"op\": \"ffd_prism\", \"axis\": \"z\","
+        " \"sides\": 7, \"degree\": 3, \"moves\": [{\"scale\": [1.2, 0.8, 1.1], \"pivot\": [0, 0, 0], \"translate\": [0.1, 0.2, 0.3],"
+        " \"rotate\": {\"axis\": [0, 0, 1], \"degrees\": 25, \"pivot\": [0, 0, 0]}}]}]}" };
+    affine_map shear = { .t = { 0.1, 0.2, 0.3 } };
+    double R[9], S[9] = { 1.2, 0, 0, 0, 0.8, 0, 0, 0, 1.1 }, z[3] = { 0, 0, 1 };
+    mat3_rotation(R, z, 25 * PI / 180);
+    mat3_mul(shear.M, R, S);
+    for (int k = 0; k < 2; k++) {
+        mk_raw_asset raw;
+        const mk_raw_mesh *m = baked_cylinder(&raw, "tube", 1, 4, 16, 8, recipes[k]);
+        if (!m) return;
+        CHECK_EQ_INT(raw.channels[0].target_count, 1);
+        mk_asset asset;
+        if (!write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
+        double worst = k ? playback_error(&asset, m, 0, 1, affine_blend, &shear) : playback_error(&asset, m, 0, 1, turn_blend, NULL);
+        fprintf(stderr, "ffd_prism %s lattice motion through the runtime: %.3g x diagonal\n", k ? "affine" : "rigid",
+                worst / diag_of(m));
+        CHECK_MSG(worst <= 1e-6 * diag_of(m) + 2e-6, "off the map by %g", worst);
+        mk_raw_free(&raw);
+    }
+}
+
+static void ffd_prism_locates_every_vertex_of_corpus_meshes(void)
+{
+    extended_ffd_turns_corpus_meshes("\"op\": \"ffd_prism\", \"sides\": 5, \"degree\": 3, \"layers\": 5");
+}
+
 static void fixed_inbetweens_and_linear_ops(void)
 {
     mk_raw_asset raw;
@@ -1465,6 +1514,38 @@ static void bad_arap_and_animated_ffd_recipes_name_the_field(void)
           "channels[0].reference: parallel" },
         { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"radius\": 1e999}]}",
           "channels[0].radius" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"axis\": \"z\", \"radius\": 0.5}]}",
+          "channels[0]: vertex 0 (1, 0, 0): outside the lattice" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"sides\": 2}]}",
+          "channels[0].sides: must be an integer in 3..64" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"sides\": \"six\"}]}",
+          "channels[0].sides" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"degree\": 0}]}",
+          "channels[0].degree: must be an integer in 1..16" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"degree\": 1.5}]}",
+          "channels[0].degree" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"layers\": 1}]}",
+          "channels[0].layers" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"dims\": [3, 6, 4]}]}",
+          "channels[0].dims: unknown field" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"radius\": 1e999}]}",
+          "channels[0].radius" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"radius\": -1}]}",
+          "channels[0].radius: must be > 0" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"center\": [0, 1e999, 0]}]}",
+          "channels[0].center" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"moves\": [{\"i\": 3}]}]}",
+          "channels[0].moves[0].i: must lie in 0..2" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"moves\": [{\"i\": [1, 2], \"j\": 6}]}]}",
+          "channels[0].moves[0].j: must lie in 0..5" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"moves\": [{\"j\": 1}]}]}",
+          "channels[0].moves[0].j: must lie in 0..0" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"moves\": [{\"k\": 4}]}]}",
+          "channels[0].moves[0].k" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"moves\": [{\"translate\": [0, 1e999, 0]}]}]}",
+          "channels[0].moves[0].translate" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"axis\": \"z\", \"reference\": [0, 0, 2]}]}",
+          "channels[0].reference: parallel" },
         { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\"}]}",
           "channels[0].travel: missing" },
         { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\"}]}",
@@ -1562,7 +1643,7 @@ static void record_channels(void *user, const mk_bake_channel_report *c)
 static void sample_recipes_bake(void)
 {
     static const char *const names[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json",
-                                         "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json" };
+                                         "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json", "ffd_prism.json" };
     const char *root = getenv("MORPHKIT_SOURCE_ROOT");
     if (!root) root = MK_SOURCE_ROOT;
     char dir[4096];
@@ -1714,6 +1795,8 @@ CHECK_MAIN(CASE(identity_deformations_give_zero_deltas),
            CASE(ffd_cylinder_recipe_moved_rigidly_plays_the_rigid_motion),
            CASE(ffd_cylinder_locates_every_vertex_of_corpus_meshes),
            CASE(prism_lattice_inverts_moves_affinely_and_is_seamless),
+           CASE(ffd_prism_recipe_moved_rigidly_or_affinely_plays_that_map),
+           CASE(ffd_prism_locates_every_vertex_of_corpus_meshes),
            CASE(bad_recipes_name_the_field),
            CASE(bad_arap_and_animated_ffd_recipes_name_the_field),
            CASE(bake_keeps_existing_channels))
