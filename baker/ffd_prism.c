@@ -9,7 +9,8 @@
  *   over a triangle, B^n_abc(l0, l1, l2) = n!/(a! b! c!) l0^a l1^b l2^c (a + b + c = n).
  *
  * Conventions fixed here:
- * - The cross-section is a regular polygon of `sides` corners around the centre, split into
+ * - The cross-section is a regular polygon of `sides` corners around the centre (or the
+ *   caller's polygon, star-shaped from the centre), split into
  *   `sides` triangles (centre, corner w, corner w + 1); extruded along the axis each is a wedge
  *   block. A block is the Bernstein triangle of degree n in (l1, l2) times the Bernstein
  *   polynomial of degree layers-1 in u. Its control point (a, b, c; k) is the lattice point on
@@ -20,10 +21,10 @@
  * - Displacement form, as ffd.c: X' = X + a sum w d. The weights sum to 1 and reproduce the
  *   rest map, so an unmoved lattice is the identity and moving every control point by one
  *   affine map moves X by that map. Linear in a: one target is exact.
- * - Point location: wedges are tried starting with the one the point's angle falls in, then
- *   outwards by angular distance; the first wedge where Newton converges with all three
+ * - Point location: wedges are tried starting with the one whose spokes enclose the point's
+ *   direction from the axis, then outwards by wedge index; the first wedge where Newton converges with all three
  *   barycentric coordinates and u in [-1e-9, 1 + 1e-9] owns the point (a point on a seam goes
- *   to the wedge its angle falls in). Newton starts from the inverse of the affine map through
+ *   to the wedge on whose first spoke it lies). Newton starts from the inverse of the affine map through
  *   the wedge's four corner points (exact for the regular lattice), clamps iterates into
  *   [-0.5, 1.5] and stops at 1e-10 of the lattice size or after 50 iterations. A wedge whose
  *   corner map puts the point more than 1/2 outside it is not searched (the point is outside).
@@ -50,7 +51,7 @@ mk_result mk_prism_prepare(mk_prism_lattice *c, mk_error *err)
     for (int k = 0; k < 3; k++)
         if (!isfinite(c->center[k]) || !isfinite(c->axis[k]) || !isfinite(c->reference[k]))
             return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX, "center/axis/reference: not finite");
-    if (!isfinite(c->radius) || !(c->radius > 0))
+    if (!c->section && (!isfinite(c->radius) || !(c->radius > 0)))
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "radius: must be > 0 (got %g)", c->radius);
     double *e1 = c->frame[0], *e2 = c->frame[1], *e3 = c->frame[2];
     memcpy(e3, c->axis, sizeof c->axis);
@@ -61,6 +62,26 @@ mk_result mk_prism_prepare(mk_prism_lattice *c, mk_error *err)
     if (!(vec3_normalize(e1) > 1e-9 * vec3_length(c->reference)))
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "reference: parallel to the axis");
     vec3_cross(e2, e3, e1);
+    c->size = fmax(c->height, c->section ? 0 : c->radius);
+    if (c->section) {
+        /* Each triangle turns left and the angles add up to one turn. */
+        double turn = 0;
+        for (uint32_t w = 0; w < c->sides; w++) {
+            const double *a = c->section + 2 * w, *b = c->section + 2 * ((w + 1) % c->sides);
+            if (!isfinite(a[0]) || !isfinite(a[1]))
+                return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX, "section: corner %u is not finite", w);
+            double cross = a[0] * b[1] - a[1] * b[0], dot = a[0] * b[0] + a[1] * b[1];
+            if (!(cross > 1e-12 * (a[0] * a[0] + a[1] * a[1] + b[0] * b[0] + b[1] * b[1])))
+                return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
+                                    "section: corners %u and %u do not turn counter-clockwise about the centre", w,
+                                    (w + 1) % c->sides);
+            turn += atan2(cross, dot);
+            c->size = fmax(c->size, sqrt(a[0] * a[0] + a[1] * a[1]));
+        }
+        if (!(fabs(turn - 2 * PI) < 1e-6))
+            return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
+                                "section: the corners go %.4g times round the centre (must be once)", turn / (2 * PI));
+    }
     size_t values = 3 * (size_t)mk_prism_point_count(c);
     for (size_t i = 0; i < values; i++)
         if ((c->rest && !isfinite(c->rest[i])) || (c->displacements && !isfinite(c->displacements[i])))
@@ -86,8 +107,9 @@ uint32_t mk_prism_index(const mk_prism_lattice *c, uint32_t ring, uint32_t posit
 /* Corner w of the polygon relative to the centre. */
 static void corner(const mk_prism_lattice *c, uint32_t w, double out[3])
 {
-    double a = 2 * PI * (w % c->sides) / c->sides;
-    for (int q = 0; q < 3; q++) out[q] = c->radius * (cos(a) * c->frame[0][q] + sin(a) * c->frame[1][q]);
+    double a = 2 * PI * (w % c->sides) / c->sides, x = c->radius * cos(a), y = c->radius * sin(a);
+    if (c->section) { x = c->section[2 * (w % c->sides)]; y = c->section[2 * (w % c->sides) + 1]; }
+    for (int q = 0; q < 3; q++) out[q] = x * c->frame[0][q] + y * c->frame[1][q];
 }
 
 void mk_prism_control_point(const mk_prism_lattice *c, uint32_t ring, uint32_t position, uint32_t layer, double out[3])
@@ -211,11 +233,20 @@ static double locate_in_wedge(const mk_prism_lattice *c, uint32_t w, const doubl
 mk_result mk_prism_coordinates(const mk_prism_lattice *c, const double p[3], double coords[4], uint32_t *iterations,
                                mk_error *err)
 {
-    double size = fmax(c->radius, c->height), target = 1e-10 * size, rel[3];
+    double size = c->size, target = 1e-10 * size, rel[3];
     vec3_sub(rel, p, c->center);
-    double angle = atan2(vec3_dot(rel, c->frame[1]), vec3_dot(rel, c->frame[0]));
-    if (angle < 0) angle += 2 * PI;
-    uint32_t first = (uint32_t)floor(angle / (2 * PI) * c->sides) % c->sides;
+    /* The wedge whose spokes (centre to corner w, w + 1) enclose p's direction: corner w on
+     * the right of it or along it, corner w + 1 on its left (0 for a point on the axis). */
+    double x = vec3_dot(rel, c->frame[0]), y = vec3_dot(rel, c->frame[1]);
+    uint32_t first = 0;
+    for (uint32_t w = 0; w < c->sides; w++) {
+        double a[3], b[3];
+        corner(c, w, a);
+        corner(c, w + 1, b);
+        double ax = vec3_dot(a, c->frame[0]), ay = vec3_dot(a, c->frame[1]);
+        double bx = vec3_dot(b, c->frame[0]), by = vec3_dot(b, c->frame[1]);
+        if (ax * y - ay * x >= 0 && bx * y - by * x < 0) { first = w; break; }
+    }
     /* The wedge that owns p, else the located wedge p is least outside of, and the wedge where
      * Newton failed with the smallest residual. */
     double best_q[3] = { 0, 0, 0 }, best_out = INFINITY, failed_res = INFINITY;

@@ -13,18 +13,25 @@ typedef struct mk_prism_lattice {
     double center[3];        /* centre of the first layer's cross-section (mesh units) */
     double axis[3];          /* the prism's axis; length = height (mesh units) */
     double reference[3];     /* direction of corner 0 (any length, not parallel to axis) */
-    double radius;           /* distance from the centre to a corner of the polygon (> 0) */
+    double radius;           /* regular polygon: distance from the centre to a corner (> 0) */
+    /* Explicit cross-section instead of the regular polygon (NULL: regular): sides corners, 2
+     * doubles each, (x, y) in mesh units along (e1, e2) from the centre, counter-clockwise
+     * about the axis; every triangle (centre, corner w, corner w + 1) must turn left, and
+     * together they must go round the centre once (a polygon star-shaped from the centre). */
+    const double *section;
     /* Control points: per layer the centre (ring 0), then ring r = 1..n with sides * r points
      * each (mk_prism_index). rest: rest positions (3 per point) or NULL for the regular lattice
      * (mk_prism_control_point); displacements: moved - rest (3 per point). Owned by the caller. */
     const double *rest;
     const double *displacements;
-    /* Filled by mk_prism_prepare: orthonormal frame (e1 = corner 0, e2, unit axis), height. */
+    /* Filled by mk_prism_prepare: orthonormal frame (e1 = reference, e2 = axis x e1, unit axis),
+     * height, and size = the larger of height and the farthest corner (Newton's scale). */
     double frame[3][3];
     double height;
+    double size;
 } mk_prism_lattice;
 
-/* Checks the counts, finiteness, radius and the frame. */
+/* Checks the counts, finiteness, radius or section and the frame. */
 mk_result mk_prism_prepare(mk_prism_lattice *lattice, mk_error *err);
 
 /* Control points per layer (1 + sides n (n + 1) / 2) and in all (times layers). */
@@ -35,8 +42,9 @@ uint32_t mk_prism_point_count(const mk_prism_lattice *lattice);
 uint32_t mk_prism_index(const mk_prism_lattice *lattice, uint32_t ring, uint32_t position, uint32_t layer);
 
 /* Regular rest position of a control point: with wedge w = m / r and c = m mod r, the point
- * center + (r - c)/n V_w + c/n V_(w+1) + k/(layers-1) axis, V_w = radius (cos a_w e1 + sin a_w e2),
- * a_w = 2 pi w / sides: ring r is the polygon scaled by r/n, evenly split. */
+ * center + (r - c)/n V_w + c/n V_(w+1) + k/(layers-1) axis, with corner V_w = radius (cos a_w e1 +
+ * sin a_w e2), a_w = 2 pi w / sides, or the section's corner w: ring r is the polygon scaled by
+ * r/n, each side split evenly. */
 void mk_prism_control_point(const mk_prism_lattice *lattice, uint32_t ring, uint32_t position, uint32_t layer,
                             double out[3]);
 

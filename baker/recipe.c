@@ -45,8 +45,8 @@ static const char *const op_fields[][12] = {
     [OP_FFD_KEYS] = { "dims", "basis", "origin", "axes", "padding", "keys", NULL },
     [OP_FFD_CYLINDER] = { "dims", "axis", "center", "range", "radius", "inner_radius", "reference", "padding",
                           "moves", NULL },
-    [OP_FFD_PRISM] = { "sides", "degree", "layers", "axis", "center", "range", "radius", "reference", "padding",
-                       "moves", NULL },
+    [OP_FFD_PRISM] = { "sides", "section", "degree", "layers", "axis", "center", "range", "radius", "reference",
+                       "padding", "moves", NULL },
 };
 
 /* Everything parsed for one channel before baking. */
@@ -859,6 +859,31 @@ static mk_result parse_ffd_prism(recipe_ctx *ctx, channel_plan *plan, const cJSO
         (r = get_uint(ctx, ch, path, "degree", &c->degree, 1, untrusted(ctx) ? 4 : 16)) != MK_OK ||
         (r = get_uint(ctx, ch, path, "layers", &c->layers, 2, most)) != MK_OK)
         return r;
+    const cJSON *section = cJSON_GetObjectItemCaseSensitive(ch, "section");
+    if (section) {
+        /* An explicit polygon: [[x, y], ...] in the frame of reference and axis x reference. */
+        if (cJSON_HasObjectItem(ch, "sides") || cJSON_HasObjectItem(ch, "radius"))
+            return field_error(ctx, path, cJSON_HasObjectItem(ch, "sides") ? "sides" : "radius",
+                               "give either section or sides and radius, not both%s", NULL);
+        int count = cJSON_IsArray(section) ? cJSON_GetArraySize(section) : 0;
+        if (count < 3 || count > (int)most)
+            return field_error(ctx, path, "section", "must be an array of 3..64 corners [x, y] (8 when untrusted)%s", NULL);
+        double *corners = mk_arena_array(ctx->scratch, 2 * (size_t)count, sizeof(double));
+        if (!corners) return mk_error_oom(ctx->err, "prism section");
+        int w = 0;
+        for (const cJSON *e = section->child; e; e = e->next, w++) {
+            char field[32];
+            snprintf(field, sizeof field, "section[%d]", w);
+            if (!cJSON_IsArray(e) || cJSON_GetArraySize(e) != 2 || !cJSON_IsNumber(e->child) || !cJSON_IsNumber(e->child->next))
+                return field_error(ctx, path, field, "must be a corner [x, y] (mesh units along reference and axis x reference)%s", NULL);
+            corners[2 * w] = e->child->valuedouble;
+            corners[2 * w + 1] = e->child->next->valuedouble;
+            if (!isfinite(corners[2 * w]) || !isfinite(corners[2 * w + 1]))
+                return field_error(ctx, path, field, "holds a value that is not finite%s", NULL);
+        }
+        c->sides = (uint32_t)count;
+        c->section = corners;
+    }
     double far, pad;
     if ((r = parse_axial_lattice(ctx, ch, path, mesh, c->center, c->axis, c->reference, &far, &pad)) != MK_OK) return r;
     /* The polygon's sides are cos(pi / sides) of the corner radius from the centre. */
