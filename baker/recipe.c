@@ -32,7 +32,7 @@ static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage",
 /* Fields accepted by every op, and per op. */
 static const char *const common_fields[] = { "name", "op", "mesh", "inbetweens", "tolerance",
                                              "samples", "max_targets", "default_weight", NULL };
-static const char *const op_fields[][12] = {
+static const char *const op_fields[][14] = {
     [OP_FFD] = { "dims", "basis", "origin", "axes", "padding", "moves", NULL },
     [OP_TAPER] = { "axis", "center", "range", "scale", NULL },
     [OP_TWIST] = { "axis", "center", "range", "angle", NULL },
@@ -46,7 +46,7 @@ static const char *const op_fields[][12] = {
     [OP_FFD_CYLINDER] = { "dims", "axis", "center", "range", "radius", "inner_radius", "reference", "padding",
                           "moves", NULL },
     [OP_FFD_PRISM] = { "sides", "section", "degree", "layers", "axis", "center", "range", "radius", "reference",
-                       "padding", "moves", NULL },
+                       "padding", "rest_moves", "moves", NULL },
 };
 
 /* Everything parsed for one channel before baking. */
@@ -350,8 +350,8 @@ static mk_result parse_index_range(recipe_ctx *ctx, const cJSON *mv, const char 
 }
 
 static mk_result parse_ffd_moves(recipe_ctx *ctx, const uint32_t dims[3], const mk_prism_lattice *prism,
-                                 const cJSON *obj, const char *path, const double *rest, double *current,
-                                 double *displacements);
+                                 const cJSON *obj, const char *path, const char *field, const double *rest,
+                                 double *current, double *displacements);
 
 /* bounds: the box the default lattice encloses (min, max), NULL = the mesh's bounding box. */
 static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path,
@@ -421,7 +421,7 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
     mk_error inner;
     if (mk_ffd_prepare(f, &inner) != MK_OK)
         return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
-    mk_result r = parse_ffd_moves(ctx, f->dims, NULL, ch, path, plan->lattice_rest, current, plan->ffd_displacements);
+    mk_result r = parse_ffd_moves(ctx, f->dims, NULL, ch, path, "moves", plan->lattice_rest, current, plan->ffd_displacements);
     if (r != MK_OK) return r;
     f->displacements = plan->ffd_displacements;
     if (mk_ffd_prepare(f, &inner) != MK_OK)
@@ -441,24 +441,24 @@ static size_t grid_index(const uint32_t dims[3], const mk_prism_lattice *prism, 
     return prism ? mk_prism_index(prism, i, j, k) : i + dims[0] * ((size_t)j + dims[1] * k);
 }
 
-/* The "moves" of obj (at path) applied to a lattice of dims control points (point (i, j, k) at
+/* The moves in obj's field (at path; "moves" but for ffd_prism's "rest_moves") applied to a lattice of dims control points (point (i, j, k) at
  * index i + dims[0] (j + dims[1] k)), or with prism set to its rings (i = ring 0..dims[0]-1,
  * j = position around ring i, k = layer 0..dims[2]-1; without "j" a move takes whole rings):
  * current starts as a copy of rest and ends moved; displacements gets moved - rest. */
 static mk_result parse_ffd_moves(recipe_ctx *ctx, const uint32_t dims[3], const mk_prism_lattice *prism,
-                                 const cJSON *obj, const char *path, const double *rest, double *current,
-                                 double *displacements)
+                                 const cJSON *obj, const char *path, const char *field, const double *rest,
+                                 double *current, double *displacements)
 {
     size_t points = prism ? mk_prism_point_count(prism) : (size_t)dims[0] * dims[1] * dims[2];
     memcpy(current, rest, 3 * points * sizeof(double));
-    const cJSON *moves = cJSON_GetObjectItemCaseSensitive(obj, "moves");
+    const cJSON *moves = cJSON_GetObjectItemCaseSensitive(obj, field);
     if (moves && !cJSON_IsArray(moves))
-        return field_error(ctx, path, "moves", "must be an array of moves%s", NULL);
+        return field_error(ctx, path, field, "must be an array of moves%s", NULL);
     int m = 0;
     for (const cJSON *mv = moves ? moves->child : NULL; mv; mv = mv->next, m++) {
         static const char *const move_fields[] = { "i", "j", "k", "translate", "rotate", "scale", "pivot", NULL };
         char mpath[256];
-        snprintf(mpath, sizeof mpath, "%s.moves[%d]", path, m);
+        snprintf(mpath, sizeof mpath, "%s.%s[%d]", path, field, m);
         if (!cJSON_IsObject(mv)) return field_error(ctx, mpath, "", "must be an object%s", NULL);
         mk_result r = check_fields(ctx, mv, mpath, move_fields, NULL);
         if (r != MK_OK) return r;
@@ -732,7 +732,7 @@ static mk_result parse_ffd_keys(recipe_ctx *ctx, channel_plan *plan, const cJSON
             return field_error(ctx, kpath, "time", "must be later than the previous key's%s", NULL);
         plan->key_displacements[k] = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
         if (!plan->key_displacements[k]) return mk_error_oom(ctx->err, "lattice keys");
-        if ((r = parse_ffd_moves(ctx, f->dims, NULL, key, kpath, plan->lattice_rest, current, plan->key_displacements[k])) != MK_OK)
+        if ((r = parse_ffd_moves(ctx, f->dims, NULL, key, kpath, "moves", plan->lattice_rest, current, plan->key_displacements[k])) != MK_OK)
             return r;
     }
     return MK_OK;
@@ -830,7 +830,7 @@ static mk_result parse_ffd_cylinder(recipe_ctx *ctx, channel_plan *plan, const c
         for (uint32_t j = 0; j < c->dims[1]; j++)
             for (uint32_t i = 0; i < c->dims[0]; i++)
                 mk_cylinder_control_point(c, i, j, k, plan->lattice_rest + 3 * (i + c->dims[0] * ((size_t)j + c->dims[1] * k)));
-    if ((r = parse_ffd_moves(ctx, c->dims, NULL, ch, path, plan->lattice_rest, current, displacements)) != MK_OK) return r;
+    if ((r = parse_ffd_moves(ctx, c->dims, NULL, ch, path, "moves", plan->lattice_rest, current, displacements)) != MK_OK) return r;
     if (c->inner_radius == 0)
         /* Ring 0 is on the axis: its points of one layer are one point; they move by their mean. */
         for (uint32_t k = 0; k < c->dims[2]; k++) {
@@ -904,10 +904,18 @@ static mk_result parse_ffd_prism(recipe_ctx *ctx, channel_plan *plan, const cJSO
             for (uint32_t j = 0; j < (i ? c->sides * i : 1); j++)
                 mk_prism_control_point(c, i, j, k, plan->lattice_rest + 3 * (size_t)mk_prism_index(c, i, j, k));
     uint32_t dims[3] = { c->degree + 1, 0, c->layers };
-    if ((r = parse_ffd_moves(ctx, dims, c, ch, path, plan->lattice_rest, current, displacements)) != MK_OK) return r;
+    if (cJSON_HasObjectItem(ch, "rest_moves")) {
+        /* The rest lattice shaped to the mesh before binding: the regular one moved. */
+        if ((r = parse_ffd_moves(ctx, dims, c, ch, path, "rest_moves", plan->lattice_rest, current, displacements)) != MK_OK)
+            return r;
+        memcpy(plan->lattice_rest, current, 3 * points * sizeof(double));
+        c->rest = plan->lattice_rest;
+    }
+    if ((r = parse_ffd_moves(ctx, dims, c, ch, path, "moves", plan->lattice_rest, current, displacements)) != MK_OK)
+        return r;
     c->displacements = displacements;
     if (mk_prism_prepare(c, &inner) != MK_OK)
-        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.moves: %s", path, inner.message);
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.moves/rest_moves: %s", path, inner.message);
     if (mk_prism_bind(c, mesh, plan->lattice_coordinates, &inner) != MK_OK)
         return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s: %s (enlarge radius or range)", path, inner.message);
     return MK_OK;

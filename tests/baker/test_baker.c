@@ -1420,13 +1420,18 @@ static void affine_blend(const void *user, double w, const double p[3], double q
 static void ffd_prism_recipe_moved_rigidly_or_affinely_plays_that_map(void)
 {
     /* Every control point turned 40 degrees about x through (0, 0, 2) and moved by (0.3, 0, -0.2)
-     * (turn_blend) in a pentagonal lattice, or scaled by (1.2, 0.8, 1.1) about the origin, turned
+     * (turn_blend) in a pentagonal lattice (regular, or with its rest shaped by rest_moves), or scaled by (1.2, 0.8, 1.1) about the origin, turned
      * 25 degrees about z and moved by (0.1, 0.2, 0.3) in an irregular hexagonal one: through the runtime, the tube at every weight is the tube blended
      * towards that map. */
-    const char *recipes[2] = {
+    const char *recipes[3] = {
         "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"turn\", \"op\": \"ffd_prism\", \"axis\": \"z\","
         " \"center\": [0, 0, 2], \"sides\": 5, \"degree\": 2, \"layers\": 3, \"moves\": [{\"translate\": [0.3, 0, -0.2],"
         " \"rotate\": {\"axis\": [1, 0, 0], \"degrees\": 40, \"pivot\": [0, 0, 2]}}]}]}",
+        /* the same turn of a rest lattice shaped off the grid (middle bulged, top twisted) */
+        "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"turn\", \"op\": \"ffd_prism\", \"axis\": \"z\","
+        " \"center\": [0, 0, 2], \"sides\": 5, \"degree\": 2, \"layers\": 4, \"rest_moves\": [{\"i\": 2, \"k\": [1, 2],"
+        " \"scale\": [1.25, 1.25, 1]}, {\"k\": 3, \"rotate\": {\"axis\": [0, 0, 1], \"degrees\": 20}}],"
+        " \"moves\": [{\"translate\": [0.3, 0, -0.2], \"rotate\": {\"axis\": [1, 0, 0], \"degrees\": 40, \"pivot\": [0, 0, 2]}}]}]}",
         "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"shear\", \"op\": \"ffd_prism\", \"axis\": \"z\","
         " \"section\": [[1.4, 0], [0.5, 1.4], [-0.7, 1.2], [-1.5, 0], [-0.5, -1.5], [0.7, -1.3]], \"degree\": 3, \"moves\": [{\"scale\": [1.2, 0.8, 1.1], \"pivot\": [0, 0, 0], \"translate\": [0.1, 0.2, 0.3],"
         " \"rotate\": {\"axis\": [0, 0, 1], \"degrees\": 25, \"pivot\": [0, 0, 0]}}]}]}" };
@@ -1434,16 +1439,17 @@ static void ffd_prism_recipe_moved_rigidly_or_affinely_plays_that_map(void)
     double R[9], S[9] = { 1.2, 0, 0, 0, 0.8, 0, 0, 0, 1.1 }, z[3] = { 0, 0, 1 };
     mat3_rotation(R, z, 25 * PI / 180);
     mat3_mul(shear.M, R, S);
-    for (int k = 0; k < 2; k++) {
+    static const char *const labels[3] = { "rigid", "rigid (shaped rest)", "affine" };
+    for (int k = 0; k < 3; k++) {
         mk_raw_asset raw;
         const mk_raw_mesh *m = baked_cylinder(&raw, "tube", 1, 4, 16, 8, recipes[k]);
         if (!m) return;
         CHECK_EQ_INT(raw.channels[0].target_count, 1);
         mk_asset asset;
         if (!write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
-        double worst = k ? playback_error(&asset, m, 0, 1, affine_blend, &shear) : playback_error(&asset, m, 0, 1, turn_blend, NULL);
-        fprintf(stderr, "ffd_prism %s lattice motion through the runtime: %.3g x diagonal\n", k ? "affine" : "rigid",
-                worst / diag_of(m));
+        double worst = k == 2 ? playback_error(&asset, m, 0, 1, affine_blend, &shear)
+                              : playback_error(&asset, m, 0, 1, turn_blend, NULL);
+        fprintf(stderr, "ffd_prism %s lattice motion through the runtime: %.3g x diagonal\n", labels[k], worst / diag_of(m));
         CHECK_MSG(worst <= 1e-6 * diag_of(m) + 2e-6, "off the map by %g", worst);
         mk_raw_free(&raw);
     }
@@ -1557,6 +1563,12 @@ static void bad_arap_and_animated_ffd_recipes_name_the_field(void)
           "channels[0].section: corners 0 and 1 do not turn counter-clockwise" },
         { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"section\": [[2, 0], [-1, 1.7], [-1, -1.7], [2, 0.01], [-1, 1.7], [-1, -1.7]]}]}",
           "channels[0].section: the corners go 2 times round the centre" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"rest_moves\": [{\"i\": 5}]}]}",
+          "channels[0].rest_moves[0].i: must lie in 0..2" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"rest_moves\": 3}]}",
+          "channels[0].rest_moves: must be an array" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"rest_moves\": [{\"i\": 2, \"scale\": 0.5}]}]}",
+          "channels[0]: vertex" },
         { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"sides\": 2}]}",
           "channels[0].sides: must be an integer in 3..64" },
         { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"sides\": \"six\"}]}",
