@@ -27,6 +27,7 @@
 #include <string.h>
 #include "ffd_cylinder.h"
 #include "bake_util.h"
+#include "lattice_newton.h"
 
 #define PI 3.14159265358979323846
 #define MAX_DIM 64
@@ -65,25 +66,6 @@ void mk_cylinder_control_point(const mk_cylinder_lattice *c, uint32_t i, uint32_
         out[q] = c->center[q] + r * (cos(a) * c->frame[0][q] + sin(a) * c->frame[1][q]) + u * c->height * c->frame[2][q];
 }
 
-/* Bernstein polynomial C(n, i) x^i (1 - x)^(n - i); 0 outside 0..n. */
-static double bernstein_value(int n, int i, double x)
-{
-    if (i < 0 || i > n) return 0;
-    double binomial = 1;
-    for (int k = 1; k <= i; k++) binomial = binomial * (n - i + k) / k;
-    return binomial * pow(x, i) * pow(1 - x, n - i);
-}
-
-/* Bernstein weights of degree n-1 at x and their derivatives n' (B_{i-1}^{n'-1} - B_i^{n'-1}). */
-static void bernstein(uint32_t n, double x, double *w, double *dw)
-{
-    int deg = (int)n - 1;
-    for (int i = 0; i <= deg; i++) {
-        w[i] = bernstein_value(deg, i, x);
-        dw[i] = deg * (bernstein_value(deg - 1, i - 1, x) - bernstein_value(deg - 1, i, x));
-    }
-}
-
 /* Periodic uniform cubic B-spline over n control points at t in [0, 1): the 4 taps (indices
  * mod n), their weights and derivatives d/dt. */
 static void periodic_bspline(uint32_t n, double t, uint32_t taps[4], double w[4], double dw[4])
@@ -110,9 +92,9 @@ static void lattice_eval(const mk_cylinder_lattice *c, const double q[3], const 
     double ws[MAX_DIM], dws[MAX_DIM], wu[MAX_DIM], dwu[MAX_DIM], wt[4], dwt[4];
     uint32_t taps[4];
     double t = q[1] - floor(q[1]);
-    bernstein(c->dims[0], q[0], ws, dws);
+    bake_bernstein(c->dims[0], q[0], ws, dws);
     periodic_bspline(c->dims[1], t, taps, wt, dwt);
-    bernstein(c->dims[2], q[2], wu, dwu);
+    bake_bernstein(c->dims[2], q[2], wu, dwu);
     memset(out, 0, 3 * sizeof(double));
     if (J) memset(J, 0, 9 * sizeof(double));
     for (uint32_t k = 0; k < c->dims[2]; k++)
@@ -135,16 +117,10 @@ static void lattice_eval(const mk_cylinder_lattice *c, const double q[3], const 
             }
 }
 
-/* Solves J x = b for 3x3 J by Cramer's rule; 0 when J is singular relative to its size. */
-static int solve3(const double J[9], const double b[3], double x[3])
+/* bake_rest_map of the cylinder's rest lattice. */
+static void rest_map(const void *user, const double q[3], double F[3], double J[9])
 {
-    double det = mat3_det(J), size = 0;
-    for (int i = 0; i < 9; i++) size = fmax(size, fabs(J[i]));
-    if (!(fabs(det) > 1e-14 * size * size * size)) return 0;
-    double cof[9];
-    mat3_cofactor(cof, J);  /* cof(J) = det(J) J^-T */
-    for (int r = 0; r < 3; r++) x[r] = (cof[r] * b[0] + cof[3 + r] * b[1] + cof[6 + r] * b[2]) / det;
-    return 1;
+    lattice_eval(user, q, NULL, 0, F, J);
 }
 
 mk_result mk_cylinder_coordinates(const mk_cylinder_lattice *c, const double p[3], double q[3], uint32_t *iterations,
@@ -158,30 +134,11 @@ mk_result mk_cylinder_coordinates(const mk_cylinder_lattice *c, const double p[3
     q[1] = angle / (2 * PI);
     q[2] = z / c->height;
     q[0] = fmin(fmax(q[0], 0), 1);
-    double f[3], J[9], res = INFINITY;
+    /* On the axis (inner radius 0, s = 0) the angle is free: J is singular, t is held. */
+    bake_newton newton = { rest_map, c, { -0.5, -INFINITY, -INFINITY }, { INFINITY, INFINITY, INFINITY }, 1,
+                           target_error, 50 };
     uint32_t it = 0;
-    for (;; it++) {
-        lattice_eval(c, q, NULL, 0, f, J);
-        vec3_sub(f, f, p);
-        res = vec3_length(f);
-        if (res <= target_error || it == 50) break;
-        double step[3];
-        if (!solve3(J, f, step)) {
-            /* On the axis (inner radius 0, s = 0) the angle is free: solve for s and u only. */
-            double A[9] = { J[0], J[2], 0, J[3], J[5], 0, J[6], J[8], 1 }, sol[3];
-            if (!solve3(A, f, sol)) break;
-            step[0] = sol[0]; step[1] = 0; step[2] = sol[1];
-        }
-        double lambda = 1, trial[3], g[3];
-        for (int h = 0; h < 30; h++, lambda *= 0.5) {
-            for (int k = 0; k < 3; k++) trial[k] = q[k] - lambda * step[k];
-            trial[0] = fmax(trial[0], -0.5);
-            lattice_eval(c, trial, NULL, 0, g, NULL);
-            vec3_sub(g, g, p);
-            if (vec3_length(g) < res) break;
-        }
-        memcpy(q, trial, sizeof trial);
-    }
+    double res = bake_newton_solve(&newton, p, q, &it);
     if (iterations) *iterations = it;
     q[1] -= floor(q[1]);
     if (!(res <= target_error))

@@ -18,20 +18,21 @@
 #include "ffd.h"
 #include "ffd_travel.h"
 #include "ffd_cylinder.h"
+#include "ffd_prism.h"
 #include "inbetween.h"
 #include "surface_edit.h"
 #include "obj.h"
 
 #define PI 3.14159265358979323846
 
-typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP, OP_FFD_TRAVEL, OP_FFD_KEYS, OP_FFD_CYLINDER } op_kind;
+typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP, OP_FFD_TRAVEL, OP_FFD_KEYS, OP_FFD_CYLINDER, OP_FFD_PRISM } op_kind;
 
-static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap", "ffd_travel", "ffd_keys", "ffd_cylinder" };
+static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap", "ffd_travel", "ffd_keys", "ffd_cylinder", "ffd_prism" };
 
 /* Fields accepted by every op, and per op. */
 static const char *const common_fields[] = { "name", "op", "mesh", "inbetweens", "tolerance",
                                              "samples", "max_targets", "default_weight", NULL };
-static const char *const op_fields[][12] = {
+static const char *const op_fields[][14] = {
     [OP_FFD] = { "dims", "basis", "origin", "axes", "padding", "moves", NULL },
     [OP_TAPER] = { "axis", "center", "range", "scale", NULL },
     [OP_TWIST] = { "axis", "center", "range", "angle", NULL },
@@ -44,6 +45,8 @@ static const char *const op_fields[][12] = {
     [OP_FFD_KEYS] = { "dims", "basis", "origin", "axes", "padding", "keys", NULL },
     [OP_FFD_CYLINDER] = { "dims", "axis", "center", "range", "radius", "inner_radius", "reference", "padding",
                           "moves", NULL },
+    [OP_FFD_PRISM] = { "sides", "section", "degree", "layers", "axis", "center", "range", "radius", "reference",
+                       "padding", "rest_moves", "moves", NULL },
 };
 
 /* Everything parsed for one channel before baking. */
@@ -65,9 +68,10 @@ typedef struct channel_plan {
     uint32_t key_count;           /* ffd_keys: lattice keys, their times and displacements */
     double *key_times;
     double **key_displacements;
-    double *lattice_rest;         /* ffd, ffd_keys, ffd_cylinder: rest control points */
+    double *lattice_rest;         /* ffd, ffd_keys, ffd_cylinder, ffd_prism: rest control points */
     mk_cylinder_lattice cylinder;
-    double *cylinder_coordinates; /* ffd_cylinder: (s, t, u) per vertex */
+    mk_prism_lattice prism;
+    double *lattice_coordinates;  /* per vertex: ffd_cylinder (s, t, u), ffd_prism (wedge, l1, l2, u) */
 } channel_plan;
 
 typedef struct recipe_ctx {
@@ -345,8 +349,9 @@ static mk_result parse_index_range(recipe_ctx *ctx, const cJSON *mv, const char 
     return MK_OK;
 }
 
-static mk_result parse_ffd_moves(recipe_ctx *ctx, const uint32_t dims[3], const cJSON *obj, const char *path,
-                                 const double *rest, double *current, double *displacements);
+static mk_result parse_ffd_moves(recipe_ctx *ctx, const uint32_t dims[3], const mk_prism_lattice *prism,
+                                 const cJSON *obj, const char *path, const char *field, const double *rest,
+                                 double *current, double *displacements);
 
 /* bounds: the box the default lattice encloses (min, max), NULL = the mesh's bounding box. */
 static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path,
@@ -416,7 +421,7 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
     mk_error inner;
     if (mk_ffd_prepare(f, &inner) != MK_OK)
         return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
-    mk_result r = parse_ffd_moves(ctx, f->dims, ch, path, plan->lattice_rest, current, plan->ffd_displacements);
+    mk_result r = parse_ffd_moves(ctx, f->dims, NULL, ch, path, "moves", plan->lattice_rest, current, plan->ffd_displacements);
     if (r != MK_OK) return r;
     f->displacements = plan->ffd_displacements;
     if (mk_ffd_prepare(f, &inner) != MK_OK)
@@ -424,37 +429,54 @@ static mk_result parse_ffd(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch,
     return MK_OK;
 }
 
-/* The "moves" of obj (at path) applied to a lattice of dims control points (point (i, j, k) at
- * index i + dims[0] (j + dims[1] k)): current starts as a copy of rest and ends moved;
- * displacements gets moved - rest. */
-static mk_result parse_ffd_moves(recipe_ctx *ctx, const uint32_t dims[3], const cJSON *obj, const char *path,
-                                 const double *rest, double *current, double *displacements)
+/* Positions j of row i of a lattice: dims[1] for a box, the sides * i points of ring i (1 for
+ * the centre) for a prism. */
+static uint32_t grid_positions(const uint32_t dims[3], const mk_prism_lattice *prism, uint32_t i)
 {
-    size_t points = (size_t)dims[0] * dims[1] * dims[2];
+    return prism ? (i ? prism->sides * i : 1) : dims[1];
+}
+
+static size_t grid_index(const uint32_t dims[3], const mk_prism_lattice *prism, uint32_t i, uint32_t j, uint32_t k)
+{
+    return prism ? mk_prism_index(prism, i, j, k) : i + dims[0] * ((size_t)j + dims[1] * k);
+}
+
+/* The moves in obj's field (at path; "moves" but for ffd_prism's "rest_moves") applied to a lattice of dims control points (point (i, j, k) at
+ * index i + dims[0] (j + dims[1] k)), or with prism set to its rings (i = ring 0..dims[0]-1,
+ * j = position around ring i, k = layer 0..dims[2]-1; without "j" a move takes whole rings):
+ * current starts as a copy of rest and ends moved; displacements gets moved - rest. */
+static mk_result parse_ffd_moves(recipe_ctx *ctx, const uint32_t dims[3], const mk_prism_lattice *prism,
+                                 const cJSON *obj, const char *path, const char *field, const double *rest,
+                                 double *current, double *displacements)
+{
+    size_t points = prism ? mk_prism_point_count(prism) : (size_t)dims[0] * dims[1] * dims[2];
     memcpy(current, rest, 3 * points * sizeof(double));
-    const cJSON *moves = cJSON_GetObjectItemCaseSensitive(obj, "moves");
+    const cJSON *moves = cJSON_GetObjectItemCaseSensitive(obj, field);
     if (moves && !cJSON_IsArray(moves))
-        return field_error(ctx, path, "moves", "must be an array of moves%s", NULL);
+        return field_error(ctx, path, field, "must be an array of moves%s", NULL);
     int m = 0;
     for (const cJSON *mv = moves ? moves->child : NULL; mv; mv = mv->next, m++) {
         static const char *const move_fields[] = { "i", "j", "k", "translate", "rotate", "scale", "pivot", NULL };
         char mpath[256];
-        snprintf(mpath, sizeof mpath, "%s.moves[%d]", path, m);
+        snprintf(mpath, sizeof mpath, "%s.%s[%d]", path, field, m);
         if (!cJSON_IsObject(mv)) return field_error(ctx, mpath, "", "must be an object%s", NULL);
         mk_result r = check_fields(ctx, mv, mpath, move_fields, NULL);
         if (r != MK_OK) return r;
         uint32_t lo[3], hi[3];
         static const char *const ijk[3] = { "i", "j", "k" };
         for (int a = 0; a < 3; a++)
-            if ((r = parse_index_range(ctx, mv, mpath, ijk[a], dims[a], &lo[a], &hi[a])) != MK_OK) return r;
+            if ((r = parse_index_range(ctx, mv, mpath, ijk[a], a == 1 ? grid_positions(dims, prism, lo[0]) : dims[a],
+                                       &lo[a], &hi[a])) != MK_OK) return r;
+        int all_j = !cJSON_HasObjectItem(mv, "j");
+#define LAST_J(i) (all_j ? grid_positions(dims, prism, i) - 1 : hi[1])
         /* Default pivot: centroid of the selected control points (current positions). */
         double centroid[3] = { 0, 0, 0 };
         size_t sel = 0;
         for (uint32_t k = lo[2]; k <= hi[2]; k++)
-            for (uint32_t j = lo[1]; j <= hi[1]; j++)
-                for (uint32_t i = lo[0]; i <= hi[0]; i++, sel++)
+            for (uint32_t i = lo[0]; i <= hi[0]; i++)
+                for (uint32_t j = lo[1]; j <= LAST_J(i); j++, sel++)
                     for (int c = 0; c < 3; c++)
-                        centroid[c] += current[3 * (i + dims[0] * ((size_t)j + dims[1] * k)) + c];
+                        centroid[c] += current[3 * grid_index(dims, prism, i, j, k) + c];
         for (int c = 0; c < 3; c++) centroid[c] /= (double)sel;
         double pivot[3] = { centroid[0], centroid[1], centroid[2] };
         if (get_vec3(ctx, mv, mpath, "pivot", pivot) < 0) return ctx->err->code;
@@ -470,15 +492,16 @@ static mk_result parse_ffd_moves(recipe_ctx *ctx, const uint32_t dims[3], const 
         mat3_rotation(R, axis, angle);
         /* P <- rotate(scale(P about pivot)) about rotate.pivot, then translate. */
         for (uint32_t k = lo[2]; k <= hi[2]; k++)
-            for (uint32_t j = lo[1]; j <= hi[1]; j++)
-                for (uint32_t i = lo[0]; i <= hi[0]; i++) {
-                    double *p = current + 3 * (i + dims[0] * ((size_t)j + dims[1] * k));
+            for (uint32_t i = lo[0]; i <= hi[0]; i++)
+                for (uint32_t j = lo[1]; j <= LAST_J(i); j++) {
+                    double *p = current + 3 * grid_index(dims, prism, i, j, k);
                     double q[3], o[3];
                     for (int c = 0; c < 3; c++) q[c] = pivot[c] + scale[c] * (p[c] - pivot[c]) - rpivot[c];
                     mat3_mul_vec(o, R, q);
                     for (int c = 0; c < 3; c++) p[c] = rpivot[c] + o[c] + translate[c];
                 }
     }
+#undef LAST_J
     for (size_t q = 0; q < 3 * points; q++) displacements[q] = current[q] - rest[q];
     return MK_OK;
 }
@@ -709,8 +732,60 @@ static mk_result parse_ffd_keys(recipe_ctx *ctx, channel_plan *plan, const cJSON
             return field_error(ctx, kpath, "time", "must be later than the previous key's%s", NULL);
         plan->key_displacements[k] = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
         if (!plan->key_displacements[k]) return mk_error_oom(ctx->err, "lattice keys");
-        if ((r = parse_ffd_moves(ctx, f->dims, key, kpath, plan->lattice_rest, current, plan->key_displacements[k])) != MK_OK)
+        if ((r = parse_ffd_moves(ctx, f->dims, NULL, key, kpath, "moves", plan->lattice_rest, current, plan->key_displacements[k])) != MK_OK)
             return r;
+    }
+    return MK_OK;
+}
+
+/* The placement shared by the lattices around an axis (ffd_cylinder, ffd_prism): fields axis,
+ * center, padding (default 0.05), range and reference. base gets the axis point of the first
+ * layer, axis_out the axis scaled to the range's length, reference the direction of sector or
+ * corner 0 (default: the coordinate axis least aligned with the axis); far gets the mesh's
+ * largest distance from the axis and pad the padding in mesh units. */
+static mk_result parse_axial_lattice(recipe_ctx *ctx, const cJSON *ch, const char *path, const mk_raw_mesh *mesh,
+                                     double base[3], double axis_out[3], double reference[3], double *far,
+                                     double *pad)
+{
+    double axis[3], bmin[3], bmax[3], diag, padding = 0.05;
+    mk_result r = parse_axis(ctx, ch, path, axis);
+    if (r != MK_OK) return r;
+    vec3_normalize(axis);
+    bake_bounds(mesh, bmin, bmax, &diag);
+    double center[3];
+    for (int k = 0; k < 3; k++) center[k] = 0.5 * (bmin[k] + bmax[k]);
+    if (get_vec3(ctx, ch, path, "center", center) < 0) return ctx->err->code;
+    if ((r = get_number(ctx, ch, path, "padding", &padding, 0)) != MK_OK) return r;
+    if (padding < 0) return field_error(ctx, path, "padding", "must be >= 0%s", NULL);
+    /* Extent along the axis and largest distance from it. */
+    double lo = INFINITY, hi = -INFINITY;
+    *far = 0;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        const float *pf = mesh->positions + 3 * (size_t)v;
+        double d[3] = { pf[0] - center[0], pf[1] - center[1], pf[2] - center[2] }, a = vec3_dot(d, axis);
+        lo = fmin(lo, a + vec3_dot(center, axis)); hi = fmax(hi, a + vec3_dot(center, axis));
+        for (int k = 0; k < 3; k++) d[k] -= a * axis[k];
+        *far = fmax(*far, vec3_length(d));
+    }
+    *pad = padding * diag;
+    double range[2] = { lo - *pad, hi + *pad };
+    const cJSON *ritem = cJSON_GetObjectItemCaseSensitive(ch, "range");
+    if (ritem) {
+        if (!cJSON_IsArray(ritem) || cJSON_GetArraySize(ritem) != 2 || !cJSON_IsNumber(ritem->child) ||
+            !cJSON_IsNumber(ritem->child->next) || !isfinite(ritem->child->valuedouble) ||
+            !isfinite(ritem->child->next->valuedouble))
+            return field_error(ctx, path, "range", "must be [min, max] along the axis (p . axis, mesh units)%s", NULL);
+        range[0] = ritem->child->valuedouble;
+        range[1] = ritem->child->next->valuedouble;
+    }
+    if (!(range[1] > range[0])) return field_error(ctx, path, "range", "must have min < max%s", NULL);
+    int least = 0;
+    for (int k = 1; k < 3; k++) if (fabs(axis[k]) < fabs(axis[least])) least = k;
+    for (int k = 0; k < 3; k++) reference[k] = k == least;
+    if (get_vec3(ctx, ch, path, "reference", reference) < 0) return ctx->err->code;
+    for (int k = 0; k < 3; k++) {
+        base[k] = center[k] + (range[0] - vec3_dot(center, axis)) * axis[k];
+        axis_out[k] = (range[1] - range[0]) * axis[k];
     }
     return MK_OK;
 }
@@ -735,48 +810,12 @@ static mk_result parse_ffd_cylinder(recipe_ctx *ctx, channel_plan *plan, const c
             c->dims[a] = (uint32_t)v;
         }
     }
-    double axis[3], bmin[3], bmax[3], diag, padding = 0.05;
-    mk_result r = parse_axis(ctx, ch, path, axis);
+    double far, pad;
+    mk_result r = parse_axial_lattice(ctx, ch, path, mesh, c->center, c->axis, c->reference, &far, &pad);
     if (r != MK_OK) return r;
-    vec3_normalize(axis);
-    bake_bounds(mesh, bmin, bmax, &diag);
-    double center[3];
-    for (int k = 0; k < 3; k++) center[k] = 0.5 * (bmin[k] + bmax[k]);
-    if (get_vec3(ctx, ch, path, "center", center) < 0) return ctx->err->code;
-    if ((r = get_number(ctx, ch, path, "padding", &padding, 0)) != MK_OK) return r;
-    if (padding < 0) return field_error(ctx, path, "padding", "must be >= 0%s", NULL);
-    /* Extent along the axis and largest distance from it. */
-    double lo = INFINITY, hi = -INFINITY, far = 0;
-    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
-        const float *pf = mesh->positions + 3 * (size_t)v;
-        double d[3] = { pf[0] - center[0], pf[1] - center[1], pf[2] - center[2] }, a = vec3_dot(d, axis);
-        lo = fmin(lo, a + vec3_dot(center, axis)); hi = fmax(hi, a + vec3_dot(center, axis));
-        for (int k = 0; k < 3; k++) d[k] -= a * axis[k];
-        far = fmax(far, vec3_length(d));
-    }
-    double range[2] = { lo - padding * diag, hi + padding * diag };
-    const cJSON *ritem = cJSON_GetObjectItemCaseSensitive(ch, "range");
-    if (ritem) {
-        if (!cJSON_IsArray(ritem) || cJSON_GetArraySize(ritem) != 2 || !cJSON_IsNumber(ritem->child) ||
-            !cJSON_IsNumber(ritem->child->next) || !isfinite(ritem->child->valuedouble) ||
-            !isfinite(ritem->child->next->valuedouble))
-            return field_error(ctx, path, "range", "must be [min, max] along the axis (p . axis, mesh units)%s", NULL);
-        range[0] = ritem->child->valuedouble;
-        range[1] = ritem->child->next->valuedouble;
-    }
-    if (!(range[1] > range[0])) return field_error(ctx, path, "range", "must have min < max%s", NULL);
-    c->outer_radius = (far + padding * diag) / mk_cylinder_ring_ratio(c->dims[1]);
+    c->outer_radius = (far + pad) / mk_cylinder_ring_ratio(c->dims[1]);
     if ((r = get_number(ctx, ch, path, "radius", &c->outer_radius, 0)) != MK_OK) return r;
     if ((r = get_number(ctx, ch, path, "inner_radius", &c->inner_radius, 0)) != MK_OK) return r;
-    /* Default reference: the coordinate axis least aligned with the cylinder's. */
-    int least = 0;
-    for (int k = 1; k < 3; k++) if (fabs(axis[k]) < fabs(axis[least])) least = k;
-    c->reference[least] = 1;
-    if (get_vec3(ctx, ch, path, "reference", c->reference) < 0) return ctx->err->code;
-    for (int k = 0; k < 3; k++) {
-        c->center[k] = center[k] + (range[0] - vec3_dot(center, axis)) * axis[k];
-        c->axis[k] = (range[1] - range[0]) * axis[k];
-    }
     mk_error inner;
     if (mk_cylinder_prepare(c, &inner) != MK_OK)
         return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
@@ -784,14 +823,14 @@ static mk_result parse_ffd_cylinder(recipe_ctx *ctx, channel_plan *plan, const c
     plan->lattice_rest = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
     double *current = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
     double *displacements = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
-    plan->cylinder_coordinates = mk_arena_array(ctx->scratch, 3 * (size_t)mesh->vertex_count, sizeof(double));
-    if (!plan->lattice_rest || !current || !displacements || !plan->cylinder_coordinates)
+    plan->lattice_coordinates = mk_arena_array(ctx->scratch, 3 * (size_t)mesh->vertex_count, sizeof(double));
+    if (!plan->lattice_rest || !current || !displacements || !plan->lattice_coordinates)
         return mk_error_oom(ctx->err, "cylinder lattice");
     for (uint32_t k = 0; k < c->dims[2]; k++)
         for (uint32_t j = 0; j < c->dims[1]; j++)
             for (uint32_t i = 0; i < c->dims[0]; i++)
                 mk_cylinder_control_point(c, i, j, k, plan->lattice_rest + 3 * (i + c->dims[0] * ((size_t)j + c->dims[1] * k)));
-    if ((r = parse_ffd_moves(ctx, c->dims, ch, path, plan->lattice_rest, current, displacements)) != MK_OK) return r;
+    if ((r = parse_ffd_moves(ctx, c->dims, NULL, ch, path, "moves", plan->lattice_rest, current, displacements)) != MK_OK) return r;
     if (c->inner_radius == 0)
         /* Ring 0 is on the axis: its points of one layer are one point; they move by their mean. */
         for (uint32_t k = 0; k < c->dims[2]; k++) {
@@ -802,14 +841,90 @@ static mk_result parse_ffd_cylinder(recipe_ctx *ctx, channel_plan *plan, const c
                 for (int q = 0; q < 3; q++) displacements[3 * (c->dims[0] * ((size_t)j + c->dims[1] * k)) + q] = mean[q];
         }
     c->displacements = displacements;
-    if (mk_cylinder_bind(c, mesh, plan->cylinder_coordinates, &inner) != MK_OK)
+    if (mk_cylinder_bind(c, mesh, plan->lattice_coordinates, &inner) != MK_OK)
         return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s: %s (enlarge radius or range)", path, inner.message);
     return MK_OK;
 }
 
-/* mk_deformer for ffd_cylinder: p + a sum w(s, t, u) d per vertex. */
-static mk_result cylinder_eval(void *user, double amplitude, double *positions, double *normals, double *tangents,
-                               uint32_t *inverted, mk_error *err)
+/* ffd_prism: the prism lattice around the axis, its moves, every vertex's wedge and coordinates. */
+static mk_result parse_ffd_prism(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    const mk_raw_mesh *mesh = &ctx->raw->meshes[plan->mesh];
+    mk_prism_lattice *c = &plan->prism;
+    memset(c, 0, sizeof *c);
+    c->sides = 6; c->degree = 2; c->layers = 4;
+    uint32_t most = untrusted(ctx) ? 8 : 64;
+    mk_result r;
+    if ((r = get_uint(ctx, ch, path, "sides", &c->sides, 3, most)) != MK_OK ||
+        (r = get_uint(ctx, ch, path, "degree", &c->degree, 1, untrusted(ctx) ? 4 : 16)) != MK_OK ||
+        (r = get_uint(ctx, ch, path, "layers", &c->layers, 2, most)) != MK_OK)
+        return r;
+    const cJSON *section = cJSON_GetObjectItemCaseSensitive(ch, "section");
+    if (section) {
+        /* An explicit polygon: [[x, y], ...] in the frame of reference and axis x reference. */
+        if (cJSON_HasObjectItem(ch, "sides") || cJSON_HasObjectItem(ch, "radius"))
+            return field_error(ctx, path, cJSON_HasObjectItem(ch, "sides") ? "sides" : "radius",
+                               "give either section or sides and radius, not both%s", NULL);
+        int count = cJSON_IsArray(section) ? cJSON_GetArraySize(section) : 0;
+        if (count < 3 || count > (int)most)
+            return field_error(ctx, path, "section", "must be an array of 3..64 corners [x, y] (8 when untrusted)%s", NULL);
+        double *corners = mk_arena_array(ctx->scratch, 2 * (size_t)count, sizeof(double));
+        if (!corners) return mk_error_oom(ctx->err, "prism section");
+        int w = 0;
+        for (const cJSON *e = section->child; e; e = e->next, w++) {
+            char field[32];
+            snprintf(field, sizeof field, "section[%d]", w);
+            if (!cJSON_IsArray(e) || cJSON_GetArraySize(e) != 2 || !cJSON_IsNumber(e->child) || !cJSON_IsNumber(e->child->next))
+                return field_error(ctx, path, field, "must be a corner [x, y] (mesh units along reference and axis x reference)%s", NULL);
+            corners[2 * w] = e->child->valuedouble;
+            corners[2 * w + 1] = e->child->next->valuedouble;
+            if (!isfinite(corners[2 * w]) || !isfinite(corners[2 * w + 1]))
+                return field_error(ctx, path, field, "holds a value that is not finite%s", NULL);
+        }
+        c->sides = (uint32_t)count;
+        c->section = corners;
+    }
+    double far, pad;
+    if ((r = parse_axial_lattice(ctx, ch, path, mesh, c->center, c->axis, c->reference, &far, &pad)) != MK_OK) return r;
+    /* The polygon's sides are cos(pi / sides) of the corner radius from the centre. */
+    c->radius = (far + pad) / cos(PI / c->sides);
+    if ((r = get_number(ctx, ch, path, "radius", &c->radius, 0)) != MK_OK) return r;
+    mk_error inner;
+    if (mk_prism_prepare(c, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.%s", path, inner.message);
+    size_t points = mk_prism_point_count(c);
+    plan->lattice_rest = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+    double *current = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+    double *displacements = mk_arena_array(ctx->scratch, 3 * points, sizeof(double));
+    plan->lattice_coordinates = mk_arena_array(ctx->scratch, 4 * (size_t)mesh->vertex_count, sizeof(double));
+    if (!plan->lattice_rest || !current || !displacements || !plan->lattice_coordinates)
+        return mk_error_oom(ctx->err, "prism lattice");
+    for (uint32_t k = 0; k < c->layers; k++)
+        for (uint32_t i = 0; i <= c->degree; i++)
+            for (uint32_t j = 0; j < (i ? c->sides * i : 1); j++)
+                mk_prism_control_point(c, i, j, k, plan->lattice_rest + 3 * (size_t)mk_prism_index(c, i, j, k));
+    uint32_t dims[3] = { c->degree + 1, 0, c->layers };
+    if (cJSON_HasObjectItem(ch, "rest_moves")) {
+        /* The rest lattice shaped to the mesh before binding: the regular one moved. */
+        if ((r = parse_ffd_moves(ctx, dims, c, ch, path, "rest_moves", plan->lattice_rest, current, displacements)) != MK_OK)
+            return r;
+        memcpy(plan->lattice_rest, current, 3 * points * sizeof(double));
+        c->rest = plan->lattice_rest;
+    }
+    if ((r = parse_ffd_moves(ctx, dims, c, ch, path, "moves", plan->lattice_rest, current, displacements)) != MK_OK)
+        return r;
+    c->displacements = displacements;
+    if (mk_prism_prepare(c, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s.moves/rest_moves: %s", path, inner.message);
+    if (mk_prism_bind(c, mesh, plan->lattice_coordinates, &inner) != MK_OK)
+        return mk_error_set(ctx->err, MK_ERROR_PARSE, UINT64_MAX, "%s: %s (enlarge radius or range)", path, inner.message);
+    return MK_OK;
+}
+
+/* mk_deformer for ffd_cylinder and ffd_prism: p + a sum w d per vertex, from the coordinates
+ * found once at parse time. */
+static mk_result extended_ffd_eval(void *user, double amplitude, double *positions, double *normals, double *tangents,
+                                   uint32_t *inverted, mk_error *err)
 {
     (void)normals; (void)tangents; (void)err;
     const channel_plan *plan = ((const bake_pointwise *)user)->user;
@@ -817,7 +932,11 @@ static mk_result cylinder_eval(void *user, double amplitude, double *positions, 
     for (uint32_t v = 0; v < mesh->vertex_count; v++) {
         const float *pf = mesh->positions + 3 * (size_t)v;
         double p[3] = { pf[0], pf[1], pf[2] };
-        mk_cylinder_eval(&plan->cylinder, amplitude, plan->cylinder_coordinates + 3 * (size_t)v, p, positions + 3 * (size_t)v);
+        if (plan->op == OP_FFD_PRISM)
+            mk_prism_eval(&plan->prism, amplitude, plan->lattice_coordinates + 4 * (size_t)v, p, positions + 3 * (size_t)v);
+        else
+            mk_cylinder_eval(&plan->cylinder, amplitude, plan->lattice_coordinates + 3 * (size_t)v, p,
+                             positions + 3 * (size_t)v);
     }
     if (inverted) *inverted = 0;
     return MK_OK;
@@ -880,12 +999,12 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     snprintf(path, sizeof path, "channels[%d]", index);
     if (!cJSON_IsObject(ch)) return field_error(ctx, path, "", "must be an object%s", NULL);
     const cJSON *op = cJSON_GetObjectItemCaseSensitive(ch, "op");
-    if (!op) return field_error(ctx, path, "op", "missing (ffd, ffd_travel, ffd_keys, ffd_cylinder, taper, twist, bend, cage, laplacian or arap)%s", NULL);
+    if (!op) return field_error(ctx, path, "op", "missing (ffd, ffd_travel, ffd_keys, ffd_cylinder, ffd_prism, taper, twist, bend, cage, laplacian or arap)%s", NULL);
     if (!cJSON_IsString(op)) return field_error(ctx, path, "op", "must be a string%s", NULL);
     int k = -1;
     for (int i = 0; i < (int)(sizeof op_names / sizeof op_names[0]); i++)
         if (!strcmp(op_names[i], op->valuestring)) k = i;
-    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, ffd_travel, ffd_keys, ffd_cylinder, taper, twist, bend, cage, laplacian or arap)", op->valuestring);
+    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, ffd_travel, ffd_keys, ffd_cylinder, ffd_prism, taper, twist, bend, cage, laplacian or arap)", op->valuestring);
     plan->op = (op_kind)k;
     mk_result r = check_fields(ctx, ch, path, common_fields, op_fields[k]);
     if (r != MK_OK) return r;
@@ -933,6 +1052,7 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     case OP_FFD_TRAVEL: r = parse_ffd_travel(ctx, plan, ch, path); break;
     case OP_FFD_KEYS: r = parse_ffd_keys(ctx, plan, ch, path); break;
     case OP_FFD_CYLINDER: r = parse_ffd_cylinder(ctx, plan, ch, path); break;
+    case OP_FFD_PRISM: r = parse_ffd_prism(ctx, plan, ch, path); break;
     case OP_CAGE: r = parse_cage(ctx, plan, ch, path); break;
     case OP_LAPLACIAN: case OP_ARAP: r = parse_edit(ctx, plan, ch, path); break;
     }
@@ -998,9 +1118,9 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
         pw.map = mk_ffd_map; pw.user = &plan->ffd;
         deformer.eval = bake_pointwise_eval; deformer.user = &pw; deformer.analytic_normals = 1;
         break;
-    case OP_FFD_CYLINDER:
+    case OP_FFD_CYLINDER: case OP_FFD_PRISM:
         pw.user = plan;
-        deformer.eval = cylinder_eval; deformer.user = &pw;
+        deformer.eval = extended_ffd_eval; deformer.user = &pw;
         break;
     case OP_FFD_TRAVEL:
         pw.map = mk_ffd_travel_map; pw.user = &plan->travel;

@@ -16,6 +16,7 @@
 #include "ffd.h"
 #include "ffd_travel.h"
 #include "ffd_cylinder.h"
+#include "ffd_prism.h"
 #include "fixtures.h"
 #include "import.h"
 #include "inbetween.h"
@@ -1166,16 +1167,15 @@ static void ffd_cylinder_recipe_moved_rigidly_plays_the_rigid_motion(void)
     mk_raw_free(&raw);
 }
 
-static void ffd_cylinder_locates_every_vertex_of_corpus_meshes(void)
+/* Default lattices of an op (its fields in op_fields, e.g. "\"op\": \"ffd_cylinder\"") around
+ * the corpus's glTF and FBX meshes: Newton must locate every vertex (the bake fails naming the
+ * vertex otherwise), and the lattice turned 30 degrees about y through the origin must turn
+ * every vertex by exactly that. Skips when the corpus is absent. */
+static void extended_ffd_turns_corpus_meshes(const char *op_fields)
 {
-    /* Default lattices around real meshes: Newton must locate every vertex (the bake fails
-     * naming the vertex otherwise), and a lattice turned 30 degrees about y through the origin
-     * must turn every vertex by exactly that. */
     static const char *const files[] = { "gltf/MorphStressTest/glTF/MorphStressTest.gltf",
                                          "gltf/MorphPrimitivesTest/glTF/MorphPrimitivesTest.gltf",
                                          "fbx/zbrush_d20_7500_binary.fbx" };
-    const char *recipe = "{\"mesh\": %u, \"channels\": [{\"name\": \"turn\", \"op\": \"ffd_cylinder\", \"dims\": [3, 12, 5],"
-        " \"moves\": [{\"rotate\": {\"axis\": [0, 1, 0], \"degrees\": 30, \"pivot\": [0, 0, 0]}}]}]}";
     uint32_t meshes = 0, vertices = 0;
     for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
         char path[4200];
@@ -1191,7 +1191,9 @@ static void ffd_cylinder_locates_every_vertex_of_corpus_meshes(void)
             CHECK_MSG(r == MK_OK, "%s: %s", files[f], err.message);
             if (r != MK_OK || mesh >= raw.mesh_count) { mk_raw_free(&raw); break; }
             char text[512];
-            snprintf(text, sizeof text, recipe, mesh);
+            snprintf(text, sizeof text, "{\"mesh\": %u, \"channels\": [{\"name\": \"turn\", %s,"
+                     " \"moves\": [{\"rotate\": {\"axis\": [0, 1, 0], \"degrees\": 30, \"pivot\": [0, 0, 0]}}]}]}",
+                     mesh, op_fields);
             r = bake(&raw, text, &err);
             CHECK_MSG(r == MK_OK, "%s mesh %u: %s", files[f], mesh, err.message);
             const mk_raw_channel *ch = r == MK_OK ? find_channel(&raw, "turn") : NULL;
@@ -1214,8 +1216,248 @@ static void ffd_cylinder_locates_every_vertex_of_corpus_meshes(void)
             mk_raw_free(&raw);
         }
     }
-    fprintf(stderr, "ffd_cylinder on the corpus: %u meshes, %u vertices located, each turned rigidly\n", meshes, vertices);
+    fprintf(stderr, "%s on the corpus: %u meshes, %u vertices located, each turned rigidly\n", op_fields, meshes, vertices);
     CHECK(meshes >= 5 && vertices > 1000);
+}
+
+static void ffd_cylinder_locates_every_vertex_of_corpus_meshes(void)
+{
+    extended_ffd_turns_corpus_meshes("\"op\": \"ffd_cylinder\", \"dims\": [3, 12, 5]");
+}
+
+/* ---- extended FFD: prism lattice ---- */
+
+/* A small deterministic generator for random lattice moves: uniform in [-1, 1]. */
+static double prism_random(uint64_t *state)
+{
+    *state = *state * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(*state >> 11) / (double)(1ull << 52) - 1;
+}
+
+/* Largest distance between p moved by the lattice and M p + t over the mesh (coords from
+ * mk_prism_coordinates), after setting every control point's displacement to M P + t - P. */
+static double prism_affine_error(mk_prism_lattice *c, double *d, const double *rest, const mk_raw_mesh *m,
+                                 const double *coords, const double M[9], const double t[3])
+{
+    uint32_t points = mk_prism_point_count(c);
+    for (uint32_t q = 0; q < points; q++) {
+        double MP[3];
+        mat3_mul_vec(MP, M, rest + 3 * q);
+        for (int x = 0; x < 3; x++) d[3 * q + x] = MP[x] + t[x] - rest[3 * q + x];
+    }
+    double worst = 0;
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, out[3], e[3];
+        mk_prism_eval(c, 1, coords + 4 * v, p, out);
+        mat3_mul_vec(e, M, p);
+        for (int x = 0; x < 3; x++) worst = fmax(worst, fabs(out[x] - e[x] - t[x]));
+    }
+    return worst;
+}
+
+/* The prism lattice c (prepared, around the unit sphere m, z from -1.1 to 1.1) located for every
+ * vertex with its regular and with a curved rest lattice, moved rigidly and affinely, and
+ * sampled across every seam with random moves. */
+static void prism_lattice_checks(mk_prism_lattice c, const mk_raw_mesh *m, const char *label)
+{
+    mk_error err;
+    uint32_t points = mk_prism_point_count(&c);
+    CHECK_EQ_INT(points, c.layers * (1 + c.sides * c.degree * (c.degree + 1) / 2));
+    double *d = calloc(3 * points, sizeof(double)), *rest = malloc(3 * points * sizeof(double));
+    double *coords = malloc(4 * m->vertex_count * sizeof(double));
+    for (uint32_t k = 0; k < c.layers; k++)
+        for (uint32_t i = 0; i <= c.degree; i++)
+            for (uint32_t j = 0; j < (i ? c.sides * i : 1); j++)
+                mk_prism_control_point(&c, i, j, k, rest + 3 * mk_prism_index(&c, i, j, k));
+    c.displacements = d;
+    double diag = diag_of(m), identity = 0, rigid, affine;
+    for (int pass = 0; pass < 2; pass++) {
+        /* pass 0: the regular rest lattice (affine per wedge); pass 1: a curved rest lattice
+         * (every rest point bent off the grid), where Newton has to iterate. */
+        if (pass) {
+            for (uint32_t q = 0; q < points; q++) {
+                double *P = rest + 3 * q;
+                double z = P[2], x = P[0];
+                P[0] += 0.04 * sin(2 * z) * (1 + 0.2 * P[1]);
+                P[1] += 0.04 * cos(1.5 * z + x);
+                P[2] += 0.03 * sin(x + P[1]);
+            }
+            c.rest = rest;
+        }
+        uint32_t most = 0, failed = 0, wedges[64] = { 0 }, fewest = UINT32_MAX;
+        double residual = 0;
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, F[3], e[3];
+            uint32_t it = 0;
+            if (mk_prism_coordinates(&c, p, coords + 4 * v, &it, &err) != MK_OK) {
+                if (!failed) fprintf(stderr, "vertex %u: %s\n", v, err.message);
+                failed++;
+                continue;
+            }
+            /* Independent check of the inversion: the rest map at the coordinates is the vertex. */
+            mk_prism_rest_map(&c, (uint32_t)coords[4 * v], coords + 4 * v + 1, F, NULL);
+            vec3_sub(e, F, p);
+            residual = fmax(residual, vec3_length(e));
+            wedges[(uint32_t)coords[4 * v]]++;
+            if (it > most) most = it;
+        }
+        for (uint32_t w = 0; w < c.sides; w++) fewest = wedges[w] < fewest ? wedges[w] : fewest;
+        fprintf(stderr, "prism lattice, %s (%s rest): Newton converged for %u of %u vertices, at most %u iterations, "
+                "residual %.3g x diagonal, at least %u vertices per wedge\n", label, pass ? "curved" : "regular",
+                m->vertex_count - failed, m->vertex_count, most, residual / diag, fewest);
+        CHECK_EQ_INT(failed, 0);
+        CHECK(residual <= 1e-9 * diag);
+        CHECK(fewest > 300);
+        if (pass) CHECK(most >= 2);  /* the curved lattice really needs Newton */
+        /* Unmoved: the identity; rigid and affine moves of every control point: that map. */
+        memset(d, 0, 3 * points * sizeof(double));
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            double p[3] = { m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2] }, out[3];
+            mk_prism_eval(&c, 1, coords + 4 * v, p, out);
+            for (int x = 0; x < 3; x++) identity = fmax(identity, fabs(out[x] - p[x]));
+        }
+        double axis[3] = { 0.3, -0.5, 0.8 }, R[9], t[3] = { 0.2, -0.1, 0.4 };
+        vec3_normalize(axis);
+        mat3_rotation(R, axis, 0.9);
+        double A[9] = { 1.2, 0.3, -0.1, 0.05, 0.8, 0.2, -0.2, 0.1, 1.1 };
+        rigid = prism_affine_error(&c, d, rest, m, coords, R, t);
+        affine = prism_affine_error(&c, d, rest, m, coords, A, t);
+        fprintf(stderr, "prism lattice, %s (%s rest): identity error %.3g, rigid %.3g, affine %.3g x diagonal\n",
+                label, pass ? "curved" : "regular", identity / diag, rigid / diag, affine / diag);
+        CHECK(identity <= 1e-6 * diag);
+        CHECK_MSG(rigid <= 1e-6 * diag, "rigid lattice motion moves the mesh %g x diagonal off", rigid / diag);
+        CHECK_MSG(affine <= 1e-6 * diag, "affine lattice motion moves the mesh %g x diagonal off", affine / diag);
+    }
+    /* Seams: every control point moved at random (0.2 of the radius); points 1e-7 either side
+     * of each shared face land within 1e-6 x diagonal, and do lie in different wedges. */
+    c.rest = NULL;
+    uint64_t state = 7;
+    for (uint32_t q = 0; q < 3 * points; q++) d[q] = 0.2 * prism_random(&state);
+    double gap = 0;
+    uint32_t seam_failures = 0, crossings = 0;
+    for (uint32_t w = 0; w < c.sides; w++)
+        for (int z = 0; z <= 10; z++)
+            for (int r = 1; r <= 10; r++) {
+                /* Along the spoke of corner w (the shared face), 1e-7 off it in the section's plane. */
+                double V[3], side[2][3], coord[2][4];
+                mk_prism_control_point(&c, c.degree, w * c.degree, 0, V);
+                vec3_sub(V, V, c.center);
+                for (int sgn = 0; sgn < 2; sgn++) {
+                    double along = 0.099 * r, off = (sgn ? 1e-7 : -1e-7) / vec3_length(V);
+                    double p[3] = { along * V[0] - off * V[1], along * V[1] + off * V[0], -1.1 + 0.22 * z };
+                    seam_failures += mk_prism_coordinates(&c, p, coord[sgn], NULL, &err) != MK_OK;
+                    mk_prism_eval(&c, 1, coord[sgn], p, side[sgn]);
+                }
+                crossings += coord[0][0] != coord[1][0];
+                double g[3];
+                vec3_sub(g, side[0], side[1]);
+                gap = fmax(gap, vec3_length(g));
+            }
+    fprintf(stderr, "prism lattice, %s: %u seam samples (%u crossing wedges), largest gap %.3g x diagonal\n",
+            label, c.sides * 11 * 10, crossings, gap / diag);
+    CHECK_EQ_INT(seam_failures, 0);
+    CHECK_EQ_INT(crossings, c.sides * 11 * 10);
+    CHECK(gap <= 1e-6 * diag);
+    /* Outside, and bad lattices, are errors. */
+    double far[3] = { 0, 0, 5 }, side_out[3] = { 1.8, 0.1, 0 }, q[4];
+    CHECK(mk_prism_coordinates(&c, far, q, NULL, &err) != MK_OK && strstr(err.message, "outside"));
+    CHECK(mk_prism_coordinates(&c, side_out, q, NULL, &err) != MK_OK && strstr(err.message, "outside"));
+    mk_prism_lattice bad = c;
+    bad.sides = 2;
+    CHECK(mk_prism_prepare(&bad, &err) != MK_OK && strstr(err.message, "sides"));
+    bad = c;
+    bad.degree = 0;
+    CHECK(mk_prism_prepare(&bad, &err) != MK_OK && strstr(err.message, "degree"));
+    bad = c;
+    bad.axis[2] = 0;
+    CHECK(mk_prism_prepare(&bad, &err) != MK_OK && strstr(err.message, "axis"));
+    free(d); free(rest); free(coords);
+}
+
+static void prism_lattice_inverts_moves_affinely_and_is_seamless(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_raw_mesh *m = fixture_icosphere(&raw, "ball", 1, 4);
+    /* Around the unit sphere: a hexagon whose sides are 1.1 from the centre, and an irregular
+     * pentagon (corners at 0, 80, 150, 215 and 290 degrees, 1.45 to 1.7 from the centre). */
+    mk_prism_lattice c = { .sides = 6, .degree = 3, .layers = 4, .center = { 0, 0, -1.1 }, .axis = { 0, 0, 2.2 },
+                           .reference = { 1, 0, 0 }, .radius = 1.1 / cos(PI / 6) };
+    mk_error err;
+    CHECK(mk_prism_prepare(&c, &err) == MK_OK);
+    prism_lattice_checks(c, m, "hexagon");
+    static const double degrees[5] = { 0, 80, 150, 215, 290 }, radii[5] = { 1.5, 1.6, 1.45, 1.7, 1.55 };
+    double section[10];
+    for (int w = 0; w < 5; w++) {
+        section[2 * w] = radii[w] * cos(degrees[w] * PI / 180);
+        section[2 * w + 1] = radii[w] * sin(degrees[w] * PI / 180);
+    }
+    mk_prism_lattice p = { .sides = 5, .degree = 2, .layers = 3, .center = { 0, 0, -1.1 }, .axis = { 0, 0, 2.2 },
+                           .reference = { 1, 0, 0 }, .section = section };
+    CHECK(mk_prism_prepare(&p, &err) == MK_OK);
+    prism_lattice_checks(p, m, "pentagon");
+    /* Sections that are not star-shaped from the centre are errors. */
+    double swapped[10];
+    memcpy(swapped, section, sizeof section);
+    swapped[2] = section[4]; swapped[3] = section[5]; swapped[4] = section[2]; swapped[5] = section[3];
+    p.section = swapped;
+    CHECK(mk_prism_prepare(&p, &err) != MK_OK && strstr(err.message, "section: corners"));
+    mk_raw_free(&raw);
+}
+
+/* One linear target of the affine map M p + t, played at weight w: p + w (M p + t - p). */
+typedef struct affine_map { double M[9], t[3]; } affine_map;
+
+static void affine_blend(const void *user, double w, const double p[3], double q[3], double J[9])
+{
+    const affine_map *a = user;
+    double m[3];
+    mat3_mul_vec(m, a->M, p);
+    for (int c = 0; c < 3; c++) q[c] = p[c] + w * (m[c] + a->t[c] - p[c]);
+    memcpy(J, a->M, sizeof a->M);
+}
+
+static void ffd_prism_recipe_moved_rigidly_or_affinely_plays_that_map(void)
+{
+    /* Every control point turned 40 degrees about x through (0, 0, 2) and moved by (0.3, 0, -0.2)
+     * (turn_blend) in a pentagonal lattice (regular, or with its rest shaped by rest_moves), or scaled by (1.2, 0.8, 1.1) about the origin, turned
+     * 25 degrees about z and moved by (0.1, 0.2, 0.3) in an irregular hexagonal one: through the runtime, the tube at every weight is the tube blended
+     * towards that map. */
+    const char *recipes[3] = {
+        "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"turn\", \"op\": \"ffd_prism\", \"axis\": \"z\","
+        " \"center\": [0, 0, 2], \"sides\": 5, \"degree\": 2, \"layers\": 3, \"moves\": [{\"translate\": [0.3, 0, -0.2],"
+        " \"rotate\": {\"axis\": [1, 0, 0], \"degrees\": 40, \"pivot\": [0, 0, 2]}}]}]}",
+        /* the same turn of a rest lattice shaped off the grid (middle bulged, top twisted) */
+        "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"turn\", \"op\": \"ffd_prism\", \"axis\": \"z\","
+        " \"center\": [0, 0, 2], \"sides\": 5, \"degree\": 2, \"layers\": 4, \"rest_moves\": [{\"i\": 2, \"k\": [1, 2],"
+        " \"scale\": [1.25, 1.25, 1]}, {\"k\": 3, \"rotate\": {\"axis\": [0, 0, 1], \"degrees\": 20}}],"
+        " \"moves\": [{\"translate\": [0.3, 0, -0.2], \"rotate\": {\"axis\": [1, 0, 0], \"degrees\": 40, \"pivot\": [0, 0, 2]}}]}]}",
+        "{\"mesh\": \"tube\", \"channels\": [{\"name\": \"shear\", \"op\": \"ffd_prism\", \"axis\": \"z\","
+        " \"section\": [[1.4, 0], [0.5, 1.4], [-0.7, 1.2], [-1.5, 0], [-0.5, -1.5], [0.7, -1.3]], \"degree\": 3, \"moves\": [{\"scale\": [1.2, 0.8, 1.1], \"pivot\": [0, 0, 0], \"translate\": [0.1, 0.2, 0.3],"
+        " \"rotate\": {\"axis\": [0, 0, 1], \"degrees\": 25, \"pivot\": [0, 0, 0]}}]}]}" };
+    affine_map shear = { .t = { 0.1, 0.2, 0.3 } };
+    double R[9], S[9] = { 1.2, 0, 0, 0, 0.8, 0, 0, 0, 1.1 }, z[3] = { 0, 0, 1 };
+    mat3_rotation(R, z, 25 * PI / 180);
+    mat3_mul(shear.M, R, S);
+    static const char *const labels[3] = { "rigid", "rigid (shaped rest)", "affine" };
+    for (int k = 0; k < 3; k++) {
+        mk_raw_asset raw;
+        const mk_raw_mesh *m = baked_cylinder(&raw, "tube", 1, 4, 16, 8, recipes[k]);
+        if (!m) return;
+        CHECK_EQ_INT(raw.channels[0].target_count, 1);
+        mk_asset asset;
+        if (!write_and_open(&raw, &asset)) { mk_raw_free(&raw); return; }
+        double worst = k == 2 ? playback_error(&asset, m, 0, 1, affine_blend, &shear)
+                              : playback_error(&asset, m, 0, 1, turn_blend, NULL);
+        fprintf(stderr, "ffd_prism %s lattice motion through the runtime: %.3g x diagonal\n", labels[k], worst / diag_of(m));
+        CHECK_MSG(worst <= 1e-6 * diag_of(m) + 2e-6, "off the map by %g", worst);
+        mk_raw_free(&raw);
+    }
+}
+
+static void ffd_prism_locates_every_vertex_of_corpus_meshes(void)
+{
+    extended_ffd_turns_corpus_meshes("\"op\": \"ffd_prism\", \"sides\": 5, \"degree\": 3, \"layers\": 5");
 }
 
 static void fixed_inbetweens_and_linear_ops(void)
@@ -1307,6 +1549,56 @@ static void bad_arap_and_animated_ffd_recipes_name_the_field(void)
           "channels[0].reference: parallel" },
         { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_cylinder\", \"radius\": 1e999}]}",
           "channels[0].radius" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"axis\": \"z\", \"radius\": 0.5}]}",
+          "channels[0]: vertex 0 (1, 0, 0): outside the lattice" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"sides\": 4, \"section\": [[2, 0], [0, 2], [-2, 0]]}]}",
+          "channels[0].sides: give either section or sides and radius" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"section\": [[2, 0], [0, 2]]}]}",
+          "channels[0].section: must be an array of 3..64 corners" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"section\": [[2, 0], [0, 2, 1], [-2, 0]]}]}",
+          "channels[0].section[1]: must be a corner [x, y]" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"section\": [[2, 0], [0, 1e999], [-2, 0]]}]}",
+          "channels[0].section[1]: holds a value that is not finite" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"section\": [[2, 0], [0, -2], [-2, 0], [0, 2]]}]}",
+          "channels[0].section: corners 0 and 1 do not turn counter-clockwise" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"section\": [[2, 0], [-1, 1.7], [-1, -1.7], [2, 0.01], [-1, 1.7], [-1, -1.7]]}]}",
+          "channels[0].section: the corners go 2 times round the centre" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"rest_moves\": [{\"i\": 5}]}]}",
+          "channels[0].rest_moves[0].i: must lie in 0..2" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"rest_moves\": 3}]}",
+          "channels[0].rest_moves: must be an array" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"rest_moves\": [{\"i\": 2, \"scale\": 0.5}]}]}",
+          "channels[0]: vertex" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"sides\": 2}]}",
+          "channels[0].sides: must be an integer in 3..64" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"sides\": \"six\"}]}",
+          "channels[0].sides" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"degree\": 0}]}",
+          "channels[0].degree: must be an integer in 1..16" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"degree\": 1.5}]}",
+          "channels[0].degree" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"layers\": 1}]}",
+          "channels[0].layers" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"dims\": [3, 6, 4]}]}",
+          "channels[0].dims: unknown field" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"radius\": 1e999}]}",
+          "channels[0].radius" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"radius\": -1}]}",
+          "channels[0].radius: must be > 0" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"center\": [0, 1e999, 0]}]}",
+          "channels[0].center" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"moves\": [{\"i\": 3}]}]}",
+          "channels[0].moves[0].i: must lie in 0..2" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"moves\": [{\"i\": [1, 2], \"j\": 6}]}]}",
+          "channels[0].moves[0].j: must lie in 0..5" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"moves\": [{\"j\": 1}]}]}",
+          "channels[0].moves[0].j: must lie in 0..0" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"moves\": [{\"k\": 4}]}]}",
+          "channels[0].moves[0].k" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"moves\": [{\"translate\": [0, 1e999, 0]}]}]}",
+          "channels[0].moves[0].translate" },
+        { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_prism\", \"axis\": \"z\", \"reference\": [0, 0, 2]}]}",
+          "channels[0].reference: parallel" },
         { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_travel\"}]}",
           "channels[0].travel: missing" },
         { "{\"mesh\": 0, \"channels\": [{\"op\": \"ffd_keys\"}]}",
@@ -1404,7 +1696,7 @@ static void record_channels(void *user, const mk_bake_channel_report *c)
 static void sample_recipes_bake(void)
 {
     static const char *const names[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json",
-                                         "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json" };
+                                         "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json", "ffd_prism.json" };
     const char *root = getenv("MORPHKIT_SOURCE_ROOT");
     if (!root) root = MK_SOURCE_ROOT;
     char dir[4096];
@@ -1555,6 +1847,9 @@ CHECK_MAIN(CASE(identity_deformations_give_zero_deltas),
            CASE(cylinder_lattice_inverts_moves_rigidly_and_is_seamless),
            CASE(ffd_cylinder_recipe_moved_rigidly_plays_the_rigid_motion),
            CASE(ffd_cylinder_locates_every_vertex_of_corpus_meshes),
+           CASE(prism_lattice_inverts_moves_affinely_and_is_seamless),
+           CASE(ffd_prism_recipe_moved_rigidly_or_affinely_plays_that_map),
+           CASE(ffd_prism_locates_every_vertex_of_corpus_meshes),
            CASE(bad_recipes_name_the_field),
            CASE(bad_arap_and_animated_ffd_recipes_name_the_field),
            CASE(bake_keeps_existing_channels))

@@ -1,0 +1,70 @@
+/* SPDX-License-Identifier: MIT */
+/* Bernstein basis, 3x3 solve and damped Newton iteration for the extended FFD lattices.
+ *
+ * Newton on a rest map F (Coquillart's extended FFD: a block whose rest shape is not affine has
+ * no closed-form local coordinates): q <- q - lambda J(q)^-1 (F(q) - p), lambda = 1, 1/2, 1/4 ...
+ * until |F - p| falls (at most 30 halvings; the last trial is taken either way), each trial
+ * clamped into the caller's box so a far start cannot run off the block. */
+#include <math.h>
+#include <string.h>
+#include "lattice_newton.h"
+#include "bake_util.h"
+
+double bake_bernstein_value(int n, int i, double x)
+{
+    if (i < 0 || i > n) return 0;
+    double binomial = 1;
+    for (int k = 1; k <= i; k++) binomial = binomial * (n - i + k) / k;
+    return binomial * pow(x, i) * pow(1 - x, n - i);
+}
+
+void bake_bernstein(uint32_t points, double x, double *w, double *dw)
+{
+    int deg = (int)points - 1;
+    for (int i = 0; i <= deg; i++) {
+        w[i] = bake_bernstein_value(deg, i, x);
+        dw[i] = deg * (bake_bernstein_value(deg - 1, i - 1, x) - bake_bernstein_value(deg - 1, i, x));
+    }
+}
+
+int bake_solve3(const double J[9], const double b[3], double x[3])
+{
+    double det = mat3_det(J), size = 0;
+    for (int i = 0; i < 9; i++) size = fmax(size, fabs(J[i]));
+    if (!(fabs(det) > 1e-14 * size * size * size)) return 0;
+    double cof[9];
+    mat3_cofactor(cof, J);  /* cof(J) = det(J) J^-T */
+    for (int r = 0; r < 3; r++) x[r] = (cof[r] * b[0] + cof[3 + r] * b[1] + cof[6 + r] * b[2]) / det;
+    return 1;
+}
+
+double bake_newton_solve(const bake_newton *n, const double p[3], double q[3], uint32_t *iterations)
+{
+    double f[3], J[9], res = INFINITY;
+    uint32_t it = 0;
+    for (;; it++) {
+        n->map(n->user, q, f, J);
+        vec3_sub(f, f, p);
+        res = vec3_length(f);
+        if (res <= n->target || it == n->max_iterations) break;
+        double step[3];
+        if (!bake_solve3(J, f, step)) {
+            /* Singular (e.g. a coordinate that is free on an axis): solve for the other two. */
+            if (n->held < 0) break;
+            int a = (n->held + 1) % 3, b = (n->held + 2) % 3;
+            double A[9] = { J[a], J[b], 0, J[3 + a], J[3 + b], 0, J[6 + a], J[6 + b], 1 }, sol[3];
+            if (!bake_solve3(A, f, sol)) break;
+            step[n->held] = 0; step[a] = sol[0]; step[b] = sol[1];
+        }
+        double lambda = 1, trial[3], g[3];
+        for (int h = 0; h < 30; h++, lambda *= 0.5) {
+            for (int k = 0; k < 3; k++) trial[k] = fmin(fmax(q[k] - lambda * step[k], n->lower[k]), n->upper[k]);
+            n->map(n->user, trial, g, NULL);
+            vec3_sub(g, g, p);
+            if (vec3_length(g) < res) break;
+        }
+        memcpy(q, trial, sizeof trial);
+    }
+    if (iterations) *iterations = it;
+    return res;
+}

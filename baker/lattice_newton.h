@@ -1,0 +1,38 @@
+/* SPDX-License-Identifier: MIT */
+/* Pieces shared by the extended FFD lattices (ffd_cylinder.c, ffd_prism.c): the Bernstein basis
+ * with its derivative, a 3x3 solve, and the damped Newton iteration that inverts a lattice
+ * block's rest map. Internal to baker/. */
+#ifndef BAKE_LATTICE_NEWTON_H
+#define BAKE_LATTICE_NEWTON_H
+
+#include <stdint.h>
+
+/* Bernstein weights of degree points-1 at x (w[0..points-1]) and their derivatives d/dx,
+ * deg (B_{i-1}^{deg-1} - B_i^{deg-1}). */
+void bake_bernstein(uint32_t points, double x, double *w, double *dw);
+
+/* Bernstein polynomial C(n, i) x^i (1 - x)^(n - i); 0 for i outside 0..n. */
+double bake_bernstein_value(int n, int i, double x);
+
+/* Solves J x = b for a 3x3 row-major J by Cramer's rule; 0 when J is singular relative to its
+ * size (|det J| <= 1e-14 max|J_ij|^3). */
+int bake_solve3(const double J[9], const double b[3], double x[3]);
+
+/* A block's rest map F(q) and, when J is not NULL, its Jacobian (row-major, column c = dF/dq_c). */
+typedef void (*bake_rest_map)(const void *user, const double q[3], double F[3], double J[9]);
+
+typedef struct bake_newton {
+    bake_rest_map map;
+    const void *user;
+    double lower[3], upper[3];  /* every trial point is clamped into [lower, upper] */
+    int held;                   /* coordinate left unchanged when J is singular; -1: stop there */
+    double target;              /* converged when |F(q) - p| <= target */
+    uint32_t max_iterations;
+} bake_newton;
+
+/* Damped Newton's method for F(q) = p starting from q: each step solves J step = F(q) - p and
+ * is halved (up to 30 times) until the residual falls. Returns the final |F(q) - p|; q holds
+ * the last iterate and *iterations (if not NULL) the number of steps taken. */
+double bake_newton_solve(const bake_newton *newton, const double p[3], double q[3], uint32_t *iterations);
+
+#endif
