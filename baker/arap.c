@@ -112,7 +112,7 @@ static mk_result global_step(mk_surface_edit *s, int identity, mk_error *err)
         memcpy(s->solution, s->target, 3 * (size_t)n * sizeof(double));
         return MK_OK;
     }
-    double *b = s->rhs->x;
+    double *b = s->spd.rhs->x;
     memset(b, 0, 3 * (size_t)nu * sizeof(double));
     double w2 = s->params.soft ? s->params.soft_weight * s->params.soft_weight : 0;
     for (uint32_t i = 0; i < n; i++) {
@@ -143,7 +143,7 @@ static mk_result global_step(mk_surface_edit *s, int identity, mk_error *err)
     }
     mk_result r = edit_solve(s, err);
     if (r != MK_OK) return r;
-    const double *x = s->x->x;
+    const double *x = s->spd.x->x;
     for (uint32_t v = 0; v < n; v++)
         for (int c = 0; c < 3; c++) {
             size_t i = 3 * (size_t)v + (size_t)c;
