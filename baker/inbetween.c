@@ -196,6 +196,17 @@ static mk_result write_target(mk_raw_asset *raw, mk_raw_channel *channel, uint32
         if (r != MK_OK) return r;
         if (inv > *inverted) *inverted = inv;
     }
+    return bake_store_target(raw, channel, mesh_index, weight, name, diagonal, pos, want_normals ? nrm : NULL,
+                             want_tangents ? tan : NULL, moved, err);
+}
+
+mk_result bake_store_target(mk_raw_asset *raw, mk_raw_channel *channel, uint32_t mesh_index, double weight,
+                            const char *name, double diagonal, const double *pos, const double *nrm,
+                            const double *tan, uint32_t *moved, mk_error *err)
+{
+    const mk_raw_mesh *mesh = &raw->meshes[mesh_index];
+    size_t n = mesh->vertex_count;
+    int want_normals = nrm != NULL, want_tangents = tan != NULL;
     double eps_p = 1e-7 * diagonal, eps_n = 1e-6;
     uint32_t count = 0;
     for (size_t v = 0; v < n; v++) {
