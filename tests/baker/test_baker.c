@@ -1401,10 +1401,18 @@ static void record_channels(void *user, const mk_bake_channel_report *c)
 
 /* Every recipe in samples/recipes bakes on a tube like samples/make_example's (radius 0.5,
  * y from 0 to 2), including the cage OBJ files that resolve against the recipe directory. */
+/* mk_bake_options.load_asset for the samples: whatever the importer reads. */
+static mk_result import_asset(void *user, const char *path, mk_raw_asset *out, mk_error *err)
+{
+    (void)user;
+    mk_import_options io = { .keep_plain_meshes = 1 };
+    return mk_import_file(path, &io, out, err);
+}
+
 static void sample_recipes_bake(void)
 {
     static const char *const names[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json",
-                                         "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json" };
+                                         "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json", "transfer.json" };
     const char *root = getenv("MORPHKIT_SOURCE_ROOT");
     if (!root) root = MK_SOURCE_ROOT;
     char dir[4096];
@@ -1435,6 +1443,7 @@ static void sample_recipes_bake(void)
             memset(&o, 0, sizeof o);
             o.base_dir = dir;
             o.channel_done = record_channels;
+            o.load_asset = import_asset;
             o.user = &rec;
             mk_bake_report rep;
             mk_error err;
