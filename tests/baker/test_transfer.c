@@ -77,13 +77,28 @@ static double diagonal(const mk_raw_mesh *m)
     return d;
 }
 
-/* Source: unit icosphere with a 2-target channel (in-between at 0.5). */
-static void make_source(mk_raw_asset *src)
+/* A sheared, leaning shape (one target). */
+static void lean(double w, const double p[3], double q[3])
 {
-    static const float weights[] = { 0.5f, 1.0f };
-    mk_raw_init(src, NULL);
+    q[0] = p[0] + 0.3 * w * (p[2] + 1) * (p[2] + 1) / 4;
+    q[1] = p[1];
+    q[2] = p[2];
+}
+
+/* Source (into an initialized raw): unit icosphere with a 2-target channel "bulge" (in-between
+ * at 0.5) and a 1-target channel "lean". */
+static void build_source(mk_raw_asset *src)
+{
+    static const float weights[] = { 0.5f, 1.0f }, one[] = { 1.0f };
     fixture_icosphere(src, "source", 1, 3);
     add_shape_channel(src, 0, "bulge", bulge_twist, weights, 2);
+    add_shape_channel(src, 0, "lean", lean, one, 1);
+}
+
+static void make_source(mk_raw_asset *src)
+{
+    mk_raw_init(src, NULL);
+    build_source(src);
 }
 
 /* Transfers every target of source channel 0 with the C API and returns the largest distance
@@ -255,6 +270,191 @@ static void transfer_onto_a_remeshed_sheet_follows_the_source_surface(void)
     CHECK(e2 < e1);
 }
 
+/* ---- the recipe op ---- */
+
+/* mk_bake_options.load_asset for the tests: models built in memory, by file name. */
+static mk_result load_fixture(void *user, const char *path, mk_raw_asset *out, mk_error *err)
+{
+    (void)user;
+    if (strstr(path, "missing"))
+        return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "cannot open %s", path);
+    if (strstr(path, "plain")) {
+        fixture_icosphere(out, "plain", 1, 1);
+        return MK_OK;
+    }
+    build_source(out);
+    return MK_OK;
+}
+
+static mk_result bake_transfer(mk_raw_asset *raw, const char *recipe, mk_error *err)
+{
+    mk_bake_options o;
+    memset(&o, 0, sizeof o);
+    o.base_dir = "fixtures";
+    o.load_asset = load_fixture;
+    mk_bake_report rep;
+    return mk_bake_recipe(raw, recipe, strlen(recipe), &o, &rep, err);
+}
+
+static const mk_raw_channel *channel_named(const mk_raw_asset *raw, const char *name, uint32_t *index)
+{
+    for (uint32_t c = 0; c < raw->channel_count; c++)
+        if (raw->channels[c].name && !strcmp(raw->channels[c].name, name)) {
+            *index = c;
+            return &raw->channels[c];
+        }
+    return NULL;
+}
+
+/* Largest distance between the runtime's playback of `channel` at weight w (others 0) and
+ * `expected` (3 doubles per vertex), mesh units. */
+static double played_distance(const mk_asset *asset, uint32_t channel, uint32_t channel_count, float w,
+                              const double *expected, uint32_t n)
+{
+    size_t scratch_size = mk_eval_scratch_size(asset, 0);
+    void *scratch = scratch_size ? aligned_alloc(16, (scratch_size + 15) / 16 * 16) : NULL;
+    float *out = malloc(3 * (size_t)n * sizeof(float)), *weights = calloc(channel_count, sizeof(float));
+    weights[channel] = w;
+    mk_eval_job job = { .asset = asset, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = weights,
+                        .weight_count = channel_count, .scratch = scratch, .scratch_size = scratch_size,
+                        .positions = out, .positions_size = 3 * (size_t)n * sizeof(float) };
+    mk_error err;
+    mk_result r = mk_eval_run(&job, &err);
+    CHECK_MSG(r == MK_OK, "eval: %s", err.message);
+    double worst = r == MK_OK ? 0 : INFINITY;
+    for (uint32_t v = 0; v < n && r == MK_OK; v++) {
+        double e2 = 0;
+        for (int c = 0; c < 3; c++) e2 += (out[3 * v + c] - expected[3 * v + c]) * (out[3 * v + c] - expected[3 * v + c]);
+        worst = fmax(worst, sqrt(e2));
+    }
+    free(out);
+    free(weights);
+    free(scratch);
+    return worst;
+}
+
+static void recipe_carries_inbetweens_and_names_and_plays_through_the_runtime(void)
+{
+    mk_raw_asset raw, src;
+    mk_raw_init(&raw, NULL);
+    make_source(&src);
+    mk_raw_mesh *tg = fixture_icosphere(&raw, "target", 1, 3);
+    mk_error err;
+    mk_result r = bake_transfer(&raw, "{\"mesh\": \"target\", \"channels\": [{\"op\": \"transfer\", "
+                                      "\"source\": \"src.gltf\", \"prefix\": \"t_\"}]}", &err);
+    CHECK_MSG(r == MK_OK, "bake: %s", err.message);
+    uint32_t ib = 0, il = 0;
+    const mk_raw_channel *bulge = channel_named(&raw, "t_bulge", &ib), *leaning = channel_named(&raw, "t_lean", &il);
+    CHECK(raw.channel_count == 2 && bulge && leaning);
+    if (r != MK_OK || !bulge || !leaning) { mk_raw_free(&raw); mk_raw_free(&src); return; }
+    /* in-betweens 1:1 at the source's full weights, names, default weight, normals */
+    CHECK_EQ_INT(bulge->target_count, 2);
+    CHECK_EQ_INT(leaning->target_count, 1);
+    CHECK(bulge->target_count == 2 && bulge->targets[0].full_weight == 0.5f && bulge->targets[1].full_weight == 1.0f);
+    CHECK(bulge->target_count == 2 && !strcmp(bulge->targets[1].name, "t_bulge") && !strcmp(bulge->targets[0].name, "t_bulge@0.5"));
+    CHECK(bulge->default_weight == 0.25f);
+    CHECK(bulge->targets[0].normals != NULL);
+    CHECK(strstr(bulge->origin, "\"op\":\"transfer\"") != NULL);
+    /* played through the runtime: at each key weight the source's shape, between keys the
+     * linear blend of the neighbouring keys */
+    mk_write_options wo = { .precision = MK_PRECISION_FLOAT };
+    void *blob = NULL;
+    size_t size = 0;
+    mk_asset asset;
+    r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, NULL, &err);
+    if (r == MK_OK) r = mk_asset_open(blob, size, &asset, &err);
+    CHECK_MSG(r == MK_OK, "write/open: %s", err.message);
+    uint32_t n = tg->vertex_count;
+    double *k0 = calloc(3 * (size_t)n, sizeof(double)), *k1 = calloc(3 * (size_t)n, sizeof(double)),
+           *mid = calloc(3 * (size_t)n, sizeof(double));
+    target_positions(&src.meshes[0], &src.channels[0].targets[0], k0);
+    target_positions(&src.meshes[0], &src.channels[0].targets[1], k1);
+    double worst = 0;
+    if (r == MK_OK) {
+        worst = fmax(worst, played_distance(&asset, ib, 2, 0.5f, k0, n));
+        worst = fmax(worst, played_distance(&asset, ib, 2, 1.0f, k1, n));
+        for (size_t i = 0; i < 3 * (size_t)n; i++) mid[i] = 0.5 * (k0[i] + k1[i]);
+        worst = fmax(worst, played_distance(&asset, ib, 2, 0.75f, mid, n));
+        for (size_t i = 0; i < 3 * (size_t)n; i++) mid[i] = 0.5 * (tg->positions[i] + k0[i]);
+        worst = fmax(worst, played_distance(&asset, ib, 2, 0.25f, mid, n));
+        target_positions(&src.meshes[0], &src.channels[1].targets[0], k1);
+        worst = fmax(worst, played_distance(&asset, il, 2, 1.0f, k1, n));
+    }
+    worst /= diagonal(tg);
+    printf("recipe onto a copy: played at weights 0.25, 0.5, 0.75, 1 vs the source's shapes: %.3g x diagonal\n", worst);
+    CHECK(worst <= 1e-4);
+    free(k0); free(k1); free(mid);
+
+    /* "channels" picks source channels; default_weight overrides the source's */
+    mk_raw_asset one;
+    mk_raw_init(&one, NULL);
+    fixture_icosphere(&one, "target", 1, 3);
+    r = bake_transfer(&one, "{\"mesh\": 0, \"channels\": [{\"op\": \"transfer\", \"source\": \"src.gltf\", "
+                             "\"channels\": [\"lean\"], \"default_weight\": 0.5}]}", &err);
+    CHECK_MSG(r == MK_OK, "bake: %s", err.message);
+    CHECK(one.channel_count == 1 && !strcmp(one.channels[0].name, "lean") && one.channels[0].default_weight == 0.5f);
+    mk_raw_free(&one);
+    mk_raw_free(&raw);
+    mk_raw_free(&src);
+}
+
+static void expect_transfer_error(const char *fields, const char *needle, int with_loader)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_icosphere(&raw, "target", 1, 2);
+    char recipe[1024];
+    snprintf(recipe, sizeof recipe, "{\"mesh\": 0, \"channels\": [{\"op\": \"transfer\"%s}]}", fields);
+    mk_error err;
+    memset(&err, 0, sizeof err);
+    mk_result r = with_loader ? bake_transfer(&raw, recipe, &err)
+                              : mk_bake_recipe(&raw, recipe, strlen(recipe), NULL, NULL, &err);
+    CHECK_MSG(r != MK_OK, "recipe accepted: %s", recipe);
+    CHECK_MSG(strstr(err.message, needle) != NULL, "error \"%s\" does not name \"%s\"", err.message, needle);
+    printf("  %s -> %s\n", fields, err.message);
+    CHECK_EQ_INT(raw.channel_count, 0);
+    mk_raw_free(&raw);
+}
+
+static void bad_transfer_recipes_name_the_field(void)
+{
+    const char *s = ", \"source\": \"src.gltf\"";
+    char f[512];
+    expect_transfer_error("", "channels[0].source: missing", 1);
+    expect_transfer_error(", \"source\": 7", "channels[0].source: must be the path", 1);
+    expect_transfer_error(", \"source\": \"missing.gltf\"", "channels[0].source: fixtures/missing.gltf: cannot open", 1);
+    expect_transfer_error(", \"source\": \"plain.gltf\"", "channels[0].source: the source mesh 0 (\"plain\") has no channels", 1);
+    expect_transfer_error(s, "channels[0].source: this bake has no asset loader", 0);
+    snprintf(f, sizeof f, "%s, \"channels\": [\"bulge\", \"nope\"]", s);
+    expect_transfer_error(f, "channels[0].channels[1]: no channel \"nope\" on the source mesh; its channels are \"bulge\", \"lean\"", 1);
+    snprintf(f, sizeof f, "%s, \"channels\": \"bulge\"", s);
+    expect_transfer_error(f, "channels[0].channels: must be a non-empty array", 1);
+    snprintf(f, sizeof f, "%s, \"markers\": [[0, 0], [1, 99999]]", s);
+    expect_transfer_error(f, "channels[0].markers[1]: the target vertex must be an integer in 0..161", 1);
+    snprintf(f, sizeof f, "%s, \"markers\": [[-1, 0]]", s);
+    expect_transfer_error(f, "channels[0].markers[0]: the source vertex must be an integer in 0..641", 1);
+    snprintf(f, sizeof f, "%s, \"markers\": [[0, 0, 0]]", s);
+    expect_transfer_error(f, "channels[0].markers[0]: must be a pair", 1);
+    snprintf(f, sizeof f, "%s, \"markers\": [0, 1]", s);
+    expect_transfer_error(f, "channels[0].markers[0]: must be a pair", 1);
+    snprintf(f, sizeof f, "%s, \"markers\": {\"a\": 1}", s);
+    expect_transfer_error(f, "channels[0].markers: must be an array", 1);
+    snprintf(f, sizeof f, "%s, \"markers\": [[0, 0], [0, 1]]", s);
+    expect_transfer_error(f, "markers: the source markers all sit at one point", 1);
+    snprintf(f, sizeof f, "%s, \"source_mesh\": 3", s);
+    expect_transfer_error(f, "channels[0].source_mesh: index 3 is not a mesh", 1);
+    snprintf(f, sizeof f, "%s, \"name\": \"x\"", s);
+    expect_transfer_error(f, "channels[0].name: does not apply to transfer", 1);
+    snprintf(f, sizeof f, "%s, \"inbetweens\": 3", s);
+    expect_transfer_error(f, "channels[0].inbetweens: does not apply to transfer", 1);
+    snprintf(f, sizeof f, "%s, \"prefix\": 3", s);
+    expect_transfer_error(f, "channels[0].prefix: must be a string", 1);
+    snprintf(f, sizeof f, "%s, \"sauce\": 3", s);
+    expect_transfer_error(f, "channels[0].sauce: unknown field", 1);
+}
+
 CHECK_MAIN(CASE(transfer_onto_a_copy_reproduces_the_targets),
            CASE(transfer_onto_a_similar_copy_gives_the_similar_targets),
-           CASE(transfer_onto_a_remeshed_sheet_follows_the_source_surface))
+           CASE(transfer_onto_a_remeshed_sheet_follows_the_source_surface),
+           CASE(recipe_carries_inbetweens_and_names_and_plays_through_the_runtime),
+           CASE(bad_transfer_recipes_name_the_field))
