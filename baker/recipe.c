@@ -926,8 +926,8 @@ static mk_result parse_transfer(recipe_ctx *ctx, channel_plan *plan, const cJSON
     mk_error inner;
     memset(&inner, 0, sizeof inner);
     if (ctx->options->load_asset(ctx->options->user, full, plan->source, &inner) != MK_OK)
-        return mk_error_set(ctx->err, inner.code ? inner.code : MK_ERROR_IO, inner.offset, "%s.source: %s: %s", path, full,
-                            inner.message);
+        return mk_error_set(ctx->err, inner.code ? inner.code : MK_ERROR_IO, inner.offset, "%s.source: %s", path,
+                            inner.message);  /* the loader names the file */
     if (ctx->options->file_read) ctx->options->file_read(ctx->options->user, full);
     const mk_raw_asset *src = plan->source;
     plan->source_mesh = 0;
