@@ -58,17 +58,18 @@ typedef struct mk_bake_options {
     /* Called once per baked channel; may be NULL. */
     void (*channel_done)(void *user, const mk_bake_channel_report *channel);
     void *user;
-    /* Nonzero for recipes from untrusted sources (fuzzing, services): cage OBJ paths are
-     * refused and work is capped (samples <= 200, lattice dims <= 8, ARAP iterations <= 50,
-     * in-betweens <= 32, lattice keys <= 32), so a hostile recipe cannot read files or run for hours. */
+    /* Nonzero for recipes from untrusted sources (fuzzing, services): cage OBJ paths and
+     * transfer sources are refused and work is capped (samples <= 200, lattice dims <= 8,
+     * ARAP iterations <= 50, in-betweens <= 32, lattice keys <= 32), so a hostile recipe
+     * cannot read files or run for hours. */
     int untrusted;
-    /* Called with the path of every file the recipe makes the bake read (cage OBJ files), e.g.
-     * for a build system's depfile; may be NULL. */
+    /* Called with the path of every file the recipe makes the bake read (cage OBJ files,
+     * transfer sources), e.g. for a build system's depfile; may be NULL. */
     void (*file_read)(void *user, const char *path);
     /* Reads the asset at path (a `transfer` op's source: .fbx, .gltf/.glb, .morph, whatever the
      * caller can import) into out, which the baker has initialized with mk_raw_init and frees
-     * with mk_raw_free. The baker itself reads no file format: `morphkit bake` passes a loader
-     * that calls mk_import_file, tests may hand over models built in memory. NULL: `transfer`
+     * with mk_raw_free. The baker itself reads no file format: `morphkit bake` passes
+     * mk_import_load_asset (formats/import.h), tests may hand over models built in memory. NULL: `transfer`
      * ops fail with an error naming the field. */
     mk_result (*load_asset)(void *user, const char *path, mk_raw_asset *out, mk_error *err);
 } mk_bake_options;

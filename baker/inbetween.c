@@ -217,6 +217,11 @@ mk_result bake_store_target(mk_raw_asset *raw, mk_raw_channel *channel, uint32_t
                 return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX,
                                     "deformation is not finite at vertex %zu (weight %g)", v, weight);
         }
+        /* finite doubles whose deltas overflow the stored floats (a huge taper scale) */
+        for (int c = 0; c < 3; c++)
+            if (!isfinite((float)(pos[3 * v + (size_t)c] - (double)mesh->positions[3 * v + (size_t)c])))
+                return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX,
+                                    "deformation moves vertex %zu beyond the float range (weight %g)", v, weight);
         if (vertex_moved(mesh, v, pos, want_normals ? nrm : NULL, want_tangents ? tan : NULL, eps_p, eps_n)) count++;
     }
     mk_raw_target *target = mk_raw_add_targets(raw, channel, 1);

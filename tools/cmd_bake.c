@@ -118,15 +118,6 @@ static void on_file_read(void *user, const char *path)
     cli_depfile_add(&ui->deps, path);
 }
 
-/* A `transfer` op's source asset: whatever the importer reads, every mesh kept so that
- * source_mesh indices count the file's meshes. */
-static mk_result load_source_asset(void *user, const char *path, mk_raw_asset *out, mk_error *err)
-{
-    (void)user;
-    mk_import_options io = { .keep_plain_meshes = 1 };
-    return mk_import_file(path, &io, out, err);
-}
-
 static void on_progress(void *user, const char *stage, double fraction)
 {
     bake_ui *ui = user;
@@ -209,7 +200,7 @@ static int run_bake(void *p)
     char dir[4096];
     dir_of(a->recipe, dir, sizeof dir);
     mk_bake_options bo = { .base_dir = dir, .progress = on_progress, .channel_done = on_channel, .user = &ui,
-                           .file_read = a->depfile ? on_file_read : NULL, .load_asset = load_source_asset };
+                           .file_read = a->depfile ? on_file_read : NULL, .load_asset = mk_import_load_asset };
     mk_bake_report report;
     if (r == MK_OK) r = mk_bake_recipe(&raw, recipe, recipe_size, &bo, &report, &err);
     if (r == MK_OK && !a->all_meshes) mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");

@@ -1278,6 +1278,8 @@ static void bad_recipes_name_the_field(void)
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"bend\", \"angle\": 30, \"direction\": [0, 0, 5], \"axis\": \"z\"}]}",
                  "direction");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"taper\", \"scale\": 0.5, \"range\": [2, 1]}]}", "channels[0].range");
+    /* finite in double, but the deltas overflow the stored floats (found by fuzz_recipe) */
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"taper\", \"scale\": 1e40}]}", "beyond the float range");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"twist\", \"angle\": 30, \"inbetweens\": 0}]}", "channels[0].inbetweens");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"cage\", \"cage\": \"/nonexistent.obj\", \"deformed_cage\": \"x.obj\"}]}",
                  "channels[0].cage");
@@ -1401,14 +1403,6 @@ static void record_channels(void *user, const mk_bake_channel_report *c)
 
 /* Every recipe in samples/recipes bakes on a tube like samples/make_example's (radius 0.5,
  * y from 0 to 2), including the cage OBJ files that resolve against the recipe directory. */
-/* mk_bake_options.load_asset for the samples: whatever the importer reads. */
-static mk_result import_asset(void *user, const char *path, mk_raw_asset *out, mk_error *err)
-{
-    (void)user;
-    mk_import_options io = { .keep_plain_meshes = 1 };
-    return mk_import_file(path, &io, out, err);
-}
-
 static void sample_recipes_bake(void)
 {
     static const char *const names[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json",
@@ -1443,7 +1437,7 @@ static void sample_recipes_bake(void)
             memset(&o, 0, sizeof o);
             o.base_dir = dir;
             o.channel_done = record_channels;
-            o.load_asset = import_asset;
+            o.load_asset = mk_import_load_asset;
             o.user = &rec;
             mk_bake_report rep;
             mk_error err;
