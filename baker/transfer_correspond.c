@@ -10,11 +10,15 @@
  * - The match is the closest-point correspondence of one pass (not the paper's iterative
  *   closest-valid-point deformation of the source onto the target): for the centroid c of each
  *   target triangle, the aligned source triangle with the nearest closest point to c, among the
- *   source triangles whose normal makes an angle below 90 degrees with the target triangle's.
- *   Brute force over source triangles, pruned by bounding spheres (centroid + radius) against
- *   the best distance so far, starting from the previous triangle's match.
+ *   source triangles whose normal makes an angle below 90 degrees with the target triangle's;
+ *   ties go to the lower source triangle index.
+ * - The search visits a uniform grid over the source triangles' bounding boxes (cells about
+ *   twice a triangle's extent, at most about 8 cells per triangle) ring by ring around the
+ *   centroid's cell, and stops when the cells not visited yet are all farther than the best
+ *   compatible candidate: the same answer as trying every source triangle.
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "transfer_internal.h"
 #include "bake_util.h"
@@ -137,31 +141,119 @@ static int triangle(const mk_raw_mesh *mesh, const double *positions, uint32_t t
     return !(vec3_length(n) > TRANSFER_DEGENERATE * longest);
 }
 
+/* A uniform grid over the aligned source triangles' bounding boxes (CSR: cell -> triangles). */
+typedef struct tri_grid {
+    double lo[3], h;
+    int32_t dims[3];
+    uint32_t *first, *tris;
+} tri_grid;
+
+static void cell_range(const tri_grid *g, const double lo[3], const double hi[3], int32_t a[3], int32_t b[3])
+{
+    for (int c = 0; c < 3; c++) {
+        double fa = floor((lo[c] - g->lo[c]) / g->h), fb = floor((hi[c] - g->lo[c]) / g->h);
+        a[c] = fa < 0 ? 0 : fa > g->dims[c] - 1 ? g->dims[c] - 1 : (int32_t)fa;
+        b[c] = fb < 0 ? 0 : fb > g->dims[c] - 1 ? g->dims[c] - 1 : (int32_t)fb;
+    }
+}
+
+static size_t cell_index(const tri_grid *g, int32_t x, int32_t y, int32_t z)
+{
+    return ((size_t)z * (size_t)g->dims[1] + (size_t)y) * (size_t)g->dims[0] + (size_t)x;
+}
+
+static mk_result build_grid(tri_grid *g, const mk_raw_mesh *source, const double *aligned, const unsigned char *bad,
+                            mk_arena *arena, mk_error *err)
+{
+    uint32_t ns = source->triangle_count, live = 0;
+    double hi[3], extent_sum = 0;
+    for (int c = 0; c < 3; c++) { g->lo[c] = INFINITY; hi[c] = -INFINITY; }
+    for (uint32_t s = 0; s < ns; s++) {
+        if (bad[s]) continue;
+        double tlo[3] = { INFINITY, INFINITY, INFINITY }, thi[3] = { -INFINITY, -INFINITY, -INFINITY }, ext = 0;
+        for (int k = 0; k < 3; k++)
+            for (int c = 0; c < 3; c++) {
+                double v = aligned[3 * (size_t)source->triangles[3 * (size_t)s + k] + c];
+                tlo[c] = fmin(tlo[c], v);
+                thi[c] = fmax(thi[c], v);
+            }
+        for (int c = 0; c < 3; c++) {
+            g->lo[c] = fmin(g->lo[c], tlo[c]);
+            hi[c] = fmax(hi[c], thi[c]);
+            ext = fmax(ext, thi[c] - tlo[c]);
+        }
+        extent_sum += ext;
+        live++;
+    }
+    double size = 0;
+    for (int c = 0; c < 3; c++) size = fmax(size, live ? hi[c] - g->lo[c] : 0);
+    /* cells about twice a triangle's extent, at most ~8 cells per triangle */
+    g->h = live ? 2 * extent_sum / live : 1;
+    if (!(g->h > 1e-9 * size)) g->h = size > 0 ? size : 1;
+    for (;;) {
+        double cells = 1;
+        for (int c = 0; c < 3; c++) {
+            double d = live ? floor((hi[c] - g->lo[c]) / g->h) + 1 : 1;
+            g->dims[c] = (int32_t)d;
+            cells *= d;
+        }
+        if (cells <= 8.0 * live + 64) break;
+        g->h *= 1.5;
+    }
+    size_t cells = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    g->first = mk_arena_array(arena, cells + 1, sizeof(uint32_t));
+    if (!g->first) return mk_error_oom(err, "transfer correspondence grid");
+    for (int pass = 0; pass < 2; pass++) {
+        for (uint32_t s = 0; s < ns; s++) {
+            if (bad[s]) continue;
+            double tlo[3] = { INFINITY, INFINITY, INFINITY }, thi[3] = { -INFINITY, -INFINITY, -INFINITY };
+            for (int k = 0; k < 3; k++)
+                for (int c = 0; c < 3; c++) {
+                    double v = aligned[3 * (size_t)source->triangles[3 * (size_t)s + k] + c];
+                    tlo[c] = fmin(tlo[c], v);
+                    thi[c] = fmax(thi[c], v);
+                }
+            int32_t a[3], b[3];
+            cell_range(g, tlo, thi, a, b);
+            for (int32_t z = a[2]; z <= b[2]; z++)
+                for (int32_t y = a[1]; y <= b[1]; y++)
+                    for (int32_t x = a[0]; x <= b[0]; x++) {
+                        size_t cell = cell_index(g, x, y, z);
+                        if (pass == 0) g->first[cell + 1]++;
+                        else g->tris[g->first[cell]++] = s;
+                    }
+        }
+        if (pass == 0) {
+            for (size_t c = 0; c < cells; c++) g->first[c + 1] += g->first[c];
+            g->tris = mk_arena_array(arena, (size_t)g->first[cells] + 1, sizeof(uint32_t));
+            if (!g->tris) return mk_error_oom(err, "transfer correspondence grid");
+        } else {
+            /* the fill advanced first[c] to first[c + 1]: shift back */
+            for (size_t c = cells; c > 0; c--) g->first[c] = g->first[c - 1];
+            g->first[0] = 0;
+        }
+    }
+    return MK_OK;
+}
+
 mk_result bake_transfer_correspond(const mk_raw_mesh *source, const double *aligned, const mk_raw_mesh *target,
                                    mk_arena *arena, uint32_t *match, double *barycentric, uint32_t *flipped,
                                    uint32_t *unmatched, mk_error *err)
 {
     uint32_t ns = source->triangle_count;
-    /* Per source triangle: bounding sphere (centroid, radius), normal, degenerate flag. */
-    double *sphere = mk_arena_array(arena, 4 * (size_t)ns + 1, sizeof(double));
     double *normal = mk_arena_array(arena, 3 * (size_t)ns + 1, sizeof(double));
     unsigned char *bad = mk_arena_array(arena, (size_t)ns + 1, 1);
-    if (!sphere || !normal || !bad) return mk_error_oom(err, "transfer correspondence");
+    uint32_t *seen = mk_arena_array(arena, (size_t)ns + 1, sizeof(uint32_t));  /* query stamp + 1 */
+    if (!normal || !bad || !seen) return mk_error_oom(err, "transfer correspondence");
     for (uint32_t s = 0; s < ns; s++) {
         double v[3][3];
         bad[s] = (unsigned char)triangle(source, aligned, s, v, normal + 3 * (size_t)s);
-        double *sp = sphere + 4 * (size_t)s;
-        for (int c = 0; c < 3; c++) sp[c] = (v[0][c] + v[1][c] + v[2][c]) / 3;
-        sp[3] = 0;
-        for (int k = 0; k < 3; k++) {
-            double d[3];
-            vec3_sub(d, v[k], sp);
-            sp[3] = fmax(sp[3], vec3_length(d));
-        }
     }
+    tri_grid g;
+    mk_result r = build_grid(&g, source, aligned, bad, arena, err);
+    if (r != MK_OK) return r;
     *flipped = 0;
     *unmatched = 0;
-    uint32_t previous = UINT32_MAX;
     for (uint32_t t = 0; t < target->triangle_count; t++) {
         double v[3][3], n[3], p[3];
         match[t] = UINT32_MAX;
@@ -170,26 +262,47 @@ mk_result bake_transfer_correspond(const mk_raw_mesh *source, const double *alig
         if (triangle(target, NULL, t, v, n)) { (*unmatched)++; continue; }
         for (int c = 0; c < 3; c++) p[c] = (v[0][c] + v[1][c] + v[2][c]) / 3;
         double best = INFINITY, best_away = INFINITY;
-        for (uint32_t q = 0; q <= ns; q++) {
-            /* q == 0 visits the previous match first (neighbors match nearby), then all */
-            uint32_t s = q == 0 ? previous : q - 1;
-            if (s == UINT32_MAX || (q > 0 && s == previous) || bad[s]) continue;
-            const double *sp = sphere + 4 * (size_t)s;
-            double d[3];
-            vec3_sub(d, p, sp);
-            double lower = vec3_length(d) - sp[3];
-            if (lower > 0 && lower * lower >= best) continue;
-            const uint32_t *tri = source->triangles + 3 * (size_t)s;
-            double b[3];
-            double d2 = closest_on_triangle(p, aligned + 3 * (size_t)tri[0], aligned + 3 * (size_t)tri[1],
-                                            aligned + 3 * (size_t)tri[2], b);
-            if (vec3_dot(n, normal + 3 * (size_t)s) > 0) {
-                if (d2 < best) { best = d2; match[t] = s; memcpy(bary, b, sizeof b); }
-            } else if (d2 < best_away) best_away = d2;
+        int32_t center[3];
+        cell_range(&g, p, p, center, center);
+        /* rings of cells at Chebyshev distance k from p's cell, until no unvisited cell can hold
+         * a point nearer than the best compatible one */
+        for (int32_t k = 0;; k++) {
+            for (int32_t z = center[2] - k; z <= center[2] + k; z++)
+                for (int32_t y = center[1] - k; y <= center[1] + k; y++)
+                    for (int32_t x = center[0] - k; x <= center[0] + k; x++) {
+                        if (x < 0 || y < 0 || z < 0 || x >= g.dims[0] || y >= g.dims[1] || z >= g.dims[2]) continue;
+                        if (abs(x - center[0]) != k && abs(y - center[1]) != k && abs(z - center[2]) != k) continue;
+                        size_t cell = cell_index(&g, x, y, z);
+                        for (uint32_t q = g.first[cell]; q < g.first[cell + 1]; q++) {
+                            uint32_t s = g.tris[q];
+                            if (seen[s] == t + 1) continue;
+                            seen[s] = t + 1;
+                            const uint32_t *tri = source->triangles + 3 * (size_t)s;
+                            double b[3];
+                            double d2 = closest_on_triangle(p, aligned + 3 * (size_t)tri[0], aligned + 3 * (size_t)tri[1],
+                                                            aligned + 3 * (size_t)tri[2], b);
+                            if (vec3_dot(n, normal + 3 * (size_t)s) > 0) {
+                                if (d2 < best || (d2 == best && s < match[t])) { best = d2; match[t] = s; memcpy(bary, b, sizeof b); }
+                            } else if (d2 < best_away) best_away = d2;
+                        }
+                    }
+            /* distance from p to the cells not visited yet (sides of the block with cells beyond) */
+            double bound = INFINITY;
+            int more = 0;
+            for (int c = 0; c < 3; c++) {
+                if (center[c] - k > 0) {
+                    more = 1;
+                    bound = fmin(bound, p[c] - (g.lo[c] + (center[c] - k) * g.h));
+                }
+                if (center[c] + k < g.dims[c] - 1) {
+                    more = 1;
+                    bound = fmin(bound, g.lo[c] + (center[c] + k + 1) * g.h - p[c]);
+                }
+            }
+            if (!more || (bound > 0 && bound * bound > best)) break;
         }
         if (match[t] == UINT32_MAX) { (*unmatched)++; continue; }
         if (best_away < best) (*flipped)++;
-        previous = match[t];
     }
     return MK_OK;
 }
