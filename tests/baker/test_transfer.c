@@ -318,6 +318,105 @@ static void correspondence_skips_triangles_facing_away(void)
     mk_raw_free(&dst);
 }
 
+/* Squared distance from p to segment ab. */
+static double segment_distance2(const double p[3], const double a[3], const double b[3])
+{
+    double ab[3], ap[3];
+    vec3_sub(ab, b, a);
+    vec3_sub(ap, p, a);
+    double len2 = vec3_dot(ab, ab), u = len2 > 0 ? vec3_dot(ap, ab) / len2 : 0;
+    u = u < 0 ? 0 : u > 1 ? 1 : u;
+    double d[3] = { ap[0] - u * ab[0], ap[1] - u * ab[1], ap[2] - u * ab[2] };
+    return vec3_dot(d, d);
+}
+
+/* Squared distance from p to triangle abc: the plane distance when p projects inside (all
+ * three edge tests agree with the normal), else the nearest edge. */
+static double triangle_distance2(const double p[3], const double a[3], const double b[3], const double c[3])
+{
+    double e1[3], e2[3], n[3], ap[3];
+    vec3_sub(e1, b, a);
+    vec3_sub(e2, c, a);
+    vec3_cross(n, e1, e2);
+    vec3_sub(ap, p, a);
+    const double *v[3] = { a, b, c };
+    int inside = 1;
+    for (int k = 0; k < 3; k++) {
+        double e[3], q[3], x[3];
+        vec3_sub(e, v[(k + 1) % 3], v[k]);
+        vec3_sub(q, p, v[k]);
+        vec3_cross(x, e, q);
+        if (vec3_dot(x, n) < 0) inside = 0;
+    }
+    if (inside) {
+        double h = vec3_dot(ap, n);
+        return h * h / vec3_dot(n, n);
+    }
+    return fmin(segment_distance2(p, a, b), fmin(segment_distance2(p, b, c), segment_distance2(p, c, a)));
+}
+
+static void load3(double out[3], const mk_raw_mesh *m, uint32_t v)
+{
+    for (int c = 0; c < 3; c++) out[c] = m->positions[3 * (size_t)v + c];
+}
+
+/* The grid search finds the same nearest compatible source triangle as trying all of them:
+ * an icosphere source against a UV sphere target shrunk, turned and moved off it (so centroids
+ * sit inside, between and outside the source's cells). */
+static void correspondence_matches_the_exhaustive_search(void)
+{
+    mk_raw_asset src, dst;
+    mk_raw_init(&src, NULL);
+    mk_raw_init(&dst, NULL);
+    mk_raw_mesh *sm = fixture_icosphere(&src, "s", 1, 3), *tg = fixture_sphere(&dst, "t", 0.8f, 40, 20);
+    for (uint32_t v = 0; v < tg->vertex_count; v++) {
+        float *p = tg->positions + 3 * (size_t)v, x = p[0], y = p[1];
+        p[0] = 0.8f * x - 0.6f * y + 0.3f;
+        p[1] = 0.6f * x + 0.8f * y - 0.2f;
+        p[2] += 0.25f;
+    }
+    mk_transfer_params prm = { sm, tg, 0, NULL };
+    mk_transfer *x = NULL;
+    mk_error err;
+    mk_result r = mk_transfer_create(&prm, NULL, &x, &err);
+    CHECK_MSG(r == MK_OK, "create: %s", err.message);
+    if (r != MK_OK) { mk_raw_free(&src); mk_raw_free(&dst); return; }
+    uint32_t worse = 0, checked = 0;
+    double worst_gap = 0;
+    for (uint32_t t = 0; t < tg->triangle_count; t++) {
+        double a[3], b[3], c[3], p[3], n[3], e1[3], e2[3], bary[3];
+        const uint32_t *tt = tg->triangles + 3 * (size_t)t;
+        load3(a, tg, tt[0]); load3(b, tg, tt[1]); load3(c, tg, tt[2]);
+        for (int k = 0; k < 3; k++) p[k] = (a[k] + b[k] + c[k]) / 3;
+        vec3_sub(e1, b, a); vec3_sub(e2, c, a); vec3_cross(n, e1, e2);
+        if (!(vec3_length(n) > 1e-12)) continue;  /* the poles' collapsed triangles */
+        uint32_t s = mk_transfer_match(x, t, bary);
+        double best = INFINITY;
+        for (uint32_t q = 0; q < sm->triangle_count; q++) {
+            double sa[3], sb[3], sc[3], f1[3], f2[3], ns[3];
+            const uint32_t *st = sm->triangles + 3 * (size_t)q;
+            load3(sa, sm, st[0]); load3(sb, sm, st[1]); load3(sc, sm, st[2]);
+            vec3_sub(f1, sb, sa); vec3_sub(f2, sc, sa); vec3_cross(ns, f1, f2);
+            if (vec3_dot(ns, n) > 0) best = fmin(best, triangle_distance2(p, sa, sb, sc));
+        }
+        checked++;
+        if (s == UINT32_MAX) { worse++; continue; }
+        const uint32_t *st = sm->triangles + 3 * (size_t)s;
+        double sa[3], sb[3], sc[3];
+        load3(sa, sm, st[0]); load3(sb, sm, st[1]); load3(sc, sm, st[2]);
+        double got = sqrt(triangle_distance2(p, sa, sb, sc)), gap = got - sqrt(best);
+        worst_gap = fmax(worst_gap, gap);
+        if (gap > 1e-9) worse++;
+    }
+    printf("grid correspondence vs exhaustive search: %u target triangles, %u matched farther, largest gap %.3g\n",
+           checked, worse, worst_gap);
+    CHECK(checked > 1000);
+    CHECK_EQ_INT(worse, 0);
+    mk_transfer_destroy(x);
+    mk_raw_free(&src);
+    mk_raw_free(&dst);
+}
+
 /* ---- the recipe op ---- */
 
 /* mk_bake_options.load_asset for the tests: models built in memory, by file name. */
@@ -505,5 +604,6 @@ CHECK_MAIN(CASE(transfer_onto_a_copy_reproduces_the_targets),
            CASE(transfer_onto_a_similar_copy_gives_the_similar_targets),
            CASE(transfer_onto_a_remeshed_sheet_follows_the_source_surface),
            CASE(correspondence_skips_triangles_facing_away),
+           CASE(correspondence_matches_the_exhaustive_search),
            CASE(recipe_carries_inbetweens_and_names_and_plays_through_the_runtime),
            CASE(bad_transfer_recipes_name_the_field))
