@@ -5,7 +5,7 @@
  * (in-betweens with full weights in (0, 1], the last one at 1), so the runtime plays a baked
  * channel like an authored shape. The recipe format is documented in docs/baking.md; the
  * per-algorithm C APIs are in barr.h, ffd.h, ffd_travel.h, ffd_cylinder.h, cage_mvc.h,
- * surface_edit.h and inbetween.h.
+ * surface_edit.h, transfer.h and inbetween.h.
  */
 #ifndef MK_BAKE_H
 #define MK_BAKE_H
@@ -36,10 +36,10 @@ typedef struct mk_bake_channel_report {
     uint32_t curve_samples;
     const float *key_weights;
     double tolerance;
-    uint32_t factorizations;   /* Laplacian/ARAP: sparse Cholesky factorizations (1 expected) */
-    double factor_seconds;     /* Laplacian/ARAP: analyze + factorize wall time */
-    double solve_seconds;      /* Laplacian/ARAP: total time of all triangular solves */
-    uint32_t solves;           /* Laplacian/ARAP: solves (each one with 3 right-hand sides) */
+    uint32_t factorizations;   /* Laplacian/ARAP/transfer: sparse Cholesky factorizations (1 expected) */
+    double factor_seconds;     /* Laplacian/ARAP/transfer: analyze + factorize wall time */
+    double solve_seconds;      /* Laplacian/ARAP/transfer: total time of all triangular solves */
+    uint32_t solves;           /* Laplacian/ARAP/transfer: solves (each one with 3 right-hand sides) */
     uint32_t iterations;       /* ARAP: local/global iterations over all evaluations */
     uint32_t max_iterations;   /* ARAP: most iterations one evaluation took */
     uint32_t unconverged;      /* ARAP: evaluations stopped by the iteration cap */
@@ -58,13 +58,20 @@ typedef struct mk_bake_options {
     /* Called once per baked channel; may be NULL. */
     void (*channel_done)(void *user, const mk_bake_channel_report *channel);
     void *user;
-    /* Nonzero for recipes from untrusted sources (fuzzing, services): cage OBJ paths are
-     * refused and work is capped (samples <= 200, lattice dims <= 8, ARAP iterations <= 50,
-     * in-betweens <= 32, lattice keys <= 32), so a hostile recipe cannot read files or run for hours. */
+    /* Nonzero for recipes from untrusted sources (fuzzing, services): cage OBJ paths and
+     * transfer sources are refused and work is capped (samples <= 200, lattice dims <= 8,
+     * ARAP iterations <= 50, in-betweens <= 32, lattice keys <= 32), so a hostile recipe
+     * cannot read files or run for hours. */
     int untrusted;
-    /* Called with the path of every file the recipe makes the bake read (cage OBJ files), e.g.
-     * for a build system's depfile; may be NULL. */
+    /* Called with the path of every file the recipe makes the bake read (cage OBJ files,
+     * transfer sources), e.g. for a build system's depfile; may be NULL. */
     void (*file_read)(void *user, const char *path);
+    /* Reads the asset at path (a `transfer` op's source: .fbx, .gltf/.glb, .morph, whatever the
+     * caller can import) into out, which the baker has initialized with mk_raw_init and frees
+     * with mk_raw_free. The baker itself reads no file format: `morphkit bake` passes
+     * mk_import_load_asset (formats/import.h), tests may hand over models built in memory. NULL: `transfer`
+     * ops fail with an error naming the field. */
+    mk_result (*load_asset)(void *user, const char *path, mk_raw_asset *out, mk_error *err);
 } mk_bake_options;
 
 /* Applies a JSON recipe (docs/baking.md) to raw. options may be NULL (defaults). All or

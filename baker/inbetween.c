@@ -196,6 +196,17 @@ static mk_result write_target(mk_raw_asset *raw, mk_raw_channel *channel, uint32
         if (r != MK_OK) return r;
         if (inv > *inverted) *inverted = inv;
     }
+    return bake_store_target(raw, channel, mesh_index, weight, name, diagonal, pos, want_normals ? nrm : NULL,
+                             want_tangents ? tan : NULL, moved, err);
+}
+
+mk_result bake_store_target(mk_raw_asset *raw, mk_raw_channel *channel, uint32_t mesh_index, double weight,
+                            const char *name, double diagonal, const double *pos, const double *nrm,
+                            const double *tan, uint32_t *moved, mk_error *err)
+{
+    const mk_raw_mesh *mesh = &raw->meshes[mesh_index];
+    size_t n = mesh->vertex_count;
+    int want_normals = nrm != NULL, want_tangents = tan != NULL;
     double eps_p = 1e-7 * diagonal, eps_n = 1e-6;
     uint32_t count = 0;
     for (size_t v = 0; v < n; v++) {
@@ -206,6 +217,11 @@ static mk_result write_target(mk_raw_asset *raw, mk_raw_channel *channel, uint32
                 return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX,
                                     "deformation is not finite at vertex %zu (weight %g)", v, weight);
         }
+        /* finite doubles whose deltas overflow the stored floats (a huge taper scale) */
+        for (int c = 0; c < 3; c++)
+            if (!isfinite((float)(pos[3 * v + (size_t)c] - (double)mesh->positions[3 * v + (size_t)c])))
+                return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX,
+                                    "deformation moves vertex %zu beyond the float range (weight %g)", v, weight);
         if (vertex_moved(mesh, v, pos, want_normals ? nrm : NULL, want_tangents ? tan : NULL, eps_p, eps_n)) count++;
     }
     mk_raw_target *target = mk_raw_add_targets(raw, channel, 1);

@@ -60,4 +60,13 @@ mk_result mk_bake_channel(mk_raw_asset *raw, uint32_t mesh, const char *name, co
                           void (*progress)(void *user, const char *stage, double fraction),
                           void *user, mk_inbetween_result *result, mk_error *err);
 
+/* Appends one target (full weight `weight`, named `name`) to `channel` of mesh `mesh`: the deltas
+ * of pos (3 doubles per vertex) from the base positions, and of nrm / tan (3 per vertex, NULL:
+ * none stored) from the base normals / tangents. Vertices moving less than 1e-7 x diagonal (and
+ * whose normal/tangent deltas are below 1e-6) are not stored; *moved gets the stored count.
+ * Fails on a value that is not finite. The one way every baker writes a target. */
+mk_result bake_store_target(mk_raw_asset *raw, mk_raw_channel *channel, uint32_t mesh, double weight,
+                            const char *name, double diagonal, const double *pos, const double *nrm,
+                            const double *tan, uint32_t *moved, mk_error *err);
+
 #endif

@@ -28,7 +28,7 @@ mk_result edit_laplacian_solve(mk_surface_edit *s, mk_error *err)
         for (size_t i = 0; i < 3 * (size_t)n; i++) s->solution[i] = s->rest[i] + dx[i];
         return MK_OK;
     }
-    double *b = s->rhs->x;
+    double *b = s->spd.rhs->x;
     memset(b, 0, 3 * (size_t)nu * sizeof(double));
     if (s->params.soft) {
         double w2 = s->params.soft_weight * s->params.soft_weight;
@@ -60,7 +60,7 @@ mk_result edit_laplacian_solve(mk_surface_edit *s, mk_error *err)
     }
     mk_result r = edit_solve(s, err);
     if (r != MK_OK) return r;
-    const double *x = s->x->x;
+    const double *x = s->spd.x->x;
     for (uint32_t v = 0; v < n; v++)
         for (int c = 0; c < 3; c++) {
             size_t i = 3 * (size_t)v + (size_t)c;

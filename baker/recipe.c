@@ -21,13 +21,14 @@
 #include "ffd_prism.h"
 #include "inbetween.h"
 #include "surface_edit.h"
+#include "transfer.h"
 #include "obj.h"
 
 #define PI 3.14159265358979323846
 
-typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP, OP_FFD_TRAVEL, OP_FFD_KEYS, OP_FFD_CYLINDER, OP_FFD_PRISM } op_kind;
+typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP, OP_FFD_TRAVEL, OP_FFD_KEYS, OP_FFD_CYLINDER, OP_FFD_PRISM, OP_TRANSFER } op_kind;
 
-static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap", "ffd_travel", "ffd_keys", "ffd_cylinder", "ffd_prism" };
+static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap", "ffd_travel", "ffd_keys", "ffd_cylinder", "ffd_prism", "transfer" };
 
 /* Fields accepted by every op, and per op. */
 static const char *const common_fields[] = { "name", "op", "mesh", "inbetweens", "tolerance",
@@ -47,6 +48,7 @@ static const char *const op_fields[][14] = {
                           "moves", NULL },
     [OP_FFD_PRISM] = { "sides", "section", "degree", "layers", "axis", "center", "range", "radius", "reference",
                        "padding", "rest_moves", "moves", NULL },
+    [OP_TRANSFER] = { "source", "source_mesh", "channels", "markers", "prefix", NULL },
 };
 
 /* Everything parsed for one channel before baking. */
@@ -72,6 +74,14 @@ typedef struct channel_plan {
     mk_cylinder_lattice cylinder;
     mk_prism_lattice prism;
     double *lattice_coordinates;  /* per vertex: ffd_cylinder (s, t, u), ffd_prism (wedge, l1, l2, u) */
+    mk_raw_asset *source;         /* transfer: the loaded source asset (freed after the bake) */
+    uint32_t source_mesh;
+    uint32_t source_channel_count;/* transfer: channels of the source asset to carry over */
+    uint32_t *source_channels;
+    uint32_t marker_count;        /* transfer: (source vertex, target vertex) pairs */
+    uint32_t (*markers)[2];
+    char prefix[64];              /* transfer: prepended to the source channel names */
+    int has_default_weight;
 } channel_plan;
 
 typedef struct recipe_ctx {
@@ -506,6 +516,14 @@ static mk_result parse_ffd_moves(recipe_ctx *ctx, const uint32_t dims[3], const 
     return MK_OK;
 }
 
+/* A recipe's file path resolved against options.base_dir (absolute paths are kept). */
+static void recipe_path(const recipe_ctx *ctx, const char *name, char *full, size_t size)
+{
+    const char *dir = ctx->options && ctx->options->base_dir ? ctx->options->base_dir : "";
+    if (name[0] == '/' || !*dir) snprintf(full, size, "%s", name);
+    else snprintf(full, size, "%s/%s", dir, name);
+}
+
 static mk_result load_cage_file(recipe_ctx *ctx, const cJSON *ch, const char *path, const char *field,
                                 double **verts, uint32_t *nv, uint32_t **tris, uint32_t *nt)
 {
@@ -514,11 +532,8 @@ static mk_result load_cage_file(recipe_ctx *ctx, const cJSON *ch, const char *pa
     if (!item) return field_error(ctx, path, field, "missing (path of an OBJ file)%s", NULL);
     if (!cJSON_IsString(item) || !*item->valuestring)
         return field_error(ctx, path, field, "must be the path of an OBJ file%s", NULL);
-    const char *name = item->valuestring;
     char full[4096];
-    const char *dir = ctx->options && ctx->options->base_dir ? ctx->options->base_dir : "";
-    if (name[0] == '/' || !*dir) snprintf(full, sizeof full, "%s", name);
-    else snprintf(full, sizeof full, "%s/%s", dir, name);
+    recipe_path(ctx, item->valuestring, full, sizeof full);
     mk_error inner;
     mk_obj obj;
     if (mk_obj_read(full, ctx->scratch, &obj, &inner) != MK_OK)
@@ -944,36 +959,43 @@ static mk_result extended_ffd_eval(void *user, double amplitude, double *positio
 
 /* ---- recipe ---- */
 
-static mk_result resolve_mesh(recipe_ctx *ctx, const cJSON *item, const char *path, uint32_t *mesh)
+/* A mesh of `raw` by name or index (field `field` of the object at path). */
+static mk_result resolve_mesh_of(recipe_ctx *ctx, const mk_raw_asset *raw, const cJSON *item, const char *path,
+                                 const char *field, uint32_t *mesh)
 {
-    if (!item) return field_error(ctx, path, "mesh", "missing (a mesh name or index)%s", NULL);
+    if (!item) return field_error(ctx, path, field, "missing (a mesh name or index)%s", NULL);
     if (cJSON_IsNumber(item)) {
         double v = item->valuedouble;
-        if (!isfinite(v) || v != floor(v) || v < 0 || v >= ctx->raw->mesh_count) {
+        if (!isfinite(v) || v != floor(v) || v < 0 || v >= raw->mesh_count) {
             char msg[96];
-            snprintf(msg, sizeof msg, "index %g is not a mesh (the asset has %u)", v, ctx->raw->mesh_count);
-            return field_error(ctx, path, "mesh", "%s", msg);
+            snprintf(msg, sizeof msg, "index %g is not a mesh (the asset has %u)", v, raw->mesh_count);
+            return field_error(ctx, path, field, "%s", msg);
         }
         *mesh = (uint32_t)v;
         return MK_OK;
     }
-    if (!cJSON_IsString(item)) return field_error(ctx, path, "mesh", "must be a mesh name or index%s", NULL);
-    for (uint32_t m = 0; m < ctx->raw->mesh_count; m++)
-        if (ctx->raw->meshes[m].name && !strcmp(ctx->raw->meshes[m].name, item->valuestring)) {
+    if (!cJSON_IsString(item)) return field_error(ctx, path, field, "must be a mesh name or index%s", NULL);
+    for (uint32_t m = 0; m < raw->mesh_count; m++)
+        if (raw->meshes[m].name && !strcmp(raw->meshes[m].name, item->valuestring)) {
             *mesh = m;
             return MK_OK;
         }
     char names[120] = "";
-    for (uint32_t m = 0; m < ctx->raw->mesh_count; m++) {
+    for (uint32_t m = 0; m < raw->mesh_count; m++) {
         size_t n = strlen(names);
-        const char *name = ctx->raw->meshes[m].name ? ctx->raw->meshes[m].name : "";
+        const char *name = raw->meshes[m].name ? raw->meshes[m].name : "";
         if (n + strlen(name) + 8 >= sizeof names) { snprintf(names + n, sizeof names - n, ", ..."); break; }
         snprintf(names + n, sizeof names - n, "%s\"%s\"", n ? ", " : "", name);
     }
     char msg[200];
     snprintf(msg, sizeof msg, "no mesh named \"%.40s\"; the meshes are %s", item->valuestring,
-             ctx->raw->mesh_count ? names : "(none)");
-    return field_error(ctx, path, "mesh", "%s", msg);
+             raw->mesh_count ? names : "(none)");
+    return field_error(ctx, path, field, "%s", msg);
+}
+
+static mk_result resolve_mesh(recipe_ctx *ctx, const cJSON *item, const char *path, uint32_t *mesh)
+{
+    return resolve_mesh_of(ctx, ctx->raw, item, path, "mesh", mesh);
 }
 
 static mk_result check_mesh(recipe_ctx *ctx, uint32_t m, const char *path)
@@ -992,6 +1014,132 @@ static mk_result check_mesh(recipe_ctx *ctx, uint32_t m, const char *path)
     return MK_OK;
 }
 
+/* transfer: load the source asset through options.load_asset, pick its mesh and channels, read
+ * the markers. The source stays loaded until the bake ends (free_plan). */
+static mk_result parse_transfer(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    static const char *const not_for_transfer[] = { "name", "inbetweens", "tolerance", "samples", "max_targets", NULL };
+    for (int i = 0; not_for_transfer[i]; i++)
+        if (cJSON_HasObjectItem(ch, not_for_transfer[i]))
+            return field_error(ctx, path, not_for_transfer[i],
+                               "does not apply to transfer%s (channels are named after the source's, with prefix; "
+                               "in-betweens are carried over one to one)", NULL);
+    plan->has_default_weight = cJSON_HasObjectItem(ch, "default_weight");
+    const cJSON *prefix = cJSON_GetObjectItemCaseSensitive(ch, "prefix");
+    if (prefix && (!cJSON_IsString(prefix) || strlen(prefix->valuestring) >= sizeof plan->prefix))
+        return field_error(ctx, path, "prefix", "must be a string under 64 bytes%s", NULL);
+    if (prefix) snprintf(plan->prefix, sizeof plan->prefix, "%s", prefix->valuestring);
+
+    if (untrusted(ctx)) return field_error(ctx, path, "source", "files are not read for untrusted recipes%s", NULL);
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(ch, "source");
+    if (!item) return field_error(ctx, path, "source", "missing (path of the asset whose channels are transferred)%s", NULL);
+    if (!cJSON_IsString(item) || !*item->valuestring)
+        return field_error(ctx, path, "source", "must be the path of an asset file (.fbx, .gltf, .glb, .morph)%s", NULL);
+    if (!ctx->options || !ctx->options->load_asset)
+        return field_error(ctx, path, "source", "this bake has no asset loader (mk_bake_options.load_asset)%s", NULL);
+    char full[4096];
+    recipe_path(ctx, item->valuestring, full, sizeof full);
+    plan->source = mk_arena_alloc(ctx->scratch, sizeof *plan->source);
+    if (!plan->source) return mk_error_oom(ctx->err, "transfer source");
+    mk_raw_init(plan->source, &ctx->raw->arena.allocator);
+    mk_error inner;
+    memset(&inner, 0, sizeof inner);
+    if (ctx->options->load_asset(ctx->options->user, full, plan->source, &inner) != MK_OK)
+        return mk_error_set(ctx->err, inner.code ? inner.code : MK_ERROR_IO, inner.offset, "%s.source: %s", path,
+                            inner.message);  /* the loader names the file */
+    if (ctx->options->file_read) ctx->options->file_read(ctx->options->user, full);
+    const mk_raw_asset *src = plan->source;
+    plan->source_mesh = 0;
+    const cJSON *sm = cJSON_GetObjectItemCaseSensitive(ch, "source_mesh");
+    mk_result r;
+    if (sm && (r = resolve_mesh_of(ctx, src, sm, path, "source_mesh", &plan->source_mesh)) != MK_OK) return r;
+    if (plan->source_mesh >= src->mesh_count)
+        return field_error(ctx, path, "source", "the asset has no mesh%s", NULL);
+    const mk_raw_mesh *smesh = &src->meshes[plan->source_mesh];
+    if (smesh->vertex_count == 0 || smesh->triangle_count == 0)
+        return field_error(ctx, path, sm ? "source_mesh" : "source", "the source mesh has no triangles%s", NULL);
+
+    /* the source mesh's channels, all by default */
+    plan->source_channels = mk_arena_array(ctx->scratch, (size_t)src->channel_count + 1, sizeof(uint32_t));
+    if (!plan->source_channels) return mk_error_oom(ctx->err, "transfer channels");
+    const cJSON *names = cJSON_GetObjectItemCaseSensitive(ch, "channels");
+    char cpath[128];
+    if (!names) {
+        for (uint32_t c = 0; c < src->channel_count; c++)
+            if (src->channels[c].mesh == plan->source_mesh) plan->source_channels[plan->source_channel_count++] = c;
+        if (plan->source_channel_count == 0) {
+            char msg[160];
+            snprintf(msg, sizeof msg, "the source mesh %u (\"%.60s\") has no channels to transfer", plan->source_mesh,
+                     smesh->name ? smesh->name : "");
+            return field_error(ctx, path, "source", "%s", msg);
+        }
+    } else {
+        if (!cJSON_IsArray(names) || cJSON_GetArraySize(names) == 0)
+            return field_error(ctx, path, "channels", "must be a non-empty array of source channel names%s", NULL);
+        int i = 0;
+        for (const cJSON *n = names->child; n; n = n->next, i++) {
+            snprintf(cpath, sizeof cpath, "%s.channels[%d]", path, i);
+            if (!cJSON_IsString(n)) return field_error(ctx, cpath, "", "must be a channel name (a string)%s", NULL);
+            uint32_t found = UINT32_MAX;
+            for (uint32_t c = 0; c < src->channel_count && found == UINT32_MAX; c++)
+                if (src->channels[c].mesh == plan->source_mesh && src->channels[c].name &&
+                    !strcmp(src->channels[c].name, n->valuestring)) found = c;
+            if (found == UINT32_MAX) {
+                char list[120] = "";
+                for (uint32_t c = 0; c < src->channel_count; c++) {
+                    if (src->channels[c].mesh != plan->source_mesh) continue;
+                    size_t len = strlen(list);
+                    const char *cn = src->channels[c].name ? src->channels[c].name : "";
+                    if (len + strlen(cn) + 8 >= sizeof list) { snprintf(list + len, sizeof list - len, ", ..."); break; }
+                    snprintf(list + len, sizeof list - len, "%s\"%s\"", len ? ", " : "", cn);
+                }
+                char msg[240];
+                snprintf(msg, sizeof msg, "no channel \"%.40s\" on the source mesh; its channels are %s", n->valuestring,
+                         *list ? list : "(none)");
+                return field_error(ctx, cpath, "", "%s", msg);
+            }
+            plan->source_channels[plan->source_channel_count++] = found;
+        }
+    }
+    for (uint32_t k = 0; k < plan->source_channel_count; k++) {
+        const mk_raw_channel *sc = &src->channels[plan->source_channels[k]];
+        if (sc->target_count == 0)
+            return field_error(ctx, path, "source", "channel \"%s\" of the source has no targets", sc->name ? sc->name : "");
+        if (strlen(plan->prefix) + strlen(sc->name ? sc->name : "") >= sizeof plan->name)
+            return field_error(ctx, path, "prefix", "with the source channel \"%.60s\" makes a name of 128 bytes or more", sc->name);
+    }
+
+    /* markers: [[source vertex, target vertex], ...] */
+    const cJSON *markers = cJSON_GetObjectItemCaseSensitive(ch, "markers");
+    if (markers) {
+        if (!cJSON_IsArray(markers))
+            return field_error(ctx, path, "markers", "must be an array of [source_vertex, target_vertex] pairs%s", NULL);
+        int count = cJSON_GetArraySize(markers);
+        plan->markers = mk_arena_array(ctx->scratch, (size_t)count + 1, sizeof *plan->markers);
+        if (!plan->markers) return mk_error_oom(ctx->err, "markers");
+        uint32_t limit[2] = { smesh->vertex_count, ctx->raw->meshes[plan->mesh].vertex_count };
+        static const char *const side[2] = { "source", "target" };
+        int i = 0;
+        for (const cJSON *m = markers->child; m; m = m->next, i++) {
+            snprintf(cpath, sizeof cpath, "%s.markers[%d]", path, i);
+            if (!cJSON_IsArray(m) || cJSON_GetArraySize(m) != 2)
+                return field_error(ctx, cpath, "", "must be a pair [source_vertex, target_vertex]%s", NULL);
+            int k = 0;
+            for (const cJSON *e = m->child; e; e = e->next, k++) {
+                double v = e->valuedouble;
+                if (!cJSON_IsNumber(e) || !isfinite(v) || v != floor(v) || v < 0 || v >= limit[k]) {
+                    char msg[120];
+                    snprintf(msg, sizeof msg, "the %s vertex must be an integer in 0..%u", side[k], limit[k] ? limit[k] - 1 : 0);
+                    return field_error(ctx, cpath, "", "%s", msg);
+                }
+                plan->markers[i][k] = (uint32_t)v;
+            }
+        }
+        plan->marker_count = (uint32_t)count;
+    }
+    return MK_OK;
+}
+
 static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int has_top_mesh,
                                uint32_t top_mesh, channel_plan *plan)
 {
@@ -999,12 +1147,12 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     snprintf(path, sizeof path, "channels[%d]", index);
     if (!cJSON_IsObject(ch)) return field_error(ctx, path, "", "must be an object%s", NULL);
     const cJSON *op = cJSON_GetObjectItemCaseSensitive(ch, "op");
-    if (!op) return field_error(ctx, path, "op", "missing (ffd, ffd_travel, ffd_keys, ffd_cylinder, ffd_prism, taper, twist, bend, cage, laplacian or arap)%s", NULL);
+    if (!op) return field_error(ctx, path, "op", "missing (ffd, ffd_travel, ffd_keys, ffd_cylinder, ffd_prism, taper, twist, bend, cage, laplacian, arap or transfer)%s", NULL);
     if (!cJSON_IsString(op)) return field_error(ctx, path, "op", "must be a string%s", NULL);
     int k = -1;
     for (int i = 0; i < (int)(sizeof op_names / sizeof op_names[0]); i++)
         if (!strcmp(op_names[i], op->valuestring)) k = i;
-    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, ffd_travel, ffd_keys, ffd_cylinder, ffd_prism, taper, twist, bend, cage, laplacian or arap)", op->valuestring);
+    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, ffd_travel, ffd_keys, ffd_cylinder, ffd_prism, taper, twist, bend, cage, laplacian, arap or transfer)", op->valuestring);
     plan->op = (op_kind)k;
     mk_result r = check_fields(ctx, ch, path, common_fields, op_fields[k]);
     if (r != MK_OK) return r;
@@ -1055,6 +1203,7 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     case OP_FFD_PRISM: r = parse_ffd_prism(ctx, plan, ch, path); break;
     case OP_CAGE: r = parse_cage(ctx, plan, ch, path); break;
     case OP_LAPLACIAN: case OP_ARAP: r = parse_edit(ctx, plan, ch, path); break;
+    case OP_TRANSFER: r = parse_transfer(ctx, plan, ch, path); break;
     }
     if (r != MK_OK) return r;
     char *json = cJSON_PrintUnformatted(ch);
@@ -1136,6 +1285,8 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
         r = mk_surface_edit_create(mesh, &plan->edit, &raw->arena.allocator, &edit, &inner);
         deformer.eval = mk_surface_edit_eval; deformer.user = edit; deformer.expensive = 1;
         break;
+    case OP_TRANSFER:  /* bake_transfer */
+        return mk_error_set(ctx->err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "%s: transfer is not a deformer", path);
     }
     if (r != MK_OK) return mk_error_set(ctx->err, inner.code, inner.offset, "%s (%s): %s", path, op_names[plan->op], inner.message);
     mk_inbetween_result res;
@@ -1243,6 +1394,65 @@ static mk_result bake_ffd_keys(recipe_ctx *ctx, channel_plan *plan, int index, m
     return MK_OK;
 }
 
+/* transfer: one channel per source channel, all from one factorization. */
+static mk_result bake_transfer(recipe_ctx *ctx, channel_plan *plan, int index, mk_bake_report *report)
+{
+    mk_raw_asset *raw = ctx->raw;
+    const mk_bake_options *o = ctx->options;
+    const mk_raw_mesh *smesh = &plan->source->meshes[plan->source_mesh];
+    double t0 = bake_now();
+    if (o && o->progress) o->progress(o->user, "transfer: matching triangles", 0);
+    mk_transfer_params tp = { smesh, &raw->meshes[plan->mesh], plan->marker_count,
+                              (const uint32_t (*)[2])plan->markers };
+    mk_transfer *x = NULL;
+    mk_error inner;
+    mk_result r = mk_transfer_create(&tp, &raw->arena.allocator, &x, &inner);
+    uint32_t solves_before = 0;
+    double solve_seconds_before = 0;
+    for (uint32_t k = 0; r == MK_OK && k < plan->source_channel_count; k++) {
+        const mk_raw_channel *sc = &plan->source->channels[plan->source_channels[k]];
+        snprintf(plan->name, sizeof plan->name, "%s%s", plan->prefix, sc->name ? sc->name : "");
+        if (o && o->progress) o->progress(o->user, plan->name, (double)k / plan->source_channel_count);
+        uint32_t moved = 0;
+        r = mk_transfer_channel(raw, plan->mesh, plan->name, plan->origin, x, smesh, sc, &moved, &inner);
+        if (r != MK_OK) break;
+        if (plan->has_default_weight) raw->channels[raw->channel_count - 1].default_weight = plan->default_weight;
+        mk_transfer_stats st;
+        mk_transfer_stats_get(x, &st);
+        mk_bake_channel_report cr;
+        memset(&cr, 0, sizeof cr);
+        cr.name = plan->name;
+        cr.op = op_names[plan->op];
+        cr.mesh = plan->mesh;
+        cr.targets = sc->target_count;
+        cr.evaluations = sc->target_count;
+        cr.moved_vertices = moved;
+        /* the one factorization is reported with the first channel, each channel its own solves */
+        cr.factorizations = k == 0;
+        cr.factor_seconds = k == 0 ? st.factor_seconds : 0;
+        cr.solves = st.solves - solves_before;
+        cr.solve_seconds = st.solve_seconds - solve_seconds_before;
+        solves_before = st.solves;
+        solve_seconds_before = st.solve_seconds;
+        cr.seconds = bake_now() - t0;
+        t0 = bake_now();
+        if (o && o->channel_done) o->channel_done(o->user, &cr);
+        report->channels_added++;
+        report->targets_added += sc->target_count;
+    }
+    if (r == MK_OK) {
+        mk_transfer_stats st;
+        mk_transfer_stats_get(x, &st);
+        if (st.flipped || st.unmatched)
+            mk_raw_warn(raw, "transfer channels[%d]: %u target triangles matched a farther source triangle facing "
+                        "their way, %u matched none (they follow their neighbors)", index, st.flipped, st.unmatched);
+    }
+    mk_transfer_destroy(x);
+    if (r != MK_OK)
+        return mk_error_set(ctx->err, inner.code, inner.offset, "channels[%d] (transfer): %s", index, inner.message);
+    return MK_OK;
+}
+
 static mk_result run_recipe(recipe_ctx *ctx, const char *json, size_t size, mk_bake_report *report)
 {
     const char *end = NULL;
@@ -1275,8 +1485,11 @@ static mk_result run_recipe(recipe_ctx *ctx, const char *json, size_t size, mk_b
         if ((r = parse_channel(ctx, ch, i, mesh_item != NULL, top_mesh, &plans[i])) != MK_OK) goto done;
     for (i = 0; i < count; i++)
         if ((r = plans[i].op == OP_FFD_KEYS ? bake_ffd_keys(ctx, &plans[i], i, report)
-                                            : bake_plan(ctx, &plans[i], i, report)) != MK_OK) goto done;
+                 : plans[i].op == OP_TRANSFER ? bake_transfer(ctx, &plans[i], i, report)
+                                              : bake_plan(ctx, &plans[i], i, report)) != MK_OK) goto done;
 done:
+    for (i = 0; plans && i < count; i++)
+        if (plans[i].source) mk_raw_free(plans[i].source);
     cJSON_Delete(root);
     return r;
 }

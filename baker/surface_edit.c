@@ -162,16 +162,11 @@ void edit_targets(mk_surface_edit *s, double amplitude)
 
 mk_result edit_solve(mk_surface_edit *s, mk_error *err)
 {
-    double t0 = bake_now();
-    if (!cholmod_solve2(CHOLMOD_A, s->factor, s->rhs, NULL, &s->x, NULL, &s->y, &s->e, &s->cm))
-        return mk_error_set(err, MK_ERROR_OUT_OF_MEMORY, UINT64_MAX, "CHOLMOD solve failed (status %d)", s->cm.status);
-    s->stats.solves++;
-    s->stats.solve_seconds += bake_now() - t0;
-    return MK_OK;
+    return bake_spd_solve(&s->spd, err);
 }
 
 /* Triplets of the system matrix (upper triangle, stype 1; duplicates are summed). */
-static mk_result assemble(mk_surface_edit *s, cholmod_sparse **out, mk_error *err)
+static mk_result assemble(mk_surface_edit *s, cholmod_triplet **out, mk_error *err)
 {
     uint32_t n = s->welded, nu = s->unknown_count;
     int arap = s->params.method == MK_EDIT_ARAP;
@@ -184,11 +179,11 @@ static mk_result assemble(mk_surface_edit *s, cholmod_sparse **out, mk_error *er
         nnz += arap ? d : d * (d + 1) / 2;
     }
     nnz += n;  /* soft diagonal */
-    cholmod_triplet *T = cholmod_allocate_triplet(nu, nu, nnz, 1, CHOLMOD_REAL, &s->cm);
+    cholmod_triplet *T = cholmod_allocate_triplet(nu, nu, nnz, 1, CHOLMOD_REAL, &s->spd.cm);
     uint32_t *cols = mk_arena_array(&s->arena, max_row, sizeof(uint32_t));
     double *vals = mk_arena_array(&s->arena, max_row, sizeof(double));
     if (!T || !cols || !vals) {
-        if (T) cholmod_free_triplet(&T, &s->cm);
+        if (T) cholmod_free_triplet(&T, &s->spd.cm);
         return mk_error_oom(err, "system matrix");
     }
     int *ti = T->i, *tj = T->j;
@@ -213,11 +208,9 @@ static mk_result assemble(mk_surface_edit *s, cholmod_sparse **out, mk_error *er
     }
 #undef PUT
     T->nnz = k;
-    *out = cholmod_triplet_to_sparse(T, 0, &s->cm);
-    cholmod_free_triplet(&T, &s->cm);
+    *out = T;
     mk_arena_release(&s->arena, cols);
     mk_arena_release(&s->arena, vals);
-    if (!*out) return mk_error_oom(err, "system matrix");
     return MK_OK;
 }
 
@@ -334,35 +327,16 @@ mk_result mk_surface_edit_create(const mk_raw_mesh *mesh, const mk_edit_params *
     }
     s->stats.unknowns = s->unknown_count;
 
-    cholmod_start(&s->cm);
-    s->cm_started = 1;
-    s->cm.print = 0;
     /* ARAP's cotangent Laplacian has a 1-ring stencil and little fill: the simplicial factor
      * solved 2x faster than the supernodal one (bench_baker, 100k vertices: 0.015 vs 0.030 s
      * per 3-rhs solve) at the same factor time. L^T L (2-ring) fills in more and factors
      * faster supernodal (2.1 vs 3.8 s), so Laplacian editing keeps CHOLMOD's choice. */
-    if (s->params.method == MK_EDIT_ARAP) s->cm.supernodal = CHOLMOD_SIMPLICIAL;
+    bake_spd_start(&s->spd, s->params.method == MK_EDIT_ARAP);
     if (s->unknown_count > 0) {
-        cholmod_sparse *A = NULL;
-        if ((r = assemble(s, &A, err)) != MK_OK) goto fail;
+        cholmod_triplet *T = NULL;
+        if ((r = assemble(s, &T, err)) != MK_OK) goto fail;
         s->stats.setup_seconds = bake_now() - t_setup;
-        double t0 = bake_now();
-        s->factor = cholmod_analyze(A, &s->cm);
-        int ok = s->factor && cholmod_factorize(A, s->factor, &s->cm);
-        cholmod_free_sparse(&A, &s->cm);
-        s->stats.factor_seconds = bake_now() - t0;
-        s->stats.factorizations = 1;
-        if (!ok || s->cm.status != CHOLMOD_OK)
-            FAIL(mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
-                              "CHOLMOD could not factor the system (status %d): the matrix is not "
-                              "positive definite", s->cm.status));
-        double rc = cholmod_rcond(s->factor, &s->cm);
-        if (!(rc > 1e-15))
-            FAIL(mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
-                              "the system is numerically singular (rcond %g): degenerate triangles?", rc));
-        s->stats.factor_nonzeros = s->cm.lnz;
-        s->rhs = cholmod_zeros(s->unknown_count, 3, CHOLMOD_REAL, &s->cm);
-        if (!s->rhs) FAIL(mk_error_oom(err, "right-hand sides"));
+        if ((r = bake_spd_factor(&s->spd, &T, 3, err)) != MK_OK) goto fail;
     }
 #undef FAIL
     *out = s;
@@ -402,19 +376,17 @@ void mk_surface_edit_stats(const mk_surface_edit *s, mk_solver_stats *stats)
 {
     *stats = s->stats;
     stats->local_seconds = s->local_seconds;
+    stats->factorizations = s->spd.factorizations;
+    stats->solves = s->spd.solves;
+    stats->factor_seconds = s->spd.factor_seconds;
+    stats->solve_seconds = s->spd.solve_seconds;
+    stats->factor_nonzeros = s->spd.factor_nonzeros;
 }
 
 void mk_surface_edit_destroy(mk_surface_edit *s)
 {
     if (!s) return;
-    if (s->cm_started) {
-        if (s->factor) cholmod_free_factor(&s->factor, &s->cm);
-        if (s->rhs) cholmod_free_dense(&s->rhs, &s->cm);
-        if (s->x) cholmod_free_dense(&s->x, &s->cm);
-        if (s->y) cholmod_free_dense(&s->y, &s->cm);
-        if (s->e) cholmod_free_dense(&s->e, &s->cm);
-        cholmod_finish(&s->cm);
-    }
+    bake_spd_finish(&s->spd);
     mk_arena arena = s->arena;
     mk_arena_free_all(&arena);
 }

@@ -3,7 +3,7 @@
 #ifndef MK_SURFACE_EDIT_INTERNAL_H
 #define MK_SURFACE_EDIT_INTERNAL_H
 
-#include <suitesparse/cholmod.h>
+#include "sparse_spd.h"
 #include "surface_edit.h"
 
 struct mk_surface_edit {
@@ -30,10 +30,7 @@ struct mk_surface_edit {
     double *anderson;         /* ARAP with Anderson acceleration: (2 + 2 * EDIT_ANDERSON_HISTORY)
                                * vectors of 3 per welded vertex (arap.c) */
     double local_seconds;     /* ARAP: time in local steps */
-    cholmod_common cm;
-    int cm_started;
-    cholmod_factor *factor;
-    cholmod_dense *rhs, *x, *y, *e;
+    bake_spd spd;             /* the factored system; spd.rhs / spd.x hold 3 columns */
     mk_solver_stats stats;
 };
 
@@ -46,7 +43,7 @@ struct mk_surface_edit {
 uint32_t edit_laplacian_row(const mk_surface_edit *edit, uint32_t v, uint32_t *cols, double *vals);
 /* Constrained positions of every constrained welded vertex at amplitude a into edit->target. */
 void edit_targets(mk_surface_edit *edit, double amplitude);
-/* Solves the factored system for the right-hand sides in edit->rhs (3 columns) into edit->x. */
+/* Solves the factored system for the right-hand sides in edit->spd.rhs (3 columns) into edit->spd.x. */
 mk_result edit_solve(mk_surface_edit *edit, mk_error *err);
 
 /* ---- the methods, leaves on the core (edit.c picks one) ---- */

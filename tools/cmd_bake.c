@@ -200,7 +200,7 @@ static int run_bake(void *p)
     char dir[4096];
     dir_of(a->recipe, dir, sizeof dir);
     mk_bake_options bo = { .base_dir = dir, .progress = on_progress, .channel_done = on_channel, .user = &ui,
-                           .file_read = a->depfile ? on_file_read : NULL };
+                           .file_read = a->depfile ? on_file_read : NULL, .load_asset = mk_import_load_asset };
     mk_bake_report report;
     if (r == MK_OK) r = mk_bake_recipe(&raw, recipe, recipe_size, &bo, &report, &err);
     if (r == MK_OK && !a->all_meshes) mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");

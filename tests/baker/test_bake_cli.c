@@ -56,6 +56,36 @@ static void bake_sample_and_open_it(void)
     mk_arena_free_all(&arena);
 }
 
+/* The transfer sample reads its source asset (a glTF next to the recipe) through the CLI's loader. */
+static void transfer_sample_reads_its_source(void)
+{
+    char in[1024], out[1024], recipe[1024];
+    snprintf(in, sizeof in, "%s/cli_tube3.morph", work);
+    snprintf(out, sizeof out, "%s/cli_tube_transfer.morph", work);
+    snprintf(recipe, sizeof recipe, "%s/transfer.json", recipes);
+    remove(out);
+    CHECK(run("\"%s\" \"%s\" > /dev/null%s%s", make_example, in, "", "") == 0);
+    CHECK(run("\"%s\" bake \"%s\" --recipe \"%s\" -o \"%s\" --quiet > /dev/null", morphkit, in, recipe, out) == 0);
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    void *data = NULL;
+    size_t size = 0;
+    mk_error err;
+    mk_asset asset;
+    mk_result r = mk_read_file(&arena, out, 1 << 28, &data, &size, &err);
+    if (r == MK_OK) r = mk_asset_open(data, size, &asset, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    if (r == MK_OK) {
+        /* the example's 2 channels + the source's "pinch" and "lean" with the prefix */
+        CHECK_EQ_INT(asset.channel_count, 4);
+        mk_channel_info ci;
+        int32_t c = mk_find_channel(&asset, "coarse_pinch");
+        CHECK(c >= 0 && mk_channel_get(&asset, (uint32_t)c, &ci) && strstr(ci.origin, "\"op\":\"transfer\"") != NULL);
+        CHECK(mk_find_channel(&asset, "coarse_lean") >= 0);
+    }
+    mk_arena_free_all(&arena);
+}
+
 static void bad_recipe_writes_nothing(void)
 {
     char in[1024], out[1024], recipe[1024];
@@ -78,6 +108,7 @@ int main(int argc, char **argv)
 {
     if (argc < 5) { fprintf(stderr, "usage: test_bake_cli MORPHKIT MAKE_EXAMPLE RECIPES_DIR WORK_DIR\n"); return 2; }
     morphkit = argv[1]; make_example = argv[2]; recipes = argv[3]; work = argv[4];
-    static const check_case cases[] = { CASE(bake_sample_and_open_it), CASE(bad_recipe_writes_nothing) };
-    return check_run(cases, 2, 1, argv);
+    static const check_case cases[] = { CASE(bake_sample_and_open_it), CASE(transfer_sample_reads_its_source),
+                                        CASE(bad_recipe_writes_nothing) };
+    return check_run(cases, 3, 1, argv);
 }

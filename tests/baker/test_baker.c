@@ -1520,6 +1520,8 @@ static void bad_recipes_name_the_field(void)
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"bend\", \"angle\": 30, \"direction\": [0, 0, 5], \"axis\": \"z\"}]}",
                  "direction");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"taper\", \"scale\": 0.5, \"range\": [2, 1]}]}", "channels[0].range");
+    /* finite in double, but the deltas overflow the stored floats (found by fuzz_recipe) */
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"taper\", \"scale\": 1e40}]}", "beyond the float range");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"twist\", \"angle\": 30, \"inbetweens\": 0}]}", "channels[0].inbetweens");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"cage\", \"cage\": \"/nonexistent.obj\", \"deformed_cage\": \"x.obj\"}]}",
                  "channels[0].cage");
@@ -1696,7 +1698,8 @@ static void record_channels(void *user, const mk_bake_channel_report *c)
 static void sample_recipes_bake(void)
 {
     static const char *const names[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json",
-                                         "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json", "ffd_prism.json" };
+                                         "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json", "ffd_prism.json",
+                                         "transfer.json" };
     const char *root = getenv("MORPHKIT_SOURCE_ROOT");
     if (!root) root = MK_SOURCE_ROOT;
     char dir[4096];
@@ -1727,6 +1730,7 @@ static void sample_recipes_bake(void)
             memset(&o, 0, sizeof o);
             o.base_dir = dir;
             o.channel_done = record_channels;
+            o.load_asset = mk_import_load_asset;
             o.user = &rec;
             mk_bake_report rep;
             mk_error err;

@@ -152,6 +152,7 @@ static int baked(const char *dir)
         mk_bake_options options;
         memset(&options, 0, sizeof options);
         options.base_dir = recipes;
+        options.load_asset = mk_import_load_asset;  /* the transfer sample's source asset */
         mk_error err;
         if (mk_bake_recipe(&raw, (const char *)json, size, &options, NULL, &err) == MK_OK) {
             char name[512];
