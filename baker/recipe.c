@@ -960,7 +960,6 @@ static mk_result parse_shell(recipe_ctx *ctx, channel_plan *plan, const cJSON *c
     if ((r = get_positive(ctx, ch, path, "kB", &p->kB, 0, 0, INFINITY, ">= 0")) != MK_OK) return r;
     if ((r = get_positive(ctx, ch, path, "epsilon", &p->epsilon, 0, 0, 1, "in [0, 1)")) != MK_OK) return r;
     if ((r = get_positive(ctx, ch, path, "thickness", &p->thickness, 0, 0, INFINITY, ">= 0 (mesh units)")) != MK_OK) return r;
-    if (p->thickness > 0) return field_error(ctx, path, "thickness", "collision handling is not implemented yet: must be 0%s", NULL);
     if ((r = parse_shell_region(ctx, plan, ch, path)) != MK_OK) return r;
     if ((r = parse_shell_at(ctx, plan, ch, path)) != MK_OK) return r;
     const cJSON *log = cJSON_GetObjectItemCaseSensitive(ch, "log");

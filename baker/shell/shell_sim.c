@@ -168,7 +168,10 @@ mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *a
         memset(s.lambda, 0, nlambda * sizeof(double));
         for (uint32_t it = 0; it < p->iterations; it++) sweep(&s, q, alpha, energy);
         double tc = bake_now();
-        /* COLLIDE */
+        if (p->thickness > 0) {
+            r = shell_collide(m, x, q, p->thickness, arena, &st->vt_hits, &st->ee_hits, &st->collision_rounds, err);
+            if (r != MK_OK) return r;
+        }
         st->ms_collision = 1000 * (bake_now() - tc);
         for (size_t k = 0; k < n3; k++) {
             if (!isfinite(q[k]))

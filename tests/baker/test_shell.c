@@ -391,9 +391,151 @@ static void same_recipe_gives_identical_bytes(void)
     mk_raw_free(&raws[1]);
 }
 
+/* ---- exact-sign triangle-triangle intersection over all non-adjacent pairs ---- */
+
+static double orient3d(const double *a, const double *b, const double *c, const double *d)
+{
+    double u[3], v[3], w[3];
+    for (int k = 0; k < 3; k++) { u[k] = b[k] - a[k]; v[k] = c[k] - a[k]; w[k] = d[k] - a[k]; }
+    return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
+}
+
+/* Does segment pq cross triangle abc (touching counts)? */
+static int segment_crosses(const double *p, const double *q, const double *a, const double *b, const double *c)
+{
+    double op = orient3d(a, b, c, p), oq = orient3d(a, b, c, q);
+    if ((op > 0 && oq > 0) || (op < 0 && oq < 0) || (op == 0 && oq == 0)) return 0;
+    double s1 = orient3d(p, q, a, b), s2 = orient3d(p, q, b, c), s3 = orient3d(p, q, c, a);
+    return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
+}
+
+static int triangles_intersect(const double *const t[3], const double *const u[3])
+{
+    for (int i = 0; i < 3; i++)
+        if (segment_crosses(t[i], t[(i + 1) % 3], u[0], u[1], u[2]) || segment_crosses(u[i], u[(i + 1) % 3], t[0], t[1], t[2]))
+            return 1;
+    return 0;
+}
+
+/* Intersecting pairs of triangles that share no vertex, found through a uniform grid of their
+ * bounding boxes (pairs met in several cells are tested each time but counted once). */
+static uint32_t self_intersections(const double *pos, const uint32_t *tris, uint32_t nt)
+{
+    double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY }, mean = 0;
+    for (uint32_t t = 0; t < nt; t++)
+        for (int k = 0; k < 3; k++) {
+            const double *a = pos + 3 * tris[3 * t + k], *b = pos + 3 * tris[3 * t + (k + 1) % 3];
+            mean += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2])) / (3.0 * nt);
+            for (int c = 0; c < 3; c++) { lo[c] = fmin(lo[c], a[c]); hi[c] = fmax(hi[c], a[c]); }
+        }
+    double cell = 2 * mean;
+    int dims[3];
+    for (int c = 0; c < 3; c++) dims[c] = (int)((hi[c] - lo[c]) / cell) + 1;
+    size_t cells = (size_t)dims[0] * dims[1] * dims[2];
+    uint32_t *count = calloc(cells + 1, sizeof(uint32_t)), **list = calloc(cells, sizeof(uint32_t *));
+    int (*box)[6] = malloc(nt * sizeof *box);
+    for (uint32_t t = 0; t < nt; t++)
+        for (int c = 0; c < 3; c++) {
+            double a = INFINITY, b = -INFINITY;
+            for (int k = 0; k < 3; k++) { a = fmin(a, pos[3 * tris[3 * t + k] + c]); b = fmax(b, pos[3 * tris[3 * t + k] + c]); }
+            box[t][c] = (int)((a - lo[c]) / cell);
+            box[t][3 + c] = (int)((b - lo[c]) / cell);
+        }
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t t = 0; t < nt; t++)
+            for (int i = box[t][0]; i <= box[t][3]; i++)
+                for (int j = box[t][1]; j <= box[t][4]; j++)
+                    for (int k = box[t][2]; k <= box[t][5]; k++) {
+                        size_t id = (size_t)i + dims[0] * ((size_t)j + dims[1] * (size_t)k);
+                        if (pass == 0) { count[id]++; continue; }
+                        if (!list[id]) { list[id] = malloc(count[id] * sizeof(uint32_t)); count[id] = 0; }
+                        list[id][count[id]++] = t;
+                    }
+    unsigned char *hit = calloc(nt, 1);
+    uint32_t pairs = 0;
+    for (size_t id = 0; id < cells; id++)
+        for (uint32_t a = 0; list[id] && a < count[id]; a++)
+            for (uint32_t b = a + 1; b < count[id]; b++) {
+                uint32_t t = list[id][a], u = list[id][b];
+                const uint32_t *ta = tris + 3 * t, *tb = tris + 3 * u;
+                int shared = 0;
+                for (int i = 0; i < 3; i++)
+                    for (int j = 0; j < 3; j++) shared |= ta[i] == tb[j];
+                if (shared) continue;
+                const double *pa[3] = { pos + 3 * ta[0], pos + 3 * ta[1], pos + 3 * ta[2] };
+                const double *pb[3] = { pos + 3 * tb[0], pos + 3 * tb[1], pos + 3 * tb[2] };
+                if (triangles_intersect(pa, pb) && !(hit[t] && hit[u])) { pairs++; hit[t] = hit[u] = 1; }
+            }
+    for (size_t id = 0; id < cells; id++) free(list[id]);
+    free(list); free(count); free(box); free(hit);
+    return pairs;
+}
+
+/* The positions of a baked target: rest + its stored deltas. */
+static void target_positions(const mk_raw_mesh *mesh, const mk_raw_target *t, double *pos)
+{
+    for (uint32_t i = 0; i < 3 * mesh->vertex_count; i++) pos[i] = mesh->positions[i];
+    for (uint32_t k = 0; k < t->count; k++)
+        for (int c = 0; c < 3; c++) pos[3 * t->indices[k] + c] += t->positions[3 * k + c];
+}
+
+/* A shell squeezed until it collapses: without collision handling its last frame crosses itself
+ * (so the check can fail); with a thickness no baked in-between does. */
+static void collisions_keep_every_inbetween_free_of_self_intersections(void)
+{
+    static const char *const recipes[2] = {
+        "{\"mesh\": \"ball\", \"channels\": [{\"op\": \"shell\", \"pressure\": 60, \"frames\": 80, \"epsilon\": 0,"
+        " \"at_frames\": [20, 40, 60, 70]}]}",
+        "{\"mesh\": \"ball\", \"channels\": [{\"op\": \"shell\", \"pressure\": 60, \"frames\": 80, \"epsilon\": 0,"
+        " \"thickness\": 0.01, \"at_frames\": [20, 40, 60, 70], \"log\": \"shell_collisions.csv\"}]}" };
+    for (int with = 0; with < 2; with++) {
+        mk_raw_asset raw;
+        mk_raw_init(&raw, NULL);
+        const mk_raw_mesh *mesh = fixture_icosphere(&raw, "ball", 1, 2);
+        mk_error err;
+        mk_result r = mk_bake_recipe(&raw, recipes[with], strlen(recipes[with]), NULL, NULL, &err);
+        CHECK_MSG(r == MK_OK, "bake: %s", err.message);
+        double *pos = malloc(3 * mesh->vertex_count * sizeof(double));
+        uint32_t worst = 0;
+        for (uint32_t t = 0; r == MK_OK && t < raw.channels[0].target_count; t++) {
+            const mk_raw_target *target = &raw.channels[0].targets[t];
+            target_positions(mesh, target, pos);
+            uint32_t pairs = self_intersections(pos, mesh->triangles, mesh->triangle_count);
+            printf("%s collisions: target at weight %.2f: %u intersecting triangle pairs (of %u triangles)\n",
+                   with ? "with" : "without", target->full_weight, pairs, mesh->triangle_count);
+            if (pairs > worst) worst = pairs;
+        }
+        if (with) CHECK_EQ_INT(worst, 0);
+        else CHECK(worst > 0);
+        if (with && r == MK_OK) {
+            /* The log: one line per frame after the header, collisions counted. */
+            size_t size = 0;
+            char *csv = (char *)check_read_file("shell_collisions.csv", &size);
+            CHECK(csv != NULL);
+            uint32_t lines = 0, vt = 0, ee = 0, frame = 0;
+            double ratio = 1;
+            for (char *line = csv ? strchr(csv, '\n') : NULL; line && line[1]; line = strchr(line + 1, '\n')) {
+                unsigned f, a, b;
+                double time, vr;
+                if (sscanf(line + 1, "%u,%lf,%lf,%*f,%*f,%*f,%u,%u", &f, &time, &vr, &a, &b) == 5) {
+                    lines++; vt += a; ee += b; frame = f; ratio = vr;
+                }
+            }
+            printf("log: %u frame lines (last frame %u, V/V0 %.4f), %u vertex-triangle and %u edge-edge hits\n", lines, frame,
+                   ratio, vt, ee);
+            CHECK_EQ_INT(lines, 81);
+            CHECK(vt + ee > 0);
+            free(csv);
+        }
+        free(pos);
+        mk_raw_free(&raw);
+    }
+}
+
 CHECK_MAIN(CASE(energy_gradients_match_finite_differences),
            CASE(volume_and_its_gradient),
            CASE(volume_falls_monotonically_and_bending_resists),
            CASE(anisotropic_region_contracts_faster),
            CASE(baked_channel_plays_the_recorded_frames),
-           CASE(same_recipe_gives_identical_bytes))
+           CASE(same_recipe_gives_identical_bytes),
+           CASE(collisions_keep_every_inbetween_free_of_self_intersections))
