@@ -50,8 +50,9 @@ static void swept_box(const double *x, const double *p, const uint32_t *idx, int
     for (int i = 0; i < k; i++)
         for (int c = 0; c < 3; c++) {
             double a = x[3 * (size_t)idx[i] + c], b = p[3 * (size_t)idx[i] + c];
-            lo[c] = fmin(lo[c], fmin(a, b));
-            hi[c] = fmax(hi[c], fmax(a, b));
+            double l = a < b ? a : b, h = a < b ? b : a;
+            if (l < lo[c]) lo[c] = l;
+            if (h > hi[c]) hi[c] = h;
         }
     for (int c = 0; c < 3; c++) { lo[c] -= pad; hi[c] += pad; }
 }
@@ -222,6 +223,8 @@ typedef struct collide_ctx {
     double thickness, tol;
     double *scale;            /* per vertex: fraction of its step kept this round (1: untouched) */
     uint32_t *stamp;          /* per triangle or edge: query + 1 of the last visit */
+    unsigned char *moved;     /* per vertex: pulled back in the previous round */
+    double *boxes[2];         /* this round's swept boxes (lo, hi: 6 doubles) of triangles, edges */
     uint32_t vt, ee;
 } collide_ctx;
 
@@ -229,6 +232,9 @@ typedef struct collide_ctx {
  * nothing (later rounds). */
 static void test_pair(collide_ctx *c, int kind, const uint32_t idx[4], int round)
 {
+    /* After the first round only pairs with a vertex pulled back in the previous round can
+     * change: the others move as they did when they were tested. */
+    if (round > 0 && !c->moved[idx[0]] && !c->moved[idx[1]] && !c->moved[idx[2]] && !c->moved[idx[3]]) return;
     const double *s[4], *e[4];
     for (int i = 0; i < 4; i++) { s[i] = c->x + 3 * (size_t)idx[i]; e[i] = c->p + 3 * (size_t)idx[i]; }
     double t = time_of_impact(kind, s, e, c->tol);
@@ -267,8 +273,7 @@ static void visit_cells(collide_ctx *c, const grid *g, int kind, uint32_t query,
                     for (int u = 0; u < (kind == 0 ? 1 : 2); u++)
                         for (int w = 0; w < nb; w++) shared |= qa[u] == ib[w];
                     if (shared) continue;
-                    double blo[3], bhi[3];
-                    swept_box(c->x, c->p, ib, nb, c->thickness, blo, bhi);
+                    const double *blo = c->boxes[kind] + 6 * (size_t)item, *bhi = blo + 3;
                     if (blo[0] > hi[0] || bhi[0] < lo[0] || blo[1] > hi[1] || bhi[1] < lo[1] || blo[2] > hi[2] || bhi[2] < lo[2])
                         continue;
                     uint32_t idx[4];
@@ -287,8 +292,11 @@ mk_result shell_collide(const shell_mesh *m, const double *x, double *p, double 
     mk_arena_init(&local, &arena->allocator);
     double *scale = mk_arena_array(&local, m->n, sizeof(double));
     uint32_t *stamp = mk_arena_array(&local, (size_t)m->tri_count + m->hinge_count, sizeof(uint32_t));
+    unsigned char *moved = mk_arena_array(&local, m->n, 1);
+    double *tri_boxes = mk_arena_array(&local, 6 * (size_t)m->tri_count, sizeof(double));
+    double *edge_boxes = mk_arena_array(&local, 6 * (size_t)m->hinge_count, sizeof(double));
     mk_result r = MK_OK;
-    if (!scale || !stamp) { mk_arena_free_all(&local); return mk_error_oom(err, "shell collisions"); }
+    if (!scale || !stamp || !moved || !tri_boxes || !edge_boxes) { mk_arena_free_all(&local); return mk_error_oom(err, "shell collisions"); }
     /* Cell size: the mean edge length at the step's start. */
     double mean = 0;
     for (uint32_t h = 0; h < m->hinge_count; h++) {
@@ -296,19 +304,19 @@ mk_result shell_collide(const shell_mesh *m, const double *x, double *p, double 
         vec3_sub(d, x + 3 * (size_t)m->hinges[4 * (size_t)h], x + 3 * (size_t)m->hinges[4 * (size_t)h + 1]);
         mean += vec3_length(d) / m->hinge_count;
     }
-    collide_ctx c = { m, x, p, thickness, fmax(thickness, 1e-9 * mean), scale, stamp, 0, 0 };
+    collide_ctx c = { m, x, p, thickness, fmax(thickness, 1e-9 * mean), scale, stamp, moved, { tri_boxes, edge_boxes }, 0, 0 };
     for (int round = 0; round < MAX_ROUNDS; round++) {
         grid tg = { NULL, 0, 0, fmax(2 * mean, 4 * thickness), &local }, eg = tg;
         int ok = 1;
         for (uint32_t t = 0; t < m->tri_count && ok; t++) {
-            double lo[3], hi[3];
-            swept_box(x, p, m->tris + 3 * (size_t)t, 3, thickness, lo, hi);
-            ok = grid_add(&tg, lo, hi, t);
+            double *box = c.boxes[0] + 6 * (size_t)t;
+            swept_box(x, p, m->tris + 3 * (size_t)t, 3, thickness, box, box + 3);
+            ok = grid_add(&tg, box, box + 3, t);
         }
         for (uint32_t h = 0; h < m->hinge_count && ok; h++) {
-            double lo[3], hi[3];
-            swept_box(x, p, m->hinges + 4 * (size_t)h, 2, thickness, lo, hi);
-            ok = grid_add(&eg, lo, hi, h);
+            double *box = c.boxes[1] + 6 * (size_t)h;
+            swept_box(x, p, m->hinges + 4 * (size_t)h, 2, thickness, box, box + 3);
+            ok = grid_add(&eg, box, box + 3, h);
         }
         if (!ok) { r = mk_error_oom(err, "shell collisions"); break; }
         qsort(tg.entries, tg.count, sizeof *tg.entries, compare_entries);
@@ -325,12 +333,14 @@ mk_result shell_collide(const shell_mesh *m, const double *x, double *p, double 
         mk_arena_release(&local, eg.entries);
         if (c.vt + c.ee == before) break;
         /* Response: pull the hit vertices back along their step. */
-        for (uint32_t v = 0; v < m->n; v++)
+        for (uint32_t v = 0; v < m->n; v++) {
+            moved[v] = scale[v] < 1;
             if (scale[v] < 1)
                 for (int k = 0; k < 3; k++) {
                     size_t i = 3 * (size_t)v + (size_t)k;
                     p[i] = x[i] + scale[v] * (p[i] - x[i]);
                 }
+        }
         if (round == MAX_ROUNDS - 1) memcpy(p, x, 3 * (size_t)m->n * sizeof(double));  /* fail-safe: no motion */
     }
     *vt = c.vt;
