@@ -341,7 +341,7 @@ static mk_result bake_channel(mk_raw_asset *raw, uint32_t mesh_index, const char
     } else {
         key_count = fixed;
         for (uint32_t i = 0; i < key_count; i++)
-            key_weight[i] = (double)(float)((double)(i + 1) / fixed);
+            key_weight[i] = (double)(float)(options->weights ? options->weights[i] : (double)(i + 1) / fixed);
     }
 
     float *key_deltas[256];

@@ -30,6 +30,8 @@ typedef struct mk_inbetween_options {
     double tolerance;      /* adaptive: max playback error, fraction of the bbox diagonal; 0 = 0.001 */
     uint32_t samples;      /* sampled weights are k/samples, k = 1..samples; 0 = 100 (step 0.01) */
     uint32_t max_targets;  /* adaptive: fail above this many targets; 0 = 64 */
+    const double *weights; /* fixed count: the targets' full weights (count increasing values in
+                            * (0, 1], the last 1); NULL = k/count */
 } mk_inbetween_options;
 
 typedef struct mk_inbetween_result {

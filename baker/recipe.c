@@ -22,18 +22,19 @@
 #include "inbetween.h"
 #include "surface_edit.h"
 #include "transfer.h"
+#include "shell/shell_channel.h"
 #include "obj.h"
 
 #define PI 3.14159265358979323846
 
-typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP, OP_FFD_TRAVEL, OP_FFD_KEYS, OP_FFD_CYLINDER, OP_FFD_PRISM, OP_TRANSFER } op_kind;
+typedef enum op_kind { OP_FFD, OP_TAPER, OP_TWIST, OP_BEND, OP_CAGE, OP_LAPLACIAN, OP_ARAP, OP_FFD_TRAVEL, OP_FFD_KEYS, OP_FFD_CYLINDER, OP_FFD_PRISM, OP_TRANSFER, OP_SHELL } op_kind;
 
-static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap", "ffd_travel", "ffd_keys", "ffd_cylinder", "ffd_prism", "transfer" };
+static const char *const op_names[] = { "ffd", "taper", "twist", "bend", "cage", "laplacian", "arap", "ffd_travel", "ffd_keys", "ffd_cylinder", "ffd_prism", "transfer", "shell" };
 
 /* Fields accepted by every op, and per op. */
 static const char *const common_fields[] = { "name", "op", "mesh", "inbetweens", "tolerance",
                                              "samples", "max_targets", "default_weight", NULL };
-static const char *const op_fields[][14] = {
+static const char *const op_fields[][20] = {
     [OP_FFD] = { "dims", "basis", "origin", "axes", "padding", "moves", NULL },
     [OP_TAPER] = { "axis", "center", "range", "scale", NULL },
     [OP_TWIST] = { "axis", "center", "range", "angle", NULL },
@@ -49,6 +50,8 @@ static const char *const op_fields[][14] = {
     [OP_FFD_PRISM] = { "sides", "section", "degree", "layers", "axis", "center", "range", "radius", "reference",
                        "padding", "rest_moves", "moves", NULL },
     [OP_TRANSFER] = { "source", "source_mesh", "channels", "markers", "prefix", NULL },
+    [OP_SHELL] = { "pressure", "ramp", "dt", "frames", "iterations", "density", "damping", "material", "mu", "lambda", "kB",
+                   "anisotropic", "thickness", "epsilon", "at_frames", "at_volume_ratios", "log", "clip", NULL },
 };
 
 /* Everything parsed for one channel before baking. */
@@ -82,6 +85,12 @@ typedef struct channel_plan {
     uint32_t (*markers)[2];
     char prefix[64];              /* transfer: prepended to the source channel names */
     int has_default_weight;
+    shell_params shell;           /* shell: the simulation */
+    unsigned char *shell_region;  /* shell: anisotropic region per render vertex, or NULL */
+    double *shell_at;             /* shell: at_frames or at_volume_ratios (0 entries: default) */
+    uint32_t shell_at_count;
+    int shell_at_ratios;
+    const char *shell_log;        /* shell: CSV log path, or NULL */
 } channel_plan;
 
 typedef struct recipe_ctx {
@@ -167,6 +176,19 @@ static mk_result check_fields(recipe_ctx *ctx, const cJSON *obj, const char *pat
     return MK_OK;
 }
 
+/* The object field `field` of obj (NULL in *out when absent): checked to be an object with only
+ * the given fields; subpath receives "path.field" for its own errors. */
+static mk_result get_object(recipe_ctx *ctx, const cJSON *obj, const char *path, const char *field,
+                            const char *const *fields, const char *usage, char *subpath, size_t subpath_size,
+                            const cJSON **out)
+{
+    *out = cJSON_GetObjectItemCaseSensitive(obj, field);
+    if (!*out) return MK_OK;
+    snprintf(subpath, subpath_size, "%s.%s", path, field);
+    if (!cJSON_IsObject(*out)) return field_error(ctx, subpath, "", "must be an object %s", usage);
+    return check_fields(ctx, *out, subpath, fields, NULL);
+}
+
 /* ---- vertex selections ---- */
 
 /* Selection object: {"indices": [...]} | {"center": [x,y,z], "radius": r} |
@@ -240,16 +262,13 @@ static mk_result parse_rotate(recipe_ctx *ctx, const cJSON *obj, const char *pat
                               double *angle, double pivot[3], const double def_pivot[3])
 {
     static const char *const rot_fields[] = { "axis", "degrees", "pivot", NULL };
-    const cJSON *rot = cJSON_GetObjectItemCaseSensitive(obj, "rotate");
+    const cJSON *rot;
+    char rpath[256];
     *angle = 0;
     axis[0] = 0; axis[1] = 0; axis[2] = 1;
     for (int c = 0; c < 3; c++) pivot[c] = def_pivot[c];
-    if (!rot) return MK_OK;
-    char rpath[256];
-    snprintf(rpath, sizeof rpath, "%s.rotate", path);
-    if (!cJSON_IsObject(rot)) return field_error(ctx, rpath, "", "must be an object {axis, degrees, pivot}%s", NULL);
-    mk_result r = check_fields(ctx, rot, rpath, rot_fields, NULL);
-    if (r != MK_OK) return r;
+    mk_result r = get_object(ctx, obj, path, "rotate", rot_fields, "{axis, degrees, pivot}", rpath, sizeof rpath, &rot);
+    if (r != MK_OK || !rot) return r;
     int got = get_vec3(ctx, rot, rpath, "axis", axis);
     if (got < 0) return ctx->err->code;
     if (got == 0) return field_error(ctx, rpath, "axis", "missing%s", NULL);
@@ -957,6 +976,138 @@ static mk_result extended_ffd_eval(void *user, double amplitude, double *positio
     return MK_OK;
 }
 
+/* shell: the simulation parameters, the anisotropic region and where the targets go. */
+static mk_result get_positive(recipe_ctx *ctx, const cJSON *ch, const char *path, const char *field, double *out,
+                              double lo, int lo_open, double hi, const char *range)
+{
+    mk_result r = get_number(ctx, ch, path, field, out, 0);
+    if (r != MK_OK) return r;
+    if ((lo_open ? !(*out > lo) : !(*out >= lo)) || !(*out < hi)) return field_error(ctx, path, field, "must be %s", range);
+    return MK_OK;
+}
+
+static mk_result parse_shell_at(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    const cJSON *frames = cJSON_GetObjectItemCaseSensitive(ch, "at_frames");
+    const cJSON *ratios = cJSON_GetObjectItemCaseSensitive(ch, "at_volume_ratios");
+    if (frames && ratios) return field_error(ctx, path, "at_volume_ratios", "give at_frames or at_volume_ratios, not both%s", NULL);
+    const cJSON *list = frames ? frames : ratios;
+    const char *field = frames ? "at_frames" : "at_volume_ratios";
+    if (!list) return MK_OK;
+    int count = cJSON_IsArray(list) ? cJSON_GetArraySize(list) : 0;
+    if (count < 1 || count > (untrusted(ctx) ? 32 : SHELL_MAX_KEYS))
+        return field_error(ctx, path, field, "must be an array of 1..256 numbers (32 when untrusted)%s", NULL);
+    plan->shell_at = mk_arena_array(ctx->scratch, (size_t)count, sizeof(double));
+    if (!plan->shell_at) return mk_error_oom(ctx->err, field);
+    plan->shell_at_ratios = ratios != NULL;
+    int k = 0;
+    for (const cJSON *e = list->child; e; e = e->next, k++) {
+        double v = e->valuedouble;
+        char msg[160];
+        int ok = cJSON_IsNumber(e) && isfinite(v);
+        if (frames) {
+            ok = ok && v == floor(v) && v >= 1 && v <= plan->shell.frames && (k == 0 || v > plan->shell_at[k - 1]);
+            snprintf(msg, sizeof msg, "entry %d must be a frame in 1..%u (frames), later than the previous entry", k, plan->shell.frames);
+        } else {
+            ok = ok && v > 0 && v < 1 && (k == 0 || v < plan->shell_at[k - 1]);
+            snprintf(msg, sizeof msg, "entry %d must be a volume ratio in (0, 1), smaller than the previous entry", k);
+        }
+        if (!ok) return field_error(ctx, path, field, "%s", msg);
+        plan->shell_at[k] = v;
+    }
+    plan->shell_at_count = (uint32_t)count;
+    return MK_OK;
+}
+
+static mk_result parse_shell_region(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    static const char *const aniso_fields[] = { "region", "direction", "energy", "stiffness", "k_A", NULL };
+    shell_params *p = &plan->shell;
+    const cJSON *an;
+    char apath[96];
+    mk_result r = get_object(ctx, ch, path, "anisotropic", aniso_fields, "{region, direction, energy, stiffness, k_A}",
+                             apath, sizeof apath, &an);
+    if (r != MK_OK || !an) return r;
+    const mk_raw_mesh *mesh = &ctx->raw->meshes[plan->mesh];
+    const cJSON *region = cJSON_GetObjectItemCaseSensitive(an, "region");
+    if (!region) return field_error(ctx, apath, "region", "missing (a vertex selection)%s", NULL);
+    plan->shell_region = mk_arena_array(ctx->scratch, mesh->vertex_count, 1);
+    if (!plan->shell_region) return mk_error_oom(ctx->err, "shell region");
+    uint32_t *list = NULL, count = 0, cap = 0;
+    char rpath[128];
+    snprintf(rpath, sizeof rpath, "%s.region", apath);
+    if ((r = parse_selection(ctx, mesh, region, rpath, plan->shell_region, &list, &count, &cap, 0)) != MK_OK) return r;
+    p->aniso_direction[1] = 1;
+    int got = get_vec3(ctx, an, apath, "direction", p->aniso_direction);
+    if (got < 0) return ctx->err->code;
+    if (!(vec3_normalize(p->aniso_direction) > 0)) return field_error(ctx, apath, "direction", "is a zero vector%s", NULL);
+    const cJSON *energy = cJSON_GetObjectItemCaseSensitive(an, "energy");
+    p->aniso_energy = SHELL_ANISO_ARAP;
+    if (energy) {
+        const char *e = cJSON_IsString(energy) ? energy->valuestring : "";
+        if (!strcmp(e, "arap")) p->aniso_energy = SHELL_ANISO_ARAP;
+        else if (!strcmp(e, "sqrt")) p->aniso_energy = SHELL_ANISO_SQRT;
+        else if (!strcmp(e, "stvk")) p->aniso_energy = SHELL_ANISO_STVK;
+        else return field_error(ctx, apath, "energy", "must be \"arap\", \"sqrt\" or \"stvk\"%s", NULL);
+    }
+    p->aniso_mu = p->mu;
+    if ((r = get_positive(ctx, an, apath, "stiffness", &p->aniso_mu, 0, 0, INFINITY, ">= 0")) != MK_OK) return r;
+    if ((r = get_number(ctx, an, apath, "k_A", &p->aniso_kA, 0)) != MK_OK) return r;
+    return MK_OK;
+}
+
+static mk_result parse_shell(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch, const char *path)
+{
+    shell_params *p = &plan->shell;
+    memset(p, 0, sizeof *p);
+    p->pressure = 20;
+    p->dt = 0.01;
+    p->frames = 100;
+    p->iterations = 5;
+    p->density = 1;
+    p->damping = 0.02;
+    p->material = SHELL_STVK;
+    p->mu = 100;
+    p->lambda = 100;
+    p->kB = 1e-2;
+    p->epsilon = 0.05;
+    mk_result r;
+    if ((r = get_positive(ctx, ch, path, "pressure", &p->pressure, 0, 1, INFINITY, "> 0")) != MK_OK) return r;
+    if ((r = get_positive(ctx, ch, path, "dt", &p->dt, 0, 1, INFINITY, "> 0 seconds")) != MK_OK) return r;
+    if ((r = get_uint(ctx, ch, path, "frames", &p->frames, 1, untrusted(ctx) ? 200 : 100000)) != MK_OK) return r;
+    if ((r = get_uint(ctx, ch, path, "iterations", &p->iterations, 1, untrusted(ctx) ? 20 : 1000)) != MK_OK) return r;
+    p->ramp = p->frames * p->dt;
+    if ((r = get_positive(ctx, ch, path, "ramp", &p->ramp, 0, 0, INFINITY, ">= 0 seconds")) != MK_OK) return r;
+    if ((r = get_positive(ctx, ch, path, "density", &p->density, 0, 1, INFINITY, "> 0")) != MK_OK) return r;
+    if ((r = get_positive(ctx, ch, path, "damping", &p->damping, 0, 0, 1, "in [0, 1)")) != MK_OK) return r;
+    const cJSON *mat = cJSON_GetObjectItemCaseSensitive(ch, "material");
+    if (mat) {
+        static const char *const names[] = { "stvk", "corotated", "linear", "mooney_rivlin" };
+        int k = -1;
+        for (int i = 0; i < 4 && cJSON_IsString(mat); i++)
+            if (!strcmp(mat->valuestring, names[i])) k = i;
+        if (k < 0) return field_error(ctx, path, "material", "must be \"stvk\", \"corotated\", \"linear\" or \"mooney_rivlin\"%s", NULL);
+        p->material = (shell_material)k;
+    }
+    if ((r = get_positive(ctx, ch, path, "mu", &p->mu, 0, 0, INFINITY, ">= 0")) != MK_OK) return r;
+    if ((r = get_positive(ctx, ch, path, "lambda", &p->lambda, 0, 0, INFINITY, ">= 0")) != MK_OK) return r;
+    if ((r = get_positive(ctx, ch, path, "kB", &p->kB, 0, 0, INFINITY, ">= 0")) != MK_OK) return r;
+    if ((r = get_positive(ctx, ch, path, "epsilon", &p->epsilon, 0, 0, 1, "in [0, 1)")) != MK_OK) return r;
+    if ((r = get_positive(ctx, ch, path, "thickness", &p->thickness, 0, 0, INFINITY, ">= 0 (mesh units)")) != MK_OK) return r;
+    if ((r = parse_shell_region(ctx, plan, ch, path)) != MK_OK) return r;
+    if ((r = parse_shell_at(ctx, plan, ch, path)) != MK_OK) return r;
+    const cJSON *log = cJSON_GetObjectItemCaseSensitive(ch, "log");
+    if (log) {
+        if (untrusted(ctx)) return field_error(ctx, path, "log", "files are not written for untrusted recipes%s", NULL);
+        if (!cJSON_IsString(log) || !*log->valuestring) return field_error(ctx, path, "log", "must be the path of a CSV file%s", NULL);
+        plan->shell_log = log->valuestring;
+    }
+    const cJSON *clip = cJSON_GetObjectItemCaseSensitive(ch, "clip");
+    if (clip && !cJSON_IsBool(clip)) return field_error(ctx, path, "clip", "must be true or false%s", NULL);
+    plan->clip_duration = cJSON_IsTrue(clip) ? -1 : 0;  /* the simulated duration, known after the run */
+    return MK_OK;
+}
+
 /* ---- recipe ---- */
 
 /* A mesh of `raw` by name or index (field `field` of the object at path). */
@@ -1147,12 +1298,12 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     snprintf(path, sizeof path, "channels[%d]", index);
     if (!cJSON_IsObject(ch)) return field_error(ctx, path, "", "must be an object%s", NULL);
     const cJSON *op = cJSON_GetObjectItemCaseSensitive(ch, "op");
-    if (!op) return field_error(ctx, path, "op", "missing (ffd, ffd_travel, ffd_keys, ffd_cylinder, ffd_prism, taper, twist, bend, cage, laplacian, arap or transfer)%s", NULL);
+    if (!op) return field_error(ctx, path, "op", "missing (ffd, ffd_travel, ffd_keys, ffd_cylinder, ffd_prism, taper, twist, bend, cage, laplacian, arap, transfer or shell)%s", NULL);
     if (!cJSON_IsString(op)) return field_error(ctx, path, "op", "must be a string%s", NULL);
     int k = -1;
     for (int i = 0; i < (int)(sizeof op_names / sizeof op_names[0]); i++)
         if (!strcmp(op_names[i], op->valuestring)) k = i;
-    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, ffd_travel, ffd_keys, ffd_cylinder, ffd_prism, taper, twist, bend, cage, laplacian, arap or transfer)", op->valuestring);
+    if (k < 0) return field_error(ctx, path, "op", "unknown op \"%s\" (expected ffd, ffd_travel, ffd_keys, ffd_cylinder, ffd_prism, taper, twist, bend, cage, laplacian, arap, transfer or shell)", op->valuestring);
     plan->op = (op_kind)k;
     mk_result r = check_fields(ctx, ch, path, common_fields, op_fields[k]);
     if (r != MK_OK) return r;
@@ -1176,6 +1327,8 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
                     plan->op == OP_FFD_TRAVEL;
     plan->inbetween.count = nonlinear ? 0 : 1;
     const cJSON *ib = cJSON_GetObjectItemCaseSensitive(ch, "inbetweens");
+    if (ib && plan->op == OP_SHELL)
+        return field_error(ctx, path, "inbetweens", "is not used by shell: give at_frames or at_volume_ratios%s", NULL);
     if (ib) {
         if (cJSON_IsString(ib) && !strcmp(ib->valuestring, "auto")) plan->inbetween.count = 0;
         else if (cJSON_IsNumber(ib) && isfinite(ib->valuedouble) && ib->valuedouble == floor(ib->valuedouble) &&
@@ -1204,6 +1357,7 @@ static mk_result parse_channel(recipe_ctx *ctx, const cJSON *ch, int index, int 
     case OP_CAGE: r = parse_cage(ctx, plan, ch, path); break;
     case OP_LAPLACIAN: case OP_ARAP: r = parse_edit(ctx, plan, ch, path); break;
     case OP_TRANSFER: r = parse_transfer(ctx, plan, ch, path); break;
+    case OP_SHELL: r = parse_shell(ctx, plan, ch, path); break;
     }
     if (r != MK_OK) return r;
     char *json = cJSON_PrintUnformatted(ch);
@@ -1243,6 +1397,35 @@ static mk_result add_travel_clip(recipe_ctx *ctx, const channel_plan *plan, uint
     return MK_OK;
 }
 
+/* shell: simulate, pick the target frames, write the log; the channel's weights are frame / last. */
+static mk_result bake_shell_run(recipe_ctx *ctx, channel_plan *plan, shell_bake **out, mk_error *err)
+{
+    const mk_bake_options *o = ctx->options;
+    shell_bake *b = mk_arena_alloc(ctx->scratch, sizeof *b);
+    if (!b) return mk_error_oom(err, "shell");
+    char stage[200];
+    snprintf(stage, sizeof stage, "%s: simulating", plan->name);
+    mk_result r = shell_bake_prepare(&ctx->raw->meshes[plan->mesh], &plan->shell, plan->shell_region, plan->shell_at,
+                                     plan->shell_at_count, plan->shell_at_ratios, ctx->scratch, o ? o->progress : NULL,
+                                     o ? o->user : NULL, stage, b, err);
+    if (r != MK_OK) return r;
+    *out = b;
+    plan->inbetween.count = b->keys;
+    plan->inbetween.weights = b->weights;
+    if (plan->clip_duration < 0) plan->clip_duration = b->last * plan->shell.dt;
+    if (plan->shell_log) {
+        char full[4096];
+        const char *dir = o && o->base_dir ? o->base_dir : "";
+        if (plan->shell_log[0] == '/' || !*dir) snprintf(full, sizeof full, "%s", plan->shell_log);
+        else snprintf(full, sizeof full, "%s/%s", dir, plan->shell_log);
+        FILE *f = fopen(full, "w");
+        int bad = !f || shell_write_log(f, &b->run) != 0;
+        if (f && fclose(f) != 0) bad = 1;
+        if (bad) return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "log: cannot write %s", full);
+    }
+    return MK_OK;
+}
+
 static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_bake_report *report)
 {
     mk_raw_asset *raw = ctx->raw;
@@ -1254,6 +1437,7 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
     bake_pointwise pw = { mesh, NULL, NULL, ctx->scratch };
     mk_cage_binding *binding = NULL;
     mk_surface_edit *edit = NULL;
+    shell_bake *shell = NULL;
     mk_result r = MK_OK;
     mk_error inner;
     char path[64];
@@ -1287,6 +1471,10 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
         break;
     case OP_TRANSFER:  /* bake_transfer */
         return mk_error_set(ctx->err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "%s: transfer is not a deformer", path);
+    case OP_SHELL:
+        r = bake_shell_run(ctx, plan, &shell, &inner);
+        deformer.eval = shell_bake_eval; deformer.user = shell;
+        break;
     }
     if (r != MK_OK) return mk_error_set(ctx->err, inner.code, inner.offset, "%s (%s): %s", path, op_names[plan->op], inner.message);
     mk_inbetween_result res;

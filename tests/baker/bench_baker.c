@@ -7,7 +7,11 @@
  * anchors z < -0.5, handle z > 0.8 moved by (0.3, 0, 0.2). Prints energy, time and distance
  * to a tightly converged reference (Anderson, relative energy change 1e-9) for 10 plain
  * iterations, plain to convergence and Anderson to convergence, and the time each run took to
- * come within 1 % of the reference energy. */
+ * come within 1 % of the reference energy.
+ *
+ * Shell: bench_baker shell SEGMENTS RINGS [THICKNESS [FRAMES [KB]]] (UV sphere of 2 x SEGMENTS x (RINGS - 1)
+ * triangles; 100 51: 10 000, 250 101: 50 000): FRAMES (100) frames of the default shell recipe, ms per
+ * frame and the collision part (THICKNESS > 0 turns collisions on). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,6 +19,7 @@
 #include "bake.h"
 #include "bake_util.h"
 #include "fixtures.h"
+#include "shell/shell.h"
 #include "surface_edit.h"
 
 typedef struct bench_user { mk_bake_channel_report last; } bench_user;
@@ -133,8 +138,51 @@ static int arap_convergence(uint32_t levels)
     return fails;
 }
 
+/* The shell simulation on a UV sphere: ms per frame with and without collision handling, the
+ * collision part separately (docs/performance.md). */
+static int shell_bench(uint32_t segments, uint32_t rings, double thickness, uint32_t frames, double kB)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_raw_mesh *mesh = fixture_sphere(&raw, "ball", 1, segments, rings);
+    shell_params p;
+    memset(&p, 0, sizeof p);
+    p.pressure = 20; p.dt = 0.01; p.frames = frames; p.ramp = 1; p.iterations = 5; p.density = 1; p.damping = 0.02;
+    p.material = SHELL_STVK; p.mu = 100; p.lambda = 100; p.kB = kB; p.epsilon = 0.05; p.thickness = thickness;
+    shell_mesh m;
+    shell_run run;
+    mk_error err;
+    double t0 = bake_now();
+    mk_result r = shell_mesh_build(mesh, p.density, &raw.arena, &m, &err);
+    double t1 = bake_now();
+    if (r == MK_OK) r = shell_simulate(&m, &p, &raw.arena, NULL, NULL, &run, &err);
+    if (r != MK_OK) { fprintf(stderr, "shell: %s\n", err.message); mk_raw_free(&raw); return 1; }
+    double frame_ms = 0, collision_ms = 0;
+    uint32_t hits = 0, rounds = 0, most = 0, rises = 0;
+    for (uint32_t f = 1; f <= run.frames; f++) {
+        rises += !(run.stats[f].volume_ratio < run.stats[f - 1].volume_ratio);
+        rounds += run.stats[f].collision_rounds;
+        if (run.stats[f].collision_rounds > most) most = run.stats[f].collision_rounds;
+        frame_ms += run.stats[f].ms_step;
+        collision_ms += run.stats[f].ms_collision;
+        hits += run.stats[f].vt_hits + run.stats[f].ee_hits;
+    }
+    printf("shell: %u triangles, %u vertices, kB %g, thickness %g: setup %.1f ms; %u frames, %.2f ms per frame of which "
+           "collisions %.2f ms (%u hits, %.1f rounds per frame, at most %u); V/V0 after the run %.4f\n", m.tri_count, m.n,
+           kB, thickness, 1000 * (t1 - t0), run.frames, frame_ms / run.frames, collision_ms / run.frames, hits,
+           (double)rounds / run.frames, most, run.stats[run.frames].volume_ratio);
+    printf("  V/V0 at frames 0, 10, ...:");
+    for (uint32_t f = 0; f <= run.frames; f += 10) printf(" %.4f", run.stats[f].volume_ratio);
+    printf("; %u frames did not lower the volume\n", rises);
+    mk_raw_free(&raw);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc >= 4 && !strcmp(argv[1], "shell"))
+        return shell_bench((uint32_t)atoi(argv[2]), (uint32_t)atoi(argv[3]), argc > 4 ? atof(argv[4]) : 0,
+                           argc > 5 ? (uint32_t)atoi(argv[5]) : 100, argc > 6 ? atof(argv[6]) : 0.01);
     if (argc == 3 && !strcmp(argv[1], "arap")) return arap_convergence((uint32_t)atoi(argv[2])) ? 1 : 0;
     uint32_t rings = 250, segments = 400;
     if (argc == 3) { rings = (uint32_t)atoi(argv[1]); segments = (uint32_t)atoi(argv[2]); }

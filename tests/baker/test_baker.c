@@ -1643,6 +1643,45 @@ static void bad_arap_and_animated_ffd_recipes_name_the_field(void)
     mk_raw_free(&raw);
 }
 
+static void bad_shell_recipes_name_the_field(void)
+{
+#define SHELL(fields) "{\"mesh\": 0, \"channels\": [{\"op\": \"shell\", \"frames\": 5, " fields "}]}"
+    static const char *const cases[][2] = {
+        { SHELL("\"pressure\": \"high\""), "channels[0].pressure: must be a number" },
+        { SHELL("\"pressure\": -1"), "channels[0].pressure: must be > 0" },
+        { SHELL("\"dt\": 0"), "channels[0].dt: must be > 0" },
+        { SHELL("\"damping\": 1"), "channels[0].damping: must be in [0, 1)" },
+        { SHELL("\"kB\": 1e999"), "channels[0].kB: is not a finite number" },
+        { SHELL("\"material\": \"rubber\""), "channels[0].material: must be \"stvk\"" },
+        { SHELL("\"iterations\": 0"), "channels[0].iterations: must be an integer" },
+        { SHELL("\"inbetweens\": 3"), "channels[0].inbetweens: is not used by shell" },
+        { SHELL("\"at_frames\": [3, 2]"), "channels[0].at_frames: entry 1" },
+        { SHELL("\"at_frames\": [6]"), "channels[0].at_frames: entry 0 must be a frame in 1..5" },
+        { SHELL("\"at_frames\": 3"), "channels[0].at_frames: must be an array" },
+        { SHELL("\"at_frames\": [1], \"at_volume_ratios\": [0.5]"), "not both" },
+        { SHELL("\"at_volume_ratios\": [1.5]"), "channels[0].at_volume_ratios: entry 0" },
+        { SHELL("\"at_volume_ratios\": [0.01]"), "at_volume_ratios[0]: V/V0 = 0.01 was not reached" },
+        { SHELL("\"epsilon\": 0.999, \"at_frames\": [5]"), "at_frames[0]: frame 5 was not simulated" },
+        { SHELL("\"anisotropic\": 3"), "channels[0].anisotropic: must be an object" },
+        { SHELL("\"anisotropic\": {\"direction\": [1, 0, 0]}"), "channels[0].anisotropic.region: missing" },
+        { SHELL("\"anisotropic\": {\"region\": {\"indices\": [99999]}}"), "channels[0].anisotropic.region.indices" },
+        { SHELL("\"anisotropic\": {\"region\": {\"indices\": [0]}, \"energy\": \"soft\"}"), "channels[0].anisotropic.energy" },
+        { SHELL("\"anisotropic\": {\"region\": {\"indices\": [0]}, \"direction\": [0, 0, 0]}"), "channels[0].anisotropic.direction: is a zero vector" },
+        { SHELL("\"anisotropic\": {\"region\": {\"indices\": [0]}, \"size\": 1}"), "channels[0].anisotropic.size: unknown field" },
+        { SHELL("\"log\": 5"), "channels[0].log: must be the path" },
+        { SHELL("\"clip\": 1"), "channels[0].clip: must be true or false" },
+        { SHELL("\"thickness\": -1"), "channels[0].thickness" },
+        { "{\"mesh\": 1, \"channels\": [{\"op\": \"shell\"}]}", "not a closed, consistently oriented surface" },
+    };
+#undef SHELL
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_icosphere(&raw, "ball", 1, 1);
+    fixture_grid(&raw, "sheet", 1, 1, 4, 4);
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) expect_error(&raw, cases[i][0], cases[i][1]);
+    mk_raw_free(&raw);
+}
+
 static void bake_keeps_existing_channels(void)
 {
     mk_raw_asset raw;
@@ -1699,7 +1738,7 @@ static void sample_recipes_bake(void)
 {
     static const char *const names[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json",
                                          "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json", "ffd_prism.json",
-                                         "transfer.json" };
+                                         "transfer.json", "shell.json" };
     const char *root = getenv("MORPHKIT_SOURCE_ROOT");
     if (!root) root = MK_SOURCE_ROOT;
     char dir[4096];
@@ -1707,6 +1746,8 @@ static void sample_recipes_bake(void)
     for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
         mk_raw_asset raw;
         mk_raw_init(&raw, NULL);
+        /* The shell needs a closed surface: its sample names a ball (an icosphere of radius 1). */
+        if (!strcmp(names[k], "shell.json")) fixture_icosphere(&raw, "ball", 1, 3);
         mk_raw_mesh *m = fixture_cylinder(&raw, "tube", 0.5f, 2, 32, 24);
         /* z-up tube -> y-up: swap y and z (a reflection), so also flip the winding */
         for (uint32_t v = 0; v < m->vertex_count; v++) {
@@ -1856,4 +1897,5 @@ CHECK_MAIN(CASE(identity_deformations_give_zero_deltas),
            CASE(ffd_prism_locates_every_vertex_of_corpus_meshes),
            CASE(bad_recipes_name_the_field),
            CASE(bad_arap_and_animated_ffd_recipes_name_the_field),
+           CASE(bad_shell_recipes_name_the_field),
            CASE(bake_keeps_existing_channels))

@@ -10,7 +10,8 @@
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static const char *const seeds[] = { "twist.json", "barr.json", "ffd.json", "cage.json", "laplacian.json",
-                                     "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json", "ffd_prism.json" };
+                                     "ffd_travel.json", "ffd_keys.json", "ffd_cylinder.json", "ffd_prism.json",
+                                     "shell.json" };
 
 static void sample_recipes_truncated_and_flipped(void)
 {

@@ -1,0 +1,144 @@
+/* SPDX-License-Identifier: MIT */
+/* Thin shell contracting under external pressure: a position-based dynamics simulation
+ * (docs/baking.md, "shell"). Internal to baker/.
+ *
+ * Everything works on the position-welded mesh in double precision. Per frame: symplectic Euler
+ * prediction under the pressure force, a few nonlinear Gauss-Seidel sweeps projecting the
+ * elastic, bending and anisotropic energies as XPBD constraints C = sqrt(2 W) with compliance 1
+ * (so that (1/2) C^2 is the energy W itself), continuous collision handling, velocities from
+ * positions.
+ *
+ * The element energies are pure functions of positions (shell_elastic.c, shell_bending.c,
+ * shell_aniso.c) returning W and its gradient, so tests compare them with finite differences.
+ */
+#ifndef SHELL_H
+#define SHELL_H
+
+#include <stdio.h>
+#include "raw.h"
+
+typedef enum shell_material {
+    SHELL_STVK, SHELL_COROTATED, SHELL_LINEAR, SHELL_MOONEY_RIVLIN
+} shell_material;
+
+typedef enum shell_aniso_energy {
+    SHELL_ANISO_ARAP, SHELL_ANISO_SQRT, SHELL_ANISO_STVK
+} shell_aniso_kind;
+
+/* Membrane energy density psi(F) and its first Piola-Kirchhoff stress P = dpsi/dF. F and P are
+ * 3x2, column-major (F[0..2] = first column, F[3..5] = second). basis (6 doubles: the rest
+ * triangle's in-plane unit axes e1, e2) is used by the linear material only. */
+double shell_material_psi(shell_material material, double mu, double lambda, const double F[6],
+                          const double basis[6], double P[6]);
+
+/* Deformation gradient F = [x1 - x0, x2 - x0] Dm^-1 (3x2, column-major); Dm_inv is 2x2
+ * row-major. */
+void shell_deformation_gradient(const double *x0, const double *x1, const double *x2,
+                                const double Dm_inv[4], double F[6]);
+/* Gradient of area * psi with respect to x0, x1, x2 (9 doubles) from P: [g1 g2] = area P Dm^-T,
+ * g0 = -(g1 + g2). */
+void shell_gradient_from_stress(const double P[6], const double Dm_inv[4], double area, double grad[9]);
+
+/* In-plane elastic energy of one triangle (area * psi) and its gradient (9 doubles). */
+double shell_membrane_energy(shell_material material, double mu, double lambda, const double Dm_inv[4],
+                             const double basis[6], double area, const double *x0, const double *x1,
+                             const double *x2, double grad[9]);
+
+/* Bending energy of one hinge: (kB / 2) * scale * (|v| - rest)^2 with v = sum_j K_j x_j
+ * (x0, x1 the hinge edge, x2, x3 the opposite vertices), scale = 3 / (A0 + A1). Gradient:
+ * 12 doubles. */
+double shell_bending_energy(const double K[4], double scale, double rest, double kB, const double *const x[4],
+                            double grad[12]);
+
+/* Anisotropic energy of one triangle, area * psi_a with I5 = |F a|^2 along the unit fibre a (2D,
+ * rest frame): arap (mu/2)(sqrt(I5) - s)^2 with s = sign(I4) given by the caller (+1 or -1),
+ * sqrt (mu/2)(sqrt(I5) - 1)^2, stvk (mu/8)(I5 - 1)^2. Gradient: 9 doubles. */
+double shell_aniso_energy(shell_aniso_kind kind, double mu, double sign, const double fibre[2],
+                          const double Dm_inv[4], double area, const double *x0, const double *x1,
+                          const double *x2, double grad[9]);
+
+/* The welded mesh and its rest data. */
+typedef struct shell_mesh {
+    uint32_t n;               /* welded vertices */
+    uint32_t *weld;           /* render vertex -> welded vertex */
+    uint32_t tri_count;
+    uint32_t *tris;           /* 3 welded indices per triangle */
+    double *rest;             /* 3 per welded vertex */
+    double *Dm_inv;           /* 4 per triangle (2x2 row-major) */
+    double *basis;            /* 6 per triangle: rest axes e1, e2 */
+    double *area;             /* per triangle, rest */
+    uint32_t hinge_count;
+    uint32_t *hinges;         /* 4 per interior edge: edge x0, x1, opposite x2, x3 */
+    double *hinge_K;          /* 4 per hinge */
+    double *hinge_scale;      /* 3 / (A0 + A1) */
+    double *hinge_rest;       /* |sum K_j X_j| at rest */
+    double *inv_mass;         /* per welded vertex */
+    double volume0;
+} shell_mesh;
+
+/* Welds the render mesh, checks it is closed (every edge shared by exactly two triangles, in
+ * opposite directions) and encloses a positive volume, builds the rest data. density: mass per
+ * unit area. Memory from arena. */
+mk_result shell_mesh_build(const mk_raw_mesh *mesh, double density, mk_arena *arena, shell_mesh *out, mk_error *err);
+
+/* Enclosed volume (1/6) sum x_a . (x_b x_c), and optionally its gradient (3 per vertex). */
+double shell_volume(const shell_mesh *m, const double *x, double *grad);
+/* Area-weighted unit vertex normals of positions x (3 per vertex). */
+void shell_vertex_normals(const shell_mesh *m, const double *x, double *normals);
+
+typedef struct shell_params {
+    double pressure;          /* external pressure P: force -P dV/dx */
+    double ramp;              /* seconds over which the pressure rises linearly from 0 to P (0: at once) */
+    double dt;                /* seconds per frame */
+    uint32_t frames;          /* frame limit */
+    uint32_t iterations;      /* Gauss-Seidel sweeps per frame */
+    double density;           /* mass per unit area */
+    double damping;           /* velocities scaled by (1 - damping) each frame */
+    shell_material material;
+    double mu, lambda;        /* Lame parameters of the membrane (per unit area) */
+    double kB;                /* bending stiffness */
+    double epsilon;           /* stop when V / V0 < epsilon */
+    double thickness;         /* collision thickness (mesh units); 0 = no collision handling */
+    /* Anisotropic region: per welded vertex flag (NULL: none); a triangle is in the region when
+     * all its vertices are. */
+    const unsigned char *aniso_region;
+    shell_aniso_kind aniso_energy;
+    double aniso_mu;          /* stiffness of the anisotropic energy */
+    double aniso_kA;          /* inward normal force on region vertices */
+    double aniso_direction[3];/* fibre direction (world), projected into each triangle */
+} shell_params;
+
+/* What one frame measured (the log). */
+typedef struct shell_frame_stats {
+    uint32_t frame;
+    double time;              /* seconds simulated */
+    double volume_ratio;      /* V / V0 */
+    double membrane, bending, aniso;  /* energies at the end of the frame */
+    uint32_t vt_hits, ee_hits;        /* collisions found (vertex-triangle, edge-edge) */
+    uint32_t collision_rounds;        /* CCD rounds this frame */
+    double ms_step, ms_collision;     /* wall time: whole frame, collision part */
+} shell_frame_stats;
+
+typedef struct shell_run {
+    uint32_t frames;          /* frames simulated (the last one is frames) */
+    float *positions;         /* (frames + 1) * 3n floats: frame f at 3 n f (frame 0 = rest) */
+    shell_frame_stats *stats; /* frames + 1 entries (entry 0: the rest state) */
+    int stopped_by_epsilon;
+} shell_run;
+
+/* Runs the simulation (memory from arena). progress(user, fraction) may be NULL. */
+mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *arena,
+                         void (*progress)(void *user, double fraction), void *user, shell_run *run,
+                         mk_error *err);
+
+/* Collision handling between the collision-free positions x and the new positions p: moves
+ * colliding vertices back until no vertex-triangle or edge-edge pair crosses over the step and
+ * no vertex is closer than thickness to a triangle it did not start closer to. Returns the hits
+ * found (*vt, *ee) and rounds. */
+mk_result shell_collide(const shell_mesh *m, const double *x, double *p, double thickness, mk_arena *arena,
+                        uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err);
+
+/* Writes the per-frame log as CSV (header line, then one line per frame). */
+int shell_write_log(FILE *f, const shell_run *run);
+
+#endif

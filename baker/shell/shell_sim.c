@@ -1,0 +1,213 @@
+/* SPDX-License-Identifier: MIT */
+/* The frame loop of the shell simulation (shell.h): prediction under pressure, Gauss-Seidel
+ * sweeps over the energy constraints (XPBD, C = sqrt(2 W), compliance 1), collision handling,
+ * velocities from positions, and the per-frame record. Single-threaded and in a fixed order, so
+ * a run is reproducible bit for bit. */
+#include <math.h>
+#include <string.h>
+#include "shell.h"
+#include "bake_util.h"
+
+typedef struct shell_state {
+    const shell_mesh *m;
+    const shell_params *p;
+    uint32_t *aniso_tris;     /* triangles of the anisotropic region */
+    uint32_t aniso_count;
+    double *fibre;            /* 2 per region triangle */
+    double *sign;             /* per region triangle: orientation against the neighbourhood */
+    double *lambda;           /* per constraint: triangles, hinges, region triangles */
+} shell_state;
+
+/* One XPBD projection of the energy constraint C = sqrt(2 W) over k vertices with gradient g of W. */
+static void project(const shell_mesh *m, double *p, const uint32_t *idx, int k, double W, const double *g,
+                    double alpha, double *lambda)
+{
+    if (!(W > 1e-300)) return;
+    double C = sqrt(2 * W), denom = alpha;
+    for (int i = 0; i < k; i++) denom += m->inv_mass[idx[i]] * vec3_dot(g + 3 * i, g + 3 * i) / (C * C);
+    if (!(denom > 0)) return;
+    double dl = (-C - alpha * *lambda) / denom;
+    *lambda += dl;
+    for (int i = 0; i < k; i++)
+        for (int c = 0; c < 3; c++) p[3 * (size_t)idx[i] + c] += m->inv_mass[idx[i]] * g[3 * i + c] / C * dl;
+}
+
+/* Energies of the three kinds at positions x; with project_alpha >= 0 each element is also
+ * projected right after it is evaluated (one Gauss-Seidel sweep). */
+static void sweep(shell_state *s, double *x, double project_alpha, double energy[3])
+{
+    const shell_mesh *m = s->m;
+    const shell_params *p = s->p;
+    double g[12];
+    energy[0] = energy[1] = energy[2] = 0;
+    for (uint32_t t = 0; t < m->tri_count; t++) {
+        const uint32_t *tri = m->tris + 3 * (size_t)t;
+        double W = shell_membrane_energy(p->material, p->mu, p->lambda, m->Dm_inv + 4 * (size_t)t, m->basis + 6 * (size_t)t,
+                                         m->area[t], x + 3 * (size_t)tri[0], x + 3 * (size_t)tri[1], x + 3 * (size_t)tri[2], g);
+        energy[0] += W;
+        if (project_alpha >= 0) project(m, x, tri, 3, W, g, project_alpha, s->lambda + t);
+    }
+    for (uint32_t h = 0; h < m->hinge_count && p->kB > 0; h++) {
+        const uint32_t *q = m->hinges + 4 * (size_t)h;
+        const double *xs[4] = { x + 3 * (size_t)q[0], x + 3 * (size_t)q[1], x + 3 * (size_t)q[2], x + 3 * (size_t)q[3] };
+        double W = shell_bending_energy(m->hinge_K + 4 * (size_t)h, m->hinge_scale[h], m->hinge_rest[h], p->kB, xs, g);
+        energy[1] += W;
+        if (project_alpha >= 0) project(m, x, q, 4, W, g, project_alpha, s->lambda + m->tri_count + h);
+    }
+    for (uint32_t i = 0; i < s->aniso_count && p->aniso_mu > 0; i++) {
+        uint32_t t = s->aniso_tris[i];
+        const uint32_t *tri = m->tris + 3 * (size_t)t;
+        double W = shell_aniso_energy(p->aniso_energy, p->aniso_mu, s->sign[i], s->fibre + 2 * (size_t)i,
+                                      m->Dm_inv + 4 * (size_t)t, m->area[t], x + 3 * (size_t)tri[0],
+                                      x + 3 * (size_t)tri[1], x + 3 * (size_t)tri[2], g);
+        energy[2] += W;
+        if (project_alpha >= 0)
+            project(m, x, tri, 3, W, g, project_alpha, s->lambda + m->tri_count + m->hinge_count + i);
+    }
+}
+
+/* The region's triangles and their fibres: the direction projected into each rest triangle. */
+static mk_result setup_region(shell_state *s, mk_arena *arena, mk_error *err)
+{
+    const shell_mesh *m = s->m;
+    const shell_params *p = s->p;
+    if (!p->aniso_region) return MK_OK;
+    for (uint32_t t = 0; t < m->tri_count; t++) {
+        const uint32_t *tri = m->tris + 3 * (size_t)t;
+        if (p->aniso_region[tri[0]] && p->aniso_region[tri[1]] && p->aniso_region[tri[2]]) s->aniso_count++;
+    }
+    s->aniso_tris = mk_arena_array(arena, s->aniso_count + 1, sizeof(uint32_t));
+    s->fibre = mk_arena_array(arena, 2 * (size_t)s->aniso_count + 2, sizeof(double));
+    s->sign = mk_arena_array(arena, s->aniso_count + 1, sizeof(double));
+    if (!s->aniso_tris || !s->fibre || !s->sign) return mk_error_oom(err, "shell region");
+    uint32_t k = 0;
+    for (uint32_t t = 0; t < m->tri_count; t++) {
+        const uint32_t *tri = m->tris + 3 * (size_t)t;
+        if (!(p->aniso_region[tri[0]] && p->aniso_region[tri[1]] && p->aniso_region[tri[2]])) continue;
+        const double *e1 = m->basis + 6 * (size_t)t, *e2 = e1 + 3;
+        double a[2] = { vec3_dot(p->aniso_direction, e1), vec3_dot(p->aniso_direction, e2) };
+        double l = sqrt(a[0] * a[0] + a[1] * a[1]);
+        if (l < 1e-9) { a[0] = 1; a[1] = 0; l = 1; }  /* direction along the normal: the first rest axis */
+        s->fibre[2 * (size_t)k] = a[0] / l;
+        s->fibre[2 * (size_t)k + 1] = a[1] / l;
+        s->sign[k] = 1;
+        s->aniso_tris[k++] = t;
+    }
+    return MK_OK;
+}
+
+/* sign(I4) per region triangle: its current normal against the mean of its vertex normals. */
+static void update_signs(shell_state *s, const double *x, const double *normals)
+{
+    const shell_mesh *m = s->m;
+    for (uint32_t i = 0; i < s->aniso_count; i++) {
+        const uint32_t *tri = m->tris + 3 * (size_t)s->aniso_tris[i];
+        double d1[3], d2[3], n[3], ref[3] = { 0, 0, 0 };
+        vec3_sub(d1, x + 3 * (size_t)tri[1], x + 3 * (size_t)tri[0]);
+        vec3_sub(d2, x + 3 * (size_t)tri[2], x + 3 * (size_t)tri[0]);
+        vec3_cross(n, d1, d2);
+        for (int k = 0; k < 3; k++)
+            for (int c = 0; c < 3; c++) ref[c] += normals[3 * (size_t)tri[k] + c];
+        s->sign[i] = vec3_dot(n, ref) < 0 ? -1 : 1;
+    }
+}
+
+mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *arena,
+                         void (*progress)(void *user, double fraction), void *user, shell_run *run,
+                         mk_error *err)
+{
+    memset(run, 0, sizeof *run);
+    size_t n3 = 3 * (size_t)m->n;
+    shell_state s;
+    memset(&s, 0, sizeof s);
+    s.m = m;
+    s.p = p;
+    mk_result r = setup_region(&s, arena, err);
+    if (r != MK_OK) return r;
+    double *x = mk_arena_array(arena, n3, sizeof(double));
+    double *v = mk_arena_array(arena, n3, sizeof(double));
+    double *q = mk_arena_array(arena, n3, sizeof(double));
+    double *grad = mk_arena_array(arena, n3, sizeof(double));
+    double *normals = mk_arena_array(arena, n3, sizeof(double));
+    s.lambda = mk_arena_array(arena, (size_t)m->tri_count + m->hinge_count + s.aniso_count + 1, sizeof(double));
+    run->positions = mk_arena_array(arena, n3 * ((size_t)p->frames + 1), sizeof(float));
+    run->stats = mk_arena_array(arena, (size_t)p->frames + 1, sizeof(shell_frame_stats));
+    if (!x || !v || !q || !grad || !normals || !s.lambda || !run->positions || !run->stats)
+        return mk_error_oom(err, "shell simulation (positions of every frame)");
+    memcpy(x, m->rest, n3 * sizeof(double));
+    memset(v, 0, n3 * sizeof(double));
+    for (size_t i = 0; i < n3; i++) run->positions[i] = (float)x[i];
+    double energy[3];
+    sweep(&s, x, -1, energy);
+    run->stats[0] = (shell_frame_stats){ .volume_ratio = 1, .membrane = energy[0], .bending = energy[1], .aniso = energy[2] };
+    double alpha = 1 / (p->dt * p->dt);
+    size_t nlambda = (size_t)m->tri_count + m->hinge_count + s.aniso_count;
+    for (uint32_t f = 1; f <= p->frames; f++) {
+        double t0 = bake_now();
+        shell_frame_stats *st = &run->stats[f];
+        memset(st, 0, sizeof *st);
+        /* Prediction: f_i = -P dV/dx_i (= -P sum over its triangles A_j n_j / 3), plus the
+         * inward push k_A on the region's vertices. */
+        shell_volume(m, x, grad);
+        double pressure = p->ramp > 0 && f * p->dt < p->ramp ? p->pressure * (f * p->dt) / p->ramp : p->pressure;
+        if (s.aniso_count && p->aniso_kA != 0) shell_vertex_normals(m, x, normals);
+        for (uint32_t i = 0; i < m->n; i++) {
+            double w = m->inv_mass[i];
+            for (int c = 0; c < 3; c++) {
+                size_t k = 3 * (size_t)i + (size_t)c;
+                double force = -pressure * grad[k];
+                if (s.aniso_count && p->aniso_kA != 0 && p->aniso_region[i]) force -= p->aniso_kA * normals[k];
+                v[k] = (1 - p->damping) * (v[k] + p->dt * w * force);
+                q[k] = x[k] + p->dt * v[k];
+            }
+        }
+        if (s.aniso_count) {
+            shell_vertex_normals(m, q, normals);
+            update_signs(&s, q, normals);
+        }
+        memset(s.lambda, 0, nlambda * sizeof(double));
+        for (uint32_t it = 0; it < p->iterations; it++) sweep(&s, q, alpha, energy);
+        double tc = bake_now();
+        if (p->thickness > 0) {
+            r = shell_collide(m, x, q, p->thickness, arena, &st->vt_hits, &st->ee_hits, &st->collision_rounds, err);
+            if (r != MK_OK) return r;
+        }
+        st->ms_collision = 1000 * (bake_now() - tc);
+        for (size_t k = 0; k < n3; k++) {
+            if (!isfinite(q[k]))
+                return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX,
+                                    "the simulation diverged at frame %u (positions not finite): lower dt or pressure, "
+                                    "or raise the stiffness", f);
+            v[k] = (q[k] - x[k]) / p->dt;
+            x[k] = q[k];
+            run->positions[n3 * f + k] = (float)x[k];
+        }
+        sweep(&s, x, -1, energy);
+        st->frame = f;
+        st->time = f * p->dt;
+        st->volume_ratio = shell_volume(m, x, NULL) / m->volume0;
+        st->membrane = energy[0];
+        st->bending = energy[1];
+        st->aniso = energy[2];
+        st->ms_step = 1000 * (bake_now() - t0);
+        run->frames = f;
+        if (progress) progress(user, (double)f / p->frames);
+        if (st->volume_ratio < p->epsilon) {
+            run->stopped_by_epsilon = 1;
+            break;
+        }
+    }
+    return MK_OK;
+}
+
+int shell_write_log(FILE *f, const shell_run *run)
+{
+    int bad = fprintf(f, "frame,time,volume_ratio,membrane_energy,bending_energy,aniso_energy,"
+                         "vt_collisions,ee_collisions,collision_rounds,ms_frame,ms_collision\n") < 0;
+    for (uint32_t k = 0; k <= run->frames && !bad; k++) {
+        const shell_frame_stats *s = &run->stats[k];
+        bad = fprintf(f, "%u,%.6g,%.9g,%.9g,%.9g,%.9g,%u,%u,%u,%.3f,%.3f\n", k, s->time, s->volume_ratio, s->membrane,
+                      s->bending, s->aniso, s->vt_hits, s->ee_hits, s->collision_rounds, s->ms_step, s->ms_collision) < 0;
+    }
+    return bad ? -1 : 0;
+}
