@@ -21,7 +21,9 @@
  *   L_ij = -w_ij), so constants span its kernel; it does not change between iterations or
  *   amplitudes: one analyze + factorize per bake (laplacian.c), 3 right-hand sides per solve.
  * - Initial guess: the global step with every R_i = I (the naive Laplacian solution with the
- *   handles in place); then params.iterations local/global rounds (default 10, as libigl).
+ *   handles in place); then L-BFGS (the default), Anderson-accelerated or plain local/global
+ *   iterations until the energy stops falling by more than params.convergence, at most
+ *   params.iterations.
  * - Hard constraints are eliminated; soft ones add w^2 (p' - c) to the energy.
  */
 #include <math.h>
@@ -161,6 +163,144 @@ static int anderson_coefficients(double G[EDIT_ANDERSON_HISTORY][EDIT_ANDERSON_H
     return 1;
 }
 
+/* Gradient of E/4 at the current positions with the current rotations, per unknown (layout of
+ * the solve: column c, row u): g_i = sum_j w_ij (f_ij - (R_i + R_j)/2 e_ij) + w^2 (p'_i - c_i).
+ * The global step solves g = 0 for fixed rotations, so A^-1 g (A the factored matrix) is the
+ * plain step's displacement, reversed. */
+static void gradient(const mk_surface_edit *s, double *g)
+{
+    const uint32_t nu = s->unknown_count;
+    const double w2 = s->params.soft ? s->params.soft_weight * s->params.soft_weight : 0;
+    for (uint32_t i = 0; i < s->welded; i++) {
+        uint32_t u = s->unknown[i];
+        if (u == UINT32_MAX) continue;
+        const double *pi = s->rest + 3 * (size_t)i, *qi = s->solution + 3 * (size_t)i, *Ri = s->rotations + 9 * (size_t)i;
+        double acc[3] = { 0, 0, 0 };
+        for (uint32_t k = s->offsets[i]; k < s->offsets[i + 1]; k++) {
+            uint32_t j = s->neighbors[k];
+            double w = s->edge_weights[k], Rs[9], r[3];
+            const double *pj = s->rest + 3 * (size_t)j, *qj = s->solution + 3 * (size_t)j, *Rj = s->rotations + 9 * (size_t)j;
+            double e[3] = { pi[0] - pj[0], pi[1] - pj[1], pi[2] - pj[2] };
+            for (int q = 0; q < 9; q++) Rs[q] = 0.5 * (Ri[q] + Rj[q]);
+            mat3_mul_vec(r, Rs, e);
+            for (int c = 0; c < 3; c++) acc[c] += w * ((qi[c] - qj[c]) - r[c]);
+        }
+        if (w2 > 0 && s->constraint[i] >= 0)
+            for (int c = 0; c < 3; c++) acc[c] += w2 * (qi[c] - s->target[3 * (size_t)i + c]);
+        for (int c = 0; c < 3; c++) g[(size_t)c * nu + u] = acc[c];
+    }
+}
+
+/* Adds t * d (solve layout) to the unknown positions. */
+static void move_unknowns(mk_surface_edit *s, const double *base, const double *d, double t)
+{
+    const uint32_t nu = s->unknown_count;
+    for (uint32_t v = 0; v < s->welded; v++) {
+        uint32_t u = s->unknown[v];
+        if (u == UINT32_MAX) continue;
+        for (int c = 0; c < 3; c++)
+            s->solution[3 * (size_t)v + c] = base[3 * (size_t)v + c] + t * d[(size_t)c * nu + u];
+    }
+}
+
+/* L-BFGS (J. Nocedal, "Updating quasi-Newton matrices with limited storage", Math. Comp. 1980)
+ * on E(x) = min_R E(x, R), whose gradient is 4 g (the rotations are optimal, so they do not
+ * contribute), with the factored A as the initial Hessian of E/4 (T. Liu, S. Bouaziz, L. Kavan,
+ * "Quasi-Newton Methods for Real-Time Simulation of Hyperelastic Materials", ACM TOG 2017): with
+ * no history the direction is exactly the plain local/global step; the curvature pairs turn it
+ * towards the energy's valleys that the plain step crosses slowly. Armijo backtracking from the
+ * full step (halving, at most 8 times; if none descends, the plain step, which cannot raise the
+ * energy, and the history restarts). Stops as edit_arap_solve. */
+static mk_result arap_lbfgs(mk_surface_edit *s, mk_error *err)
+{
+    const uint32_t nu = s->unknown_count, m = EDIT_LBFGS_HISTORY, cap = s->params.iterations;
+    const size_t n3 = 3 * (size_t)s->welded, u3 = 3 * (size_t)nu;
+    const double tolerance = s->params.convergence;
+    mk_result r = global_step(s, 1, err);
+    if (r != MK_OK) return r;
+    double *x_prev = s->work;                    /* welded layout */
+    double *g = s->anderson, *g_new = g + n3, *d = g_new + n3, *q = d + n3;
+    double *S = q + n3, *Y = S + m * n3;         /* pairs, solve layout */
+    double rho[EDIT_LBFGS_HISTORY], alpha[EDIT_LBFGS_HISTORY];
+    uint32_t history = 0, head = 0, it = 0;
+    double scale, t0 = bake_now();
+    double energy = local_step(s, &scale), energy_prev = INFINITY;
+    s->local_seconds += bake_now() - t0;
+    s->stats.start_energy = energy;
+    gradient(s, g);
+    for (;; it++) {
+        if (s->params.iteration_done) s->params.iteration_done(s->params.user, it, energy);
+        if (energy <= 1e-14 * scale || nu == 0) break;
+        if (it > 0 && tolerance >= 0 && energy_prev - energy <= tolerance * energy_prev) break;
+        if (it == cap) { s->stats.unconverged++; break; }
+        /* Two-loop recursion: d = -H g, H0 = A^-1 (one solve). */
+        memcpy(q, g, u3 * sizeof(double));
+        for (uint32_t k = 0; k < history; k++) {
+            uint32_t slot = (head + m - 1 - k) % m;
+            alpha[slot] = rho[slot] * dot(S + slot * n3, q, u3);
+            const double *y = Y + slot * n3;
+            for (size_t i = 0; i < u3; i++) q[i] -= alpha[slot] * y[i];
+        }
+        memcpy(s->spd.rhs->x, q, u3 * sizeof(double));
+        if ((r = edit_solve(s, err)) != MK_OK) return r;
+        memcpy(d, s->spd.x->x, u3 * sizeof(double));
+        for (uint32_t k = history; k-- > 0;) {
+            uint32_t slot = (head + m - 1 - k) % m;
+            double beta = rho[slot] * dot(Y + slot * n3, d, u3);
+            const double *sv = S + slot * n3;
+            for (size_t i = 0; i < u3; i++) d[i] += (alpha[slot] - beta) * sv[i];
+        }
+        for (size_t i = 0; i < u3; i++) d[i] = -d[i];
+        double slope = dot(g, d, u3);            /* of E/4 along d */
+        memcpy(x_prev, s->solution, n3 * sizeof(double));
+        double step = 1, trial = INFINITY;      /* step: the fraction of d tried */
+        int found = 0;
+        t0 = bake_now();
+        if (slope < 0)
+            for (int tries = 0; tries < 8 && !found; tries++, step *= 0.5) {
+                move_unknowns(s, x_prev, d, step);
+                trial = local_step(s, &scale);
+                found = trial / 4 <= energy / 4 + 1e-4 * step * slope;
+            }
+        s->local_seconds += bake_now() - t0;
+        if (!found) {
+            /* The plain step from x_prev: rotations of x_prev, one global solve. */
+            memcpy(s->solution, x_prev, n3 * sizeof(double));
+            local_step(s, &scale);
+            if ((r = global_step(s, 0, err)) != MK_OK) return r;
+            t0 = bake_now();
+            trial = local_step(s, &scale);
+            s->local_seconds += bake_now() - t0;
+            history = 0;
+            s->stats.rejected_steps++;
+        }
+        gradient(s, g_new);
+        /* The new pair: s = x - x_prev, y = g_new - g (solve layout); kept when y.s > 0. */
+        double *sv = S + head * n3, *yv = Y + head * n3;
+        for (uint32_t v = 0; v < s->welded; v++) {
+            uint32_t u = s->unknown[v];
+            if (u == UINT32_MAX) continue;
+            for (int c = 0; c < 3; c++)
+                sv[(size_t)c * nu + u] = s->solution[3 * (size_t)v + c] - x_prev[3 * (size_t)v + c];
+        }
+        for (size_t i = 0; i < u3; i++) yv[i] = g_new[i] - g[i];
+        double ys = dot(yv, sv, u3);
+        if (ys > 1e-12 * dot(yv, yv, u3)) {
+            rho[head] = 1 / ys;
+            head = (head + 1) % m;
+            if (history < m) history++;
+        }
+        memcpy(g, g_new, u3 * sizeof(double));
+        energy_prev = energy;
+        energy = trial;
+    }
+    s->stats.evaluations++;
+    s->stats.iterations += it;
+    if (it > s->stats.max_iterations) s->stats.max_iterations = it;
+    s->stats.energy = energy;
+    return MK_OK;
+}
+
 /* Local/global iterations from the global step with identity rotations, as a fixed-point map
  * x -> G(x) = global(local(x)) on the stacked positions (constrained entries are constant).
  * Plain: x_{k+1} = G(x_k); each iteration cannot raise the energy (both steps minimize it).
@@ -178,6 +318,7 @@ mk_result edit_arap_solve(mk_surface_edit *s, mk_error *err)
     const size_t n3 = 3 * (size_t)s->welded;
     const uint32_t cap = s->params.iterations, window = EDIT_ANDERSON_HISTORY;
     const double tolerance = s->params.convergence;
+    if (s->params.acceleration == MK_ARAP_LBFGS) return arap_lbfgs(s, err);
     mk_result r = global_step(s, 1, err);
     if (r != MK_OK) return r;
     double *x = s->solution, *previous = s->work;

@@ -616,9 +616,10 @@ static mk_result parse_edit(recipe_ctx *ctx, channel_plan *plan, const cJSON *ch
     if (e->convergence == 0) e->convergence = -1;  /* the C API's "all iterations" */
     const cJSON *acc = cJSON_GetObjectItemCaseSensitive(ch, "acceleration");
     if (acc) {
-        if (cJSON_IsString(acc) && !strcmp(acc->valuestring, "anderson")) e->acceleration = MK_ARAP_ANDERSON;
+        if (cJSON_IsString(acc) && !strcmp(acc->valuestring, "lbfgs")) e->acceleration = MK_ARAP_LBFGS;
+        else if (cJSON_IsString(acc) && !strcmp(acc->valuestring, "anderson")) e->acceleration = MK_ARAP_ANDERSON;
         else if (cJSON_IsString(acc) && !strcmp(acc->valuestring, "none")) e->acceleration = MK_ARAP_PLAIN;
-        else return field_error(ctx, path, "acceleration", "must be \"anderson\" or \"none\"%s", NULL);
+        else return field_error(ctx, path, "acceleration", "must be \"lbfgs\", \"anderson\" or \"none\"%s", NULL);
     }
 
     unsigned char *mark = mk_arena_array(ctx->scratch, mesh->vertex_count ? mesh->vertex_count : 1, 1);

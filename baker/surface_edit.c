@@ -319,9 +319,10 @@ mk_result mk_surface_edit_create(const mk_raw_mesh *mesh, const mk_edit_params *
     if (s->params.method == MK_EDIT_ARAP) {
         s->rotations = mk_arena_array(&s->arena, 9 * (size_t)n, sizeof(double));
         if (!s->rotations) FAIL(mk_error_oom(err, "rotations"));
-        if (s->params.acceleration == MK_ARAP_ANDERSON) {
-            s->anderson = mk_arena_array(&s->arena, (2 + 2 * (size_t)EDIT_ANDERSON_HISTORY) * 3 * n,
-                                         sizeof(double));
+        if (s->params.acceleration != MK_ARAP_PLAIN) {
+            size_t vectors = s->params.acceleration == MK_ARAP_ANDERSON ? 2 + 2 * (size_t)EDIT_ANDERSON_HISTORY
+                                                                        : 4 + 2 * (size_t)EDIT_LBFGS_HISTORY;
+            s->anderson = mk_arena_array(&s->arena, vectors * 3 * n, sizeof(double));
             if (!s->anderson) FAIL(mk_error_oom(err, "Anderson acceleration history"));
         }
     }

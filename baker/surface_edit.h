@@ -17,10 +17,13 @@ typedef enum mk_laplacian_weights {
 } mk_laplacian_weights;
 
 typedef enum mk_arap_acceleration {
-    MK_ARAP_ANDERSON = 0,      /* Anderson acceleration of the local/global map (Peng et al. 2018),
+    MK_ARAP_LBFGS = 0,         /* L-BFGS on the energy with the Laplacian as its initial Hessian
+                                * (Liu, Bouaziz, Kavan 2017) and an Armijo line search; its first
+                                * step is the plain one */
+    MK_ARAP_ANDERSON = 1,      /* Anderson acceleration of the local/global map (Peng et al. 2018),
                                 * an accelerated step that raises the energy is replaced by the
                                 * plain one */
-    MK_ARAP_PLAIN = 1          /* plain local/global iterations (Sorkine & Alexa 2007) */
+    MK_ARAP_PLAIN = 2          /* plain local/global iterations (Sorkine & Alexa 2007) */
 } mk_arap_acceleration;
 
 /* A set of vertices moved rigidly: at amplitude a a handle vertex goes to

@@ -36,6 +36,8 @@ struct mk_surface_edit {
 
 /* Anderson acceleration window (previous iterates combined per step), Peng et al. 2018 use 5-6. */
 #define EDIT_ANDERSON_HISTORY 5
+/* L-BFGS history (curvature pairs kept). */
+#define EDIT_LBFGS_HISTORY 8
 
 /* ---- the core (surface_edit.c) ---- */
 

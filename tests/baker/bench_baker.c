@@ -61,6 +61,7 @@ typedef struct arap_trace {
 static void on_iteration(void *user, uint32_t iteration, double energy)
 {
     arap_trace *t = user;
+    if (getenv("BENCH_ARAP_TRACE")) printf("    %u %.6f\n", iteration, energy);
     if (t->reached_seconds < 0 && energy <= 1.01 * t->target_energy) {
         t->reached_seconds = bake_now() - t->t0;
         t->reached_iteration = iteration;
@@ -78,7 +79,9 @@ static int arap_convergence(uint32_t levels)
     const double move = sqrt(0.3 * 0.3 + 0.2 * 0.2);
     /* BENCH_ARAP_RUNS=n: only the first n runs (the reference always). */
     struct { const char *label; mk_arap_acceleration acc; uint32_t cap; double convergence; } runs[] = {
-        { "reference (anderson, 1e-9)", MK_ARAP_ANDERSON, 5000, 1e-9 },
+        { "reference (lbfgs, 1e-10)", MK_ARAP_LBFGS, 5000, 1e-10 },
+        { "lbfgs, default", MK_ARAP_LBFGS, 1000, 0 },
+        { "lbfgs, 1e-7", MK_ARAP_LBFGS, 1000, 1e-7 },
         { "plain, 10 iterations", MK_ARAP_PLAIN, 10, -1 },
         { "anderson, default", MK_ARAP_ANDERSON, 1000, 0 },
         { "plain, default", MK_ARAP_PLAIN, 1000, 0 },
