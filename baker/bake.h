@@ -47,6 +47,13 @@ typedef struct mk_bake_channel_report {
                                 * in-between search evaluated later weights last) */
     double start_energy;       /* ARAP: energy of that evaluation's initial guess */
     double seconds;            /* whole channel, wall time */
+    /* shell: the enclosed volume over the rest volume at frames 0..volume_frames - 1 (frame 0 is
+     * the rest state), frame_seconds apart, and the chosen frames' indices (key_frames, one per
+     * target); the arrays live in the raw asset's arena. NULL / 0 for other ops. */
+    const double *volume_ratios;
+    uint32_t volume_frames;
+    double frame_seconds;
+    const uint32_t *key_frames;
 } mk_bake_channel_report;
 
 typedef struct mk_bake_options {

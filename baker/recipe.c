@@ -1518,6 +1518,17 @@ static mk_result bake_plan(recipe_ctx *ctx, channel_plan *plan, int index, mk_ba
     cr.curve_samples = res.curve_samples;
     cr.key_weights = res.key_weights;
     cr.tolerance = res.tolerance;
+    if (shell) {  /* the volume curve outlives the scratch the run lives in */
+        double *ratios = mk_arena_array(&raw->arena, (size_t)shell->run.frames + 1, sizeof(double));
+        uint32_t *keys = mk_arena_array(&raw->arena, shell->keys ? shell->keys : 1, sizeof(uint32_t));
+        if (!ratios || !keys) return mk_error_oom(ctx->err, "shell volume curve");
+        for (uint32_t f = 0; f <= shell->run.frames; f++) ratios[f] = shell->run.stats[f].volume_ratio;
+        memcpy(keys, shell->frames, shell->keys * sizeof(uint32_t));
+        cr.volume_ratios = ratios;
+        cr.volume_frames = shell->run.frames + 1;
+        cr.frame_seconds = plan->shell.dt;
+        cr.key_frames = keys;
+    }
     cr.seconds = bake_now() - t0;
     if (o && o->channel_done) o->channel_done(o->user, &cr);
     report->channels_added++;

@@ -10,4 +10,9 @@
  * named `name` (copied). Returns the mesh, or NULL when memory runs out (the arena records it). */
 mk_raw_mesh *mk_raw_add_tube(mk_raw_asset *raw, const char *name, uint32_t segments, uint32_t rings);
 
+/* Adds a closed icosphere: the icosahedron with every triangle split in four `levels` times
+ * (10 * 4^levels + 2 vertices), new vertices pushed onto the sphere of radius `radius`,
+ * outward normals and winding, one control point per vertex. NULL when memory runs out. */
+mk_raw_mesh *mk_raw_add_icosphere(mk_raw_asset *raw, const char *name, float radius, uint32_t levels);
+
 #endif

@@ -28,4 +28,33 @@ void mkr_draw_line(mkr_image *img, int x0, int y0, int x1, int y1, const uint8_t
  * The y range is [0, max(largest value, limit) x 1.1]. */
 void mkr_plot_draw(mkr_image *img, int x, int y, int width, int height, const mkr_plot *plot);
 
+/* One curve of a line chart: values[k] at x = k (e.g. a frame), its label in the legend and
+ * indices k marked with a dot on the curve. */
+typedef struct mkr_series {
+    const double *values;
+    uint32_t count;
+    const char *label;
+    const uint32_t *marks;
+    uint32_t mark_count;
+} mkr_series;
+
+/* Several curves on shared axes (the volume ratios of `morphkit bake --plot`). */
+typedef struct mkr_lines {
+    const char *title, *x_label, *y_label;
+    double x_scale;              /* x tick labels show k * x_scale (e.g. seconds per frame); 0: k */
+    double y_max;                /* the y axis is [0, y_max]; 0: the largest value x 1.1 */
+    const mkr_series *series;
+    uint32_t series_count;
+} mkr_lines;
+
+/* The color of curve i (a fixed palette, repeating). */
+const uint8_t *mkr_series_color(uint32_t i);
+
+/* Draws the chart in the rectangle (x, y, width, height): a title, axes with tick labels (x at
+ * 0, half and the longest curve's end; y at 0, half and the top; values above the top are drawn
+ * at the top), the x label under the axis and the y label inside the top-left corner, every
+ * curve in its color with its marks as dots, and a legend of the labels in their colors at the
+ * top right. */
+void mkr_lines_draw(mkr_image *img, int x, int y, int width, int height, const mkr_lines *lines);
+
 #endif

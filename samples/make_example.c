@@ -2,9 +2,11 @@
 /* Builds the bundled example asset by code (no external files): a tube with a "bulge"
  * channel and a progressive "bend" channel (four in-betweens sampled from an exact bend, so
  * playback follows the curved path), normals computed from the targets, and a clip "wave"
- * animating both. usage: make_example OUT.morph */
+ * animating both. With --ball, a closed icosphere "ball" (642 vertices, no channels) instead:
+ * the mesh the shell sample recipe deflates. usage: make_example [--ball] OUT.morph */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 #include "blob_io.h"
 #include "primitives.h"
 
@@ -28,9 +30,30 @@ static mk_raw_target *fill_target(mk_raw_asset *raw, mk_raw_channel *ch, const m
     return t;
 }
 
+/* The ball: a closed icosphere of radius 1. */
+static int write_ball(const char *path)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_error err;
+    void *blob = NULL;
+    size_t size = 0;
+    int status = 0;
+    if (!mk_raw_add_icosphere(&raw, "ball", 1, 3)) { fprintf(stderr, "make_example: out of memory\n"); status = 1; }
+    else if (mk_write_blob(&raw, NULL, &raw.arena, &blob, &size, NULL, &err) || mk_write_file(path, blob, size, &err)) {
+        fprintf(stderr, "make_example: %s\n", err.message);
+        status = 1;
+    } else {
+        printf("wrote %s: ball of %u vertices (closed, no channels); %zu bytes\n", path, raw.meshes[0].vertex_count, size);
+    }
+    mk_raw_free(&raw);
+    return status;
+}
+
 int main(int argc, char **argv)
 {
-    if (argc != 2) { fprintf(stderr, "usage: make_example OUT.morph\n"); return 2; }
+    if (argc == 3 && !strcmp(argv[1], "--ball")) return write_ball(argv[2]);
+    if (argc != 2 || argv[1][0] == '-') { fprintf(stderr, "usage: make_example [--ball] OUT.morph\n"); return 2; }
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_raw_mesh *m = mk_raw_add_tube(&raw, "tube", SEGMENTS, RINGS);

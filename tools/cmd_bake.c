@@ -32,7 +32,7 @@ static const cli_option options[] = {
       NULL, NULL, 0, 0, 0, 0 },
     { "--plot", "FILE.png", CLI_STRING, offsetof(bake_args, plot),
       "Also draw each baked channel's playback error against its weight, with the tolerance and the in-between "
-      "weights marked (one panel per channel).",
+      "weights marked (one panel per channel), under a chart of the shell channels' volume ratios.",
       NULL, NULL, 0, 0, 0, 0 },
     { "--quiet", NULL, CLI_FLAG, offsetof(bake_args, quiet),
       "No progress lines and no solver details (results are still printed).", NULL, NULL, 0, 0, 0, 0 },
@@ -63,6 +63,11 @@ typedef struct plot_channel {
     const float *keys;
     uint32_t samples, key_count;
     double tolerance;
+    char name[128];                /* shell channels: the volume curve (else volume_frames 0) */
+    const double *volume_ratios;
+    uint32_t volume_frames;
+    double frame_seconds;
+    const uint32_t *key_frames;
 } plot_channel;
 
 typedef struct bake_ui {
@@ -88,24 +93,54 @@ static void keep_curve(bake_ui *ui, const mk_bake_channel_report *c)
     pc->samples = c->curve_samples;
     pc->key_count = c->key_weights ? c->targets : 0;
     pc->tolerance = c->tolerance;
+    snprintf(pc->name, sizeof pc->name, "%s", c->name);
+    pc->volume_ratios = c->volume_ratios;
+    pc->volume_frames = c->volume_ratios ? c->volume_frames : 0;
+    pc->frame_seconds = c->frame_seconds;
+    pc->key_frames = c->key_frames;
 }
 
-/* One 720 x 200 panel per channel, stacked. Returns -1 when fine, else the exit status. */
+/* The volume ratio of every shell channel over its frames, on one chart (VOLUME_PANEL high). */
+enum { VOLUME_PANEL = 260 };
+static void draw_volumes(const bake_ui *ui, mkr_image *img)
+{
+    mkr_series series[6];
+    uint32_t count = 0;
+    double seconds = 0;
+    for (uint32_t i = 0; i < ui->channel_count && count < 6; i++) {
+        const plot_channel *pc = &ui->channels[i];
+        if (!pc->volume_frames) continue;
+        series[count++] = (mkr_series){ pc->volume_ratios, pc->volume_frames, pc->name, pc->key_frames, pc->key_count };
+        seconds = count == 1 || seconds == pc->frame_seconds ? pc->frame_seconds : -1;  /* -1: time steps differ */
+    }
+    mkr_lines lines = { .title = "shell: enclosed volume / rest volume per frame (dots: the frames baked as targets)",
+                        .x_label = seconds > 0 ? "simulated time (s)" : "frame", .y_label = "V/V0",
+                        .x_scale = seconds > 0 ? seconds : 0, .y_max = 1,
+                        .series = series, .series_count = count };
+    mkr_lines_draw(img, 0, 0, 720, VOLUME_PANEL - 2, &lines);
+}
+
+/* One 720 x 200 panel per channel, stacked, under one chart of the shell channels' volumes when
+ * there are any. Returns -1 when fine, else the exit status. */
 static int draw_plot(const cli_verb *verb, const bake_ui *ui, mkr_image *img, mkr_png *png, cli_output *out)
 {
     mk_error err;
-    uint32_t n = ui->channel_count ? ui->channel_count : 1;
+    uint32_t n = ui->channel_count ? ui->channel_count : 1, shells = 0;
     if (n > 80) n = 80;   /* a picture people can read; more channels are left out (said below) */
-    if (mkr_image_create(img, 720, 200 * (int)n, &err) != MK_OK) return cli_fail(verb->name, &err);
+    for (uint32_t i = 0; i < ui->channel_count; i++) shells += ui->channels[i].volume_frames > 0;
+    const int top = shells ? VOLUME_PANEL : 0;
+    if (mkr_image_create(img, 720, top + 200 * (int)n, &err) != MK_OK) return cli_fail(verb->name, &err);
     static const uint8_t background[4] = { 20, 20, 24, 255 };
     mkr_image_clear(img, background);
+    if (shells) draw_volumes(ui, img);
+    if (shells > 6) fprintf(stderr, "morphkit bake: --plot draws the volumes of the first 6 of %u shell channels\n", shells);
     for (uint32_t i = 0; i < n && i < ui->channel_count; i++) {
         const plot_channel *pc = &ui->channels[i];
         mkr_plot plot = { .title = pc->title, .values = pc->curve, .count = pc->curve ? pc->samples + 1 : 0,
                           .limit = pc->tolerance, .marks = pc->keys, .mark_count = pc->key_count,
                           .label_scale = 100, .unit = "%",
                           .note = "no error curve: a fixed count of an expensive deformer is checked at span midpoints" };
-        mkr_plot_draw(img, 0, 200 * (int)i, 720, 198, &plot);
+        mkr_plot_draw(img, 0, top + 200 * (int)i, 720, 198, &plot);
     }
     if (ui->channel_count > n)
         fprintf(stderr, "morphkit bake: --plot shows the first %u of %u channels\n", n, ui->channel_count);

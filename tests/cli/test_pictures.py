@@ -162,6 +162,29 @@ rc, out, err = run("bake", path("ex.morph"), "--recipe", os.path.join(recipes, "
                    "--plot", path("plot_dir.png"))
 check("an impossible --plot leaves no blob behind", rc != 0 and not os.path.exists(path("baked3.morph")), err)
 
+# bake --plot with shell channels: one chart of every shell channel's volume ratio above the
+# error panels, each curve in its color over its simulated time, the legend naming them.
+subprocess.run([make_example, "--ball", path("ball.morph")], check=True, capture_output=True)
+rc, out, err = run("bake", path("ball.morph"), "--recipe", os.path.join(recipes, "shell.json"), "-o",
+                   path("shell.morph"), "--plot", path("shell.png"), "--quiet")
+check("bake --plot on shell channels", rc == 0 and os.path.isfile(path("shell.png")), err)
+if rc == 0:
+    pw, ph, pp = read_png(path("shell.png"))
+    check("a 720x260 volume chart above one panel per channel", (pw, ph) == (720, 260 + 2 * 200), (pw, ph))
+    FIRST, SECOND = (250, 220, 90), (110, 190, 250)
+    def chart_columns(color):   # the plot area, left of the legend
+        return sorted({x for y in range(22, 228) for x in range(64, 600) if pp[y][x] == color})
+    first, second = chart_columns(FIRST), chart_columns(SECOND)
+    # "deflate" runs 100 frames, "dent" 60 (dt 0.01 both): x = 64 + 646 * frame / 100.
+    check("the 100-frame curve reaches the legend's edge, the 60-frame one ends at 0.6 s",
+          first and first[-1] >= 599 and second and abs(second[-1] - (64 + 646 * 0.6)) <= 3,
+          (first[-1:] , second[-1:]))
+    top_y = min(y for y in range(22, 228) if pp[y][66] in (FIRST, SECOND))
+    end_y = max(y for y in range(22, 228) for x in range(second[-1] - 3, second[-1] + 1) if pp[y][x] == SECOND)
+    check("volumes start at V/V0 = 1 (the top) and fall", top_y <= 24 and end_y > 100, (top_y, end_y))
+    legend = sum(1 for y in range(22, 80) for x in range(600, 711) if pp[y][x] in (FIRST, SECOND))
+    check("the legend names both channels in their colors", legend > 60, legend)
+
 # conform --report: golden frames of the example, plus a case whose reference is the moved copy
 # (so its frame fails); the page lists every frame, links only pictures that exist, shows the
 # failing frame first, and opens in headless Chromium without errors.

@@ -3,9 +3,11 @@
  * the fill rule, font, color map, sheets and PNG bytes. */
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 #include "check.h"
 #include "render.h"
+#include "plot.h"
 
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_ONLY_PNG
@@ -807,6 +809,44 @@ static void png_decodes(void)
 
 /* ---- errors ---- */
 
+/* A line chart: a straight series lands on the pixels its values give, clipped at y_max, with
+ * its mark as a 5x5 dot; a second series gets the palette's second color. */
+static void lines_chart(void)
+{
+    mkr_image img;
+    mk_error err;
+    CHECK(mkr_image_create(&img, 400, 200, &err) == MK_OK);
+    double rising[11], flat[6];
+    for (int k = 0; k <= 10; k++) rising[k] = k / 8.0;          /* passes y_max = 1 at k = 8 */
+    for (int k = 0; k < 6; k++) flat[k] = 0.3;
+    const uint32_t mark = 4;
+    mkr_series series[2] = { { rising, 11, "rising", &mark, 1 }, { flat, 6, "flat", NULL, 0 } };
+    mkr_lines lines = { .title = "t", .x_label = "x", .y_label = "y", .y_max = 1, .series = series, .series_count = 2 };
+    mkr_lines_draw(&img, 0, 0, 400, 200, &lines);
+    const int left = 64, right = 390, top = 22, bottom = 168;   /* the plot area of a 400x200 chart */
+    const uint8_t *c0 = mkr_series_color(0), *c1 = mkr_series_color(1);
+    int hits = 0, clipped = 0;
+    for (int k = 0; k <= 10; k++) {
+        int px = left + (int)lround((right - left) * k / 10.0);
+        double v = rising[k] < 1 ? rising[k] : 1;
+        int py = bottom - (int)lround((bottom - top) * v);
+        const uint8_t *p = mkr_image_pixel(&img, px, py);
+        hits += p && !memcmp(p, c0, 3);
+        clipped += k >= 8 && py == top;
+    }
+    CHECK_MSG(hits == 11, "%d of 11 points of the rising series on their pixels", hits);
+    CHECK(clipped == 3);
+    int mx = left + (int)lround((right - left) * 0.4), my = bottom - (int)lround((bottom - top) * 0.5), dot = 0;
+    for (int dy = -2; dy <= 2; dy++)
+        for (int dx = -2; dx <= 2; dx++) dot += !memcmp(mkr_image_pixel(&img, mx + dx, my + dy), c0, 3);
+    CHECK_MSG(dot == 25, "mark dot %d of 25 pixels", dot);
+    int flat_y = bottom - (int)lround((bottom - top) * 0.3), flat_end = 0;
+    for (int x = left; x <= right; x++)
+        if (!memcmp(mkr_image_pixel(&img, x, flat_y), c1, 3)) flat_end = x;
+    CHECK_MSG(abs(flat_end - (left + (int)lround((right - left) * 0.5))) <= 1, "flat series ends at %d", flat_end);
+    mkr_image_destroy(&img);
+}
+
 static void errors(void)
 {
     mkr_image img;
@@ -858,4 +898,4 @@ CHECK_MAIN(CASE(silhouette_front), CASE(silhouette_side), CASE(silhouette_top), 
            CASE(shading_iso_faces), CASE(shading_toward_and_away), CASE(shading_flipped_normals),
            CASE(shading_per_pixel_normals), CASE(depth_order), CASE(fill_rule), CASE(font_glyph),
            CASE(colormap_lightness), CASE(diff_sheet_hot_cell), CASE(sheet_fixed_camera), CASE(labels),
-           CASE(png_decodes), CASE(errors))
+           CASE(png_decodes), CASE(lines_chart), CASE(errors))
