@@ -69,15 +69,7 @@ static mk_result global_step(mk_surface_edit *s, int identity, mk_error *err)
             for (int c = 0; c < 3; c++) acc[c] += w2 * s->target[3 * (size_t)i + c];
         for (int c = 0; c < 3; c++) b[(size_t)c * nu + u] = acc[c];
     }
-    mk_result r = edit_solve(s, err);
-    if (r != MK_OK) return r;
-    const double *x = s->spd.x->x;
-    for (uint32_t v = 0; v < n; v++)
-        for (int c = 0; c < 3; c++) {
-            size_t i = 3 * (size_t)v + (size_t)c;
-            s->solution[i] = s->unknown[v] != UINT32_MAX ? x[(size_t)c * nu + s->unknown[v]] : s->target[i];
-        }
-    return MK_OK;
+    return edit_solve_positions(s, s->target, NULL, err);
 }
 
 /* Local step: R_i for the current positions. Returns the ARAP energy of those positions with

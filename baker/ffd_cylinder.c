@@ -46,15 +46,8 @@ mk_result mk_cylinder_prepare(mk_cylinder_lattice *c, mk_error *err)
         !(c->outer_radius > c->inner_radius))
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
                             "radius: need 0 <= inner radius < outer radius (got %g, %g)", c->inner_radius, c->outer_radius);
-    double *e1 = c->frame[0], *e2 = c->frame[1], *e3 = c->frame[2];
-    memcpy(e3, c->axis, sizeof c->axis);
-    c->height = vec3_normalize(e3);
-    if (!(c->height > 0)) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "axis: zero length (no height)");
-    double d = vec3_dot(c->reference, e3);
-    for (int k = 0; k < 3; k++) e1[k] = c->reference[k] - d * e3[k];
-    if (!(vec3_normalize(e1) > 1e-9 * vec3_length(c->reference)))
-        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "reference: parallel to the axis");
-    vec3_cross(e2, e3, e1);
+    mk_result r = bake_axial_frame(c->axis, c->reference, c->frame, &c->height, err);
+    if (r != MK_OK) return r;
     return MK_OK;
 }
 
@@ -177,15 +170,12 @@ double mk_cylinder_ring_ratio(uint32_t sectors)
     return least;
 }
 
+static mk_result locate(const void *lattice, const double p[3], double *stu, mk_error *err)
+{
+    return mk_cylinder_coordinates(lattice, p, stu, NULL, err);
+}
+
 mk_result mk_cylinder_bind(const mk_cylinder_lattice *c, const mk_raw_mesh *mesh, double *stu, mk_error *err)
 {
-    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
-        const float *pf = mesh->positions + 3 * (size_t)v;
-        double p[3] = { pf[0], pf[1], pf[2] };
-        mk_error inner;
-        if (mk_cylinder_coordinates(c, p, stu + 3 * (size_t)v, NULL, &inner) != MK_OK)
-            return mk_error_set(err, inner.code, UINT64_MAX, "vertex %u (%g, %g, %g): %s", v, p[0], p[1], p[2],
-                                inner.message);
-    }
-    return MK_OK;
+    return bake_lattice_bind(c, locate, 3, mesh, stu, err);
 }

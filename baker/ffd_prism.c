@@ -53,15 +53,8 @@ mk_result mk_prism_prepare(mk_prism_lattice *c, mk_error *err)
             return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX, "center/axis/reference: not finite");
     if (!c->section && (!isfinite(c->radius) || !(c->radius > 0)))
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "radius: must be > 0 (got %g)", c->radius);
-    double *e1 = c->frame[0], *e2 = c->frame[1], *e3 = c->frame[2];
-    memcpy(e3, c->axis, sizeof c->axis);
-    c->height = vec3_normalize(e3);
-    if (!(c->height > 0)) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "axis: zero length (no height)");
-    double d = vec3_dot(c->reference, e3);
-    for (int k = 0; k < 3; k++) e1[k] = c->reference[k] - d * e3[k];
-    if (!(vec3_normalize(e1) > 1e-9 * vec3_length(c->reference)))
-        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "reference: parallel to the axis");
-    vec3_cross(e2, e3, e1);
+    mk_result r = bake_axial_frame(c->axis, c->reference, c->frame, &c->height, err);
+    if (r != MK_OK) return r;
     c->size = fmax(c->height, c->section ? 0 : c->radius);
     if (c->section) {
         /* Each triangle turns left and the angles add up to one turn. */
@@ -289,15 +282,12 @@ void mk_prism_eval(const mk_prism_lattice *c, double amplitude, const double coo
     for (int k = 0; k < 3; k++) out[k] = p[k] + moved[k];
 }
 
+static mk_result locate(const void *lattice, const double p[3], double *coords, mk_error *err)
+{
+    return mk_prism_coordinates(lattice, p, coords, NULL, err);
+}
+
 mk_result mk_prism_bind(const mk_prism_lattice *c, const mk_raw_mesh *mesh, double *coords, mk_error *err)
 {
-    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
-        const float *pf = mesh->positions + 3 * (size_t)v;
-        double p[3] = { pf[0], pf[1], pf[2] };
-        mk_error inner;
-        if (mk_prism_coordinates(c, p, coords + 4 * (size_t)v, NULL, &inner) != MK_OK)
-            return mk_error_set(err, inner.code, UINT64_MAX, "vertex %u (%g, %g, %g): %s", v, p[0], p[1], p[2],
-                                inner.message);
-    }
-    return MK_OK;
+    return bake_lattice_bind(c, locate, 4, mesh, coords, err);
 }

@@ -58,15 +58,6 @@ mk_result edit_laplacian_solve(mk_surface_edit *s, mk_error *err)
             }
         }
     }
-    mk_result r = edit_solve(s, err);
-    if (r != MK_OK) return r;
-    const double *x = s->spd.x->x;
-    for (uint32_t v = 0; v < n; v++)
-        for (int c = 0; c < 3; c++) {
-            size_t i = 3 * (size_t)v + (size_t)c;
-            double d = s->unknown[v] != UINT32_MAX ? x[(size_t)c * nu + s->unknown[v]] : dx[i];
-            s->solution[i] = s->rest[i] + d;
-        }
-    return MK_OK;
+    return edit_solve_positions(s, dx, s->rest, err);
 }
 

@@ -68,3 +68,32 @@ double bake_newton_solve(const bake_newton *n, const double p[3], double q[3], u
     if (iterations) *iterations = it;
     return res;
 }
+
+mk_result bake_lattice_bind(const void *lattice, bake_locate locate, uint32_t stride, const mk_raw_mesh *mesh,
+                            double *coords, mk_error *err)
+{
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        const float *pf = mesh->positions + 3 * (size_t)v;
+        double p[3] = { pf[0], pf[1], pf[2] };
+        mk_error inner;
+        if (locate(lattice, p, coords + stride * (size_t)v, &inner) != MK_OK)
+            return mk_error_set(err, inner.code, UINT64_MAX, "vertex %u (%g, %g, %g): %s", v, p[0], p[1], p[2],
+                                inner.message);
+    }
+    return MK_OK;
+}
+
+mk_result bake_axial_frame(const double axis[3], const double reference[3], double frame[3][3], double *height,
+                           mk_error *err)
+{
+    double *e1 = frame[0], *e2 = frame[1], *e3 = frame[2];
+    memcpy(e3, axis, 3 * sizeof(double));
+    *height = vec3_normalize(e3);
+    if (!(*height > 0)) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "axis: zero length (no height)");
+    double d = vec3_dot(reference, e3);
+    for (int k = 0; k < 3; k++) e1[k] = reference[k] - d * e3[k];
+    if (!(vec3_normalize(e1) > 1e-9 * vec3_length(reference)))
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "reference: parallel to the axis");
+    vec3_cross(e2, e3, e1);
+    return MK_OK;
+}

@@ -6,6 +6,7 @@
 #define BAKE_LATTICE_NEWTON_H
 
 #include <stdint.h>
+#include "raw.h"
 
 /* Bernstein weights of degree points-1 at x (w[0..points-1]) and their derivatives d/dx,
  * deg (B_{i-1}^{deg-1} - B_i^{deg-1}). */
@@ -34,5 +35,19 @@ typedef struct bake_newton {
  * is halved (up to 30 times) until the residual falls. Returns the final |F(q) - p|; q holds
  * the last iterate and *iterations (if not NULL) the number of steps taken. */
 double bake_newton_solve(const bake_newton *newton, const double p[3], double q[3], uint32_t *iterations);
+
+/* The frame of a lattice around an axis: frame[2] the unit axis, frame[0] the reference made
+ * perpendicular to it, frame[1] = frame[2] x frame[0]; *height the axis's length. Errors name
+ * `axis` (zero length) or `reference` (parallel to the axis). */
+mk_result bake_axial_frame(const double axis[3], const double reference[3], double frame[3][3], double *height,
+                           mk_error *err);
+
+/* Where p lies in a lattice: its coordinates (stride doubles) or an error saying why not. */
+typedef mk_result (*bake_locate)(const void *lattice, const double p[3], double *coords, mk_error *err);
+
+/* Locates every vertex of mesh (coords: stride doubles per vertex); the first vertex that
+ * fails is named in the error with its position. */
+mk_result bake_lattice_bind(const void *lattice, bake_locate locate, uint32_t stride, const mk_raw_mesh *mesh,
+                            double *coords, mk_error *err);
 
 #endif

@@ -165,6 +165,21 @@ mk_result edit_solve(mk_surface_edit *s, mk_error *err)
     return bake_spd_solve(&s->spd, err);
 }
 
+mk_result edit_solve_positions(mk_surface_edit *s, const double *known, const double *base, mk_error *err)
+{
+    mk_result r = edit_solve(s, err);
+    if (r != MK_OK) return r;
+    const double *x = s->spd.x->x;
+    const uint32_t nu = s->unknown_count;
+    for (uint32_t v = 0; v < s->welded; v++)
+        for (int c = 0; c < 3; c++) {
+            size_t i = 3 * (size_t)v + (size_t)c;
+            double d = s->unknown[v] != UINT32_MAX ? x[(size_t)c * nu + s->unknown[v]] : known[i];
+            s->solution[i] = base ? base[i] + d : d;
+        }
+    return MK_OK;
+}
+
 /* Triplets of the system matrix (upper triangle, stype 1; duplicates are summed). */
 static mk_result assemble(mk_surface_edit *s, cholmod_triplet **out, mk_error *err)
 {

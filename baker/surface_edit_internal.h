@@ -47,6 +47,9 @@ uint32_t edit_laplacian_row(const mk_surface_edit *edit, uint32_t v, uint32_t *c
 void edit_targets(mk_surface_edit *edit, double amplitude);
 /* Solves the factored system for the right-hand sides in edit->spd.rhs (3 columns) into edit->spd.x. */
 mk_result edit_solve(mk_surface_edit *edit, mk_error *err);
+/* Solves, then edit->solution = base + (the solution for unknowns, known[i] for eliminated
+ * vertices), base NULL meaning zero (3 per welded vertex each). */
+mk_result edit_solve_positions(mk_surface_edit *edit, const double *known, const double *base, mk_error *err);
 
 /* ---- the methods, leaves on the core (edit.c picks one) ---- */
 

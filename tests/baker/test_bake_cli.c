@@ -24,25 +24,33 @@ static int exists(const char *path)
     return f != NULL;
 }
 
-static void bake_sample_and_open_it(void)
+/* Writes the example tube to work/IN_NAME, bakes samples/recipes/RECIPE_NAME onto it into
+ * work/OUT_NAME through the CLI and opens the result (data in arena). 1 when it opened. */
+static int bake_example(const char *in_name, const char *recipe_name, const char *out_name, mk_arena *arena,
+                        mk_asset *asset)
 {
     char in[1024], out[1024], recipe[1024];
-    snprintf(in, sizeof in, "%s/cli_tube.morph", work);
-    snprintf(out, sizeof out, "%s/cli_tube_baked.morph", work);
-    snprintf(recipe, sizeof recipe, "%s/barr.json", recipes);
+    snprintf(in, sizeof in, "%s/%s", work, in_name);
+    snprintf(out, sizeof out, "%s/%s", work, out_name);
+    snprintf(recipe, sizeof recipe, "%s/%s", recipes, recipe_name);
     remove(out);
     CHECK(run("\"%s\" \"%s\" > /dev/null%s%s", make_example, in, "", "") == 0);
     CHECK(run("\"%s\" bake \"%s\" --recipe \"%s\" -o \"%s\" --quiet > /dev/null", morphkit, in, recipe, out) == 0);
-    mk_arena arena;
-    mk_arena_init(&arena, NULL);
     void *data = NULL;
     size_t size = 0;
     mk_error err;
-    mk_asset asset;
-    mk_result r = mk_read_file(&arena, out, 1 << 28, &data, &size, &err);
-    if (r == MK_OK) r = mk_asset_open(data, size, &asset, &err);
+    mk_result r = mk_read_file(arena, out, 1 << 28, &data, &size, &err);
+    if (r == MK_OK) r = mk_asset_open(data, size, asset, &err);
     CHECK_MSG(r == MK_OK, "%s", err.message);
-    if (r == MK_OK) {
+    return r == MK_OK;
+}
+
+static void bake_sample_and_open_it(void)
+{
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    mk_asset asset;
+    if (bake_example("cli_tube.morph", "barr.json", "cli_tube_baked.morph", &arena, &asset)) {
         /* the example's 2 channels untouched + 3 baked ones, baked ones carry their recipe */
         CHECK_EQ_INT(asset.channel_count, 5);
         int32_t c = mk_find_channel(&asset, "bend_forward");
@@ -59,23 +67,10 @@ static void bake_sample_and_open_it(void)
 /* The transfer sample reads its source asset (a glTF next to the recipe) through the CLI's loader. */
 static void transfer_sample_reads_its_source(void)
 {
-    char in[1024], out[1024], recipe[1024];
-    snprintf(in, sizeof in, "%s/cli_tube3.morph", work);
-    snprintf(out, sizeof out, "%s/cli_tube_transfer.morph", work);
-    snprintf(recipe, sizeof recipe, "%s/transfer.json", recipes);
-    remove(out);
-    CHECK(run("\"%s\" \"%s\" > /dev/null%s%s", make_example, in, "", "") == 0);
-    CHECK(run("\"%s\" bake \"%s\" --recipe \"%s\" -o \"%s\" --quiet > /dev/null", morphkit, in, recipe, out) == 0);
     mk_arena arena;
     mk_arena_init(&arena, NULL);
-    void *data = NULL;
-    size_t size = 0;
-    mk_error err;
     mk_asset asset;
-    mk_result r = mk_read_file(&arena, out, 1 << 28, &data, &size, &err);
-    if (r == MK_OK) r = mk_asset_open(data, size, &asset, &err);
-    CHECK_MSG(r == MK_OK, "%s", err.message);
-    if (r == MK_OK) {
+    if (bake_example("cli_tube3.morph", "transfer.json", "cli_tube_transfer.morph", &arena, &asset)) {
         /* the example's 2 channels + the source's "pinch" and "lean" with the prefix */
         CHECK_EQ_INT(asset.channel_count, 4);
         mk_channel_info ci;
