@@ -637,6 +637,21 @@ static int edit_at_full_amplitude(const mk_raw_mesh *m, const mk_edit_params *p,
     return r == MK_OK;
 }
 
+/* A tube of radius 1 along z in [0, 3] (24 x 12) and its bottom and top rings (malloc'ed). */
+static mk_raw_mesh *tube_with_ends(mk_raw_asset *raw, uint32_t **bottom, uint32_t *nb, uint32_t **top, uint32_t *nt)
+{
+    mk_raw_mesh *m = fixture_cylinder(raw, "tube", 1, 3, 24, 12);
+    *bottom = malloc(m->vertex_count * sizeof(uint32_t));
+    *top = malloc(m->vertex_count * sizeof(uint32_t));
+    *nb = *nt = 0;
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        float z = m->positions[3 * (size_t)v + 2];
+        if (z < 0.01f) (*bottom)[(*nb)++] = v;
+        else if (z > 2.99f) (*top)[(*nt)++] = v;
+    }
+    return m;
+}
+
 static void arap_converges_to_the_rigid_optimum_with_falling_energy(void)
 {
     /* Handles at both ends of a tube moved by one rigid motion, nothing anchored: the rigidly
@@ -645,14 +660,8 @@ static void arap_converges_to_the_rigid_optimum_with_falling_energy(void)
      * every iteration. */
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
-    mk_raw_mesh *m = fixture_cylinder(&raw, "tube", 1, 3, 24, 12);
-    uint32_t *bottom = malloc(m->vertex_count * sizeof(uint32_t)), *top = malloc(m->vertex_count * sizeof(uint32_t));
-    uint32_t nb = 0, nt = 0;
-    for (uint32_t v = 0; v < m->vertex_count; v++) {
-        float z = m->positions[3 * (size_t)v + 2];
-        if (z < 0.01f) bottom[nb++] = v;
-        else if (z > 2.99f) top[nt++] = v;
-    }
+    uint32_t *bottom, *top, nb, nt;
+    mk_raw_mesh *m = tube_with_ends(&raw, &bottom, &nb, &top, &nt);
     double angle = 50 * PI / 180;
     mk_edit_handle h[2] = { { nb, bottom, { 0.3, -0.2, 0.5 }, { 1, 1, 0.5 }, angle, { 0, 0, 1.5 } },
                             { nt, top, { 0.3, -0.2, 0.5 }, { 1, 1, 0.5 }, angle, { 0, 0, 1.5 } } };
@@ -713,6 +722,34 @@ static void arap_anderson_lowers_energy_faster_than_plain(void)
     CHECK(fabs(energy[A][1] - energy[P][1]) <= 1e-3 * energy[P][1] && fabs(energy[L][1] - energy[P][1]) <= 1e-3 * energy[P][1]);
     for (int acc = 0; acc < 3; acc++) CHECK(energy[acc][1] <= energy[acc][0]);
     free(pos); free(anchors); free(handle);
+    mk_raw_free(&raw);
+}
+
+/* A twist of a tube by 160 degrees: L-BFGS's full steps overshoot there, so its line search must
+ * cut them back; the energy still falls at every iteration and ends where plain iterations end. */
+static void arap_lbfgs_line_search_keeps_the_energy_falling(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    uint32_t *bottom, *top, nb, nt;
+    mk_raw_mesh *m = tube_with_ends(&raw, &bottom, &nb, &top, &nt);
+    mk_edit_handle h = { nt, top, { 0, 0, 3 }, { 0, 0, 1 }, 160 * PI / 180, { 0.5, 0, -0.5 } };
+    double *pos = malloc(3 * m->vertex_count * sizeof(double)), energy[3] = { 0, 0, 0 };
+    for (int acc = MK_ARAP_LBFGS; acc <= MK_ARAP_PLAIN; acc += MK_ARAP_PLAIN - MK_ARAP_LBFGS) {
+        energy_log log = { .count = 0 };
+        mk_edit_params p = { .method = MK_EDIT_ARAP, .anchor_count = nb, .anchors = bottom, .handle_count = 1,
+                             .handles = &h, .acceleration = (mk_arap_acceleration)acc, .iterations = 2000,
+                             .convergence = 1e-10, .iteration_done = log_energy, .user = &log };
+        mk_solver_stats st;
+        if (!edit_at_full_amplitude(m, &p, pos, &st)) continue;
+        energy[acc] = st.energy;
+        fprintf(stderr, "ARAP twisted tube (%s): %u iterations, energy %.6f -> %.6f\n", acc ? "plain" : "lbfgs",
+                st.iterations, st.start_energy, st.energy);
+        CHECK(energies_decrease(&log));
+    }
+    CHECK_MSG(fabs(energy[MK_ARAP_LBFGS] - energy[MK_ARAP_PLAIN]) <= 1e-3 * energy[MK_ARAP_PLAIN], "lbfgs %g, plain %g",
+              energy[MK_ARAP_LBFGS], energy[MK_ARAP_PLAIN]);
+    free(pos); free(bottom); free(top);
     mk_raw_free(&raw);
 }
 
@@ -1884,7 +1921,7 @@ CHECK_MAIN(CASE(identity_deformations_give_zero_deltas),
            CASE(laplacian_translation_of_everything_is_exact),
            CASE(arap_rigid_handles_without_anchors_move_rigidly),
            CASE(arap_converges_to_the_rigid_optimum_with_falling_energy),
-           CASE(arap_anderson_lowers_energy_faster_than_plain),
+           CASE(arap_anderson_lowers_energy_faster_than_plain), CASE(arap_lbfgs_line_search_keeps_the_energy_falling),
            CASE(component_without_constraint_is_rejected),
            CASE(twist_180_auto_inbetweens_play_back_within_tolerance),
            CASE(fixed_inbetweens_and_linear_ops),
