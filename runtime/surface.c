@@ -37,8 +37,15 @@ typedef struct layout {
     size_t group_of, group_tri_first, group_tris, tri_groups, rest, size;
 } layout;
 
+/* Per smoothing group: the sum of its face normals and whether a corner of its triangles moved
+ * (a job's sums in its scratch; the rest normals in the topology, normalized, moved unused). */
+typedef struct group_sum {
+    float normal[3];
+    uint32_t moved;
+} group_sum;
+
 /* Offsets of the arrays; size 0 when the mesh cannot have a topology. The rest-normal region
- * (3 floats per possible group) first serves as the build's scratch (control point lists). */
+ * (a group_sum per possible group) first serves as the build's scratch (control point lists). */
 static layout topology_layout(const mk_blob_mesh *m)
 {
     layout l = { 0, 0, 0, 0, 0, 0 };
@@ -46,7 +53,7 @@ static layout topology_layout(const mk_blob_mesh *m)
     size_t v = m->vertex_count, t = m->triangle_count, c = m->control_point_count;
     if (v > SIZE_MAX / 64 || t > SIZE_MAX / 64 || c > SIZE_MAX / 64) return l;
     size_t scratch = mk_smoothing_groups_scratch_size((uint32_t)c, (uint32_t)v);
-    size_t rest = 12 * v > scratch ? 12 * v : scratch;
+    size_t rest = sizeof(group_sum) * v > scratch ? sizeof(group_sum) * v : scratch;
     l.group_of = align16(sizeof(topology_header));
     l.group_tri_first = l.group_of + align16(4 * v);
     l.group_tris = l.group_tri_first + align16(4 * (v + 1));
@@ -107,6 +114,27 @@ static void face_normal(const uint32_t *tri, const uint8_t *p, size_t stride, fl
     out[2] = e1[0] * e2[1] - e1[1] * e2[0];
 }
 
+/* Adds the face normal of every triangle in [t_lo, t_hi) (those with mark[t], mark NULL: all) at
+ * positions p to each of its distinct corner groups, in triangle order (docs/semantics.md), and
+ * with vmoved (per vertex, may be NULL) marks a group moved when a corner of one of its
+ * triangles moved. The one sum behind both N(P0) (the build) and N(P) (every job). */
+static void add_face_normals(const uint32_t *triangles, const uint32_t *tri_groups, const uint8_t *mark, uint32_t t_lo,
+                             uint32_t t_hi, const uint8_t *p, size_t stride, const uint8_t *vmoved, group_sum *sums)
+{
+    for (uint32_t t = t_lo; t < t_hi; t++) {
+        if (mark && !mark[t]) continue;
+        const uint32_t *tri = &triangles[3u * t], *g = &tri_groups[3u * t];
+        float f[3];
+        face_normal(tri, p, stride, f);
+        uint32_t moved_corners = vmoved ? (uint32_t)vmoved[tri[0]] + vmoved[tri[1]] + vmoved[tri[2]] : 0;
+        for (int c = 0; c < 3; c++)
+            if (g[c] != NO_GROUP) {
+                group_sum *gs = &sums[g[c]];
+                gs->normal[0] += f[0]; gs->normal[1] += f[1]; gs->normal[2] += f[2]; gs->moved |= moved_corners != 0;
+            }
+    }
+}
+
 /* N: a group's summed face normals, normalized; the fallback where the sum is zero. */
 static void normalize_sum(const float sum[3], const float fallback[3], float out[3])
 {
@@ -143,38 +171,30 @@ mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *
     /* The groups, with the rest-normal region as scratch; then a fill cursor there. */
     uint32_t *fill = (uint32_t *)(void *)(base + l.rest);
     uint32_t groups = mk_smoothing_groups(cp, cps, normals, n, group_of, fill);
-    /* Group -> triangles: each triangle once per distinct corner group, in triangle order. */
+    /* Triangle -> its distinct corner groups (NO_GROUP for a repeated one), and the inverse:
+     * group -> its triangles in triangle order (CSR, counted first). */
     memset(tri_first, 0, 4 * ((size_t)groups + 1));
     for (uint32_t t = 0; t < tri_count; t++) {
         uint32_t g0 = group_of[triangles[3u * t]], g1 = group_of[triangles[3u * t + 1]], g2 = group_of[triangles[3u * t + 2]];
-        tri_first[g0 + 1]++;
-        if (g1 != g0) tri_first[g1 + 1]++;
-        if (g2 != g0 && g2 != g1) tri_first[g2 + 1]++;
+        uint32_t *g = &tri_groups[3u * t];
+        g[0] = g0;
+        g[1] = g1 != g0 ? g1 : NO_GROUP;
+        g[2] = g2 != g0 && g2 != g1 ? g2 : NO_GROUP;
+        for (int c = 0; c < 3; c++)
+            if (g[c] != NO_GROUP) tri_first[g[c] + 1]++;
     }
     for (uint32_t g = 0; g < groups; g++) tri_first[g + 1] += tri_first[g];
     memcpy(fill, tri_first, 4 * (size_t)groups);
-    for (uint32_t t = 0; t < tri_count; t++) {
-        uint32_t g0 = group_of[triangles[3u * t]], g1 = group_of[triangles[3u * t + 1]], g2 = group_of[triangles[3u * t + 2]];
-        group_tris[fill[g0]++] = t;
-        if (g1 != g0) group_tris[fill[g1]++] = t;
-        if (g2 != g0 && g2 != g1) group_tris[fill[g2]++] = t;
-        /* Triangle -> its distinct corner groups (NO_GROUP for a repeated one). */
-        tri_groups[3u * t] = g0;
-        tri_groups[3u * t + 1] = g1 != g0 ? g1 : NO_GROUP;
-        tri_groups[3u * t + 2] = g2 != g0 && g2 != g1 ? g2 : NO_GROUP;
-    }
-    /* Rest normals (the scratch is no longer needed); (0,0,0) for a group without area, whose
-     * vertices then take their own base normal as the rest normal. */
-    float *rest = (float *)(void *)(base + l.rest);
+    for (uint32_t t = 0; t < tri_count; t++)
+        for (int c = 0; c < 3; c++)
+            if (tri_groups[3u * t + c] != NO_GROUP) group_tris[fill[tri_groups[3u * t + c]]++] = t;
+    /* Rest normals N(P0) by the jobs' own sum (the scratch is no longer needed); (0,0,0) for a
+     * group without area, whose vertices then take their own base normal as the rest normal. */
+    group_sum *rest = (group_sum *)(void *)(base + l.rest);
     static const float none[3] = { 0, 0, 0 };
-    for (uint32_t g = 0; g < groups; g++) {
-        float sum[3] = { 0, 0, 0 }, f[3];
-        for (uint32_t k = tri_first[g]; k < tri_first[g + 1]; k++) {
-            face_normal(&triangles[3u * group_tris[k]], asset->data + m->positions, 12, f);
-            sum[0] += f[0]; sum[1] += f[1]; sum[2] += f[2];
-        }
-        normalize_sum(sum, none, &rest[3u * g]);
-    }
+    memset(rest, 0, sizeof(group_sum) * (size_t)groups);
+    add_face_normals(triangles, tri_groups, NULL, 0, tri_count, asset->data + m->positions, 12, NULL, rest);
+    for (uint32_t g = 0; g < groups; g++) normalize_sum(rest[g].normal, none, rest[g].normal);
     topology_header h = { .magic = TOPOLOGY_MAGIC, .mesh = mesh, .vertex_count = n, .triangle_count = tri_count,
                           .group_count = groups, .size = l.size, .checksum = asset->header->checksum,
                           .group_of = l.group_of, .group_tri_first = l.group_tri_first, .group_tris = l.group_tris,
@@ -229,10 +249,6 @@ mk_result mk_surface_validate(const mk_surface_job *job, mk_error *err)
  * accumulator per possible group (the sum of its face normals at the evaluated positions and
  * whether a corner of its triangles moved). A job fills what it reads, so the scratch needs no
  * initialization and any job may use any scratch. */
-typedef struct group_sum {
-    float normal[3];
-    uint32_t moved;
-} group_sum;
 
 static size_t marks_size(const mk_blob_mesh *m) { return align16(m->triangle_count) + align16(m->vertex_count); }
 
@@ -266,7 +282,7 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
     const uint32_t *tri_first = (const uint32_t *)(const void *)(base + h.group_tri_first);
     const uint32_t *group_tris = (const uint32_t *)(const void *)(base + h.group_tris);
     const uint32_t *tri_groups = (const uint32_t *)(const void *)(base + h.tri_groups);
-    const float *rest = (const float *)(const void *)(base + h.rest);
+    const group_sum *rest = (const group_sum *)(const void *)(base + h.rest);
     const uint32_t *triangles = (const uint32_t *)(const void *)(a->data + m->triangles);
     const float *p0 = (const float *)(const void *)(a->data + m->positions);
     const float *normals = (const float *)(const void *)(a->data + m->normals);
@@ -281,8 +297,8 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
     /* The triangles the range needs: those with a corner in a group of one of its vertices
      * (all of them for the whole mesh), in [t_lo, t_hi). */
     uint32_t t_lo = 0, t_hi = tri_count, v_lo = 0, v_hi = m->vertex_count;
-    if (n == m->vertex_count) {
-        memset(mark, 1, tri_count);
+    const int whole = n == m->vertex_count;   /* every triangle: no marks needed */
+    if (whole) {
         memset(sums, 0, sizeof(group_sum) * (size_t)h.group_count);
     } else {
         memset(mark, 0, tri_count);
@@ -308,22 +324,7 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
                 }
     }
     vertices_moved(vmoved, v_lo, v_hi, p, ps, p0);
-    /* One pass over those triangles in triangle order: each adds its face normal once to each
-     * distinct corner group (the order of every group's sum is the triangle order, as in
-     * docs/semantics.md) and marks the groups moved when a corner moved. */
-    for (uint32_t t = t_lo; t < t_hi; t++) {
-        if (!mark[t]) continue;
-        const uint32_t *tri = &triangles[3u * t];
-        const uint32_t *g = &tri_groups[3u * t];
-        float f[3];
-        face_normal(tri, p, ps, f);
-        uint32_t moved_corners = (uint32_t)vmoved[tri[0]] + vmoved[tri[1]] + vmoved[tri[2]];
-        for (int c = 0; c < 3; c++)
-            if (g[c] != NO_GROUP) {
-                group_sum *gs = &sums[g[c]];
-                gs->normal[0] += f[0]; gs->normal[1] += f[1]; gs->normal[2] += f[2]; gs->moved |= moved_corners != 0;
-            }
-    }
+    add_face_normals(triangles, tri_groups, whole ? NULL : mark, t_lo, t_hi, p, ps, vmoved, sums);
     for (uint32_t i = 0; i < n; i++) {
         uint32_t v = job->first_vertex + i, g = group_of[v];
         const float *b = &normals[3u * v];
@@ -334,7 +335,7 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
         if (moved) {
             float now[3], d[3];
             normalize_sum(sums[g].normal, b, now);
-            const float *r0 = &rest[3u * g];
+            const float *r0 = rest[g].normal;
             int flat = r0[0] == 0 && r0[1] == 0 && r0[2] == 0;
             for (int c = 0; c < 3; c++) d[c] = flat ? now[c] : b[c] + (now[c] - r0[c]);
             float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
