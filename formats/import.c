@@ -88,6 +88,7 @@ mk_result mk_import_file(const char *path, const mk_import_options *options, mk_
 
 mk_result mk_import_load_asset(void *user, const char *path, mk_raw_asset *out, mk_error *err)
 {
+    (void)user;   /* the bake's user pointer belongs to its other callbacks */
     mk_import_options keep = { .keep_plain_meshes = 1 };
-    return mk_import_file(path, user ? (const mk_import_options *)user : &keep, out, err);
+    return mk_import_file(path, &keep, out, err);
 }

@@ -12,9 +12,9 @@
 mk_result mk_import_memory(const void *data, size_t size, const mk_import_options *options, mk_raw_asset *out,
                            mk_error *err);
 mk_result mk_import_file(const char *path, const mk_import_options *options, mk_raw_asset *out, mk_error *err);
-/* mk_import_file in the shape of mk_bake_options.load_asset (a `transfer` recipe's source):
- * user is a const mk_import_options * or NULL for the default with every mesh kept, so mesh
- * indices count the file's meshes. */
+/* mk_import_file in the shape of mk_bake_options.load_asset (a `transfer` recipe's source), with
+ * the default options and every mesh kept, so mesh indices count the file's meshes. user is not
+ * read: mk_bake_options.user is shared with the bake's other callbacks (progress, reports). */
 mk_result mk_import_load_asset(void *user, const char *path, mk_raw_asset *out, mk_error *err);
 
 #endif
