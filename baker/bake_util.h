@@ -46,6 +46,16 @@ static inline void mat3_mul(double out[9], const double a[9], const double b[9])
             r[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j];
     for (int i = 0; i < 9; i++) out[i] = r[i];
 }
+/* Union-find: the root of v's set, halving the path on the way (parent[root] == root). */
+static inline uint32_t bake_find_root(uint32_t *parent, uint32_t v)
+{
+    while (parent[v] != v) {
+        parent[v] = parent[parent[v]];
+        v = parent[v];
+    }
+    return v;
+}
+
 static inline double mat3_det(const double m[9])
 {
     return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +

@@ -139,12 +139,10 @@ static void wedge_eval(const mk_prism_lattice *c, uint32_t w, const double q[3],
 {
     int n = (int)c->degree;
     double tri[(MAX_DEGREE + 1) * (MAX_DEGREE + 1)], low[(MAX_DEGREE + 1) * (MAX_DEGREE + 1)];
-    double wu[MAX_LAYERS], dwu[MAX_LAYERS], A[3], B[3];
+    double wu[MAX_LAYERS], dwu[MAX_LAYERS];
     triangle_bernstein(n, q[0], q[1], tri);
     triangle_bernstein(n - 1, q[0], q[1], low);
     bake_bernstein(c->layers, q[2], wu, dwu);
-    corner(c, w, A);
-    corner(c, w + 1, B);
     memset(out, 0, 3 * sizeof(double));
     if (J) memset(J, 0, 9 * sizeof(double));
     for (uint32_t k = 0; k < c->layers; k++)
@@ -158,9 +156,7 @@ static void wedge_eval(const mk_prism_lattice *c, uint32_t w, const double q[3],
                 else if (c->rest)
                     memcpy(p, c->rest + 3 * (size_t)index, sizeof p);
                 else
-                    for (int x = 0; x < 3; x++)
-                        p[x] = c->center[x] + (double)b / n * A[x] + (double)cc / n * B[x] +
-                               (double)k / (c->layers - 1) * c->height * c->frame[2][x];
+                    mk_prism_control_point(c, r, m, k, p);
                 double bt = tri[b * (n + 1) + cc], wgt = bt * wu[k];
                 for (int x = 0; x < 3; x++) out[x] += wgt * p[x];
                 if (!J) continue;

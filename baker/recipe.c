@@ -1416,9 +1416,7 @@ static mk_result bake_shell_run(recipe_ctx *ctx, channel_plan *plan, shell_bake 
     if (plan->clip_duration < 0) plan->clip_duration = b->last * plan->shell.dt;
     if (plan->shell_log) {
         char full[4096];
-        const char *dir = o && o->base_dir ? o->base_dir : "";
-        if (plan->shell_log[0] == '/' || !*dir) snprintf(full, sizeof full, "%s", plan->shell_log);
-        else snprintf(full, sizeof full, "%s/%s", dir, plan->shell_log);
+        recipe_path(ctx, plan->shell_log, full, sizeof full);
         FILE *f = fopen(full, "w");
         int bad = !f || shell_write_log(f, &b->run) != 0;
         if (f && fclose(f) != 0) bad = 1;

@@ -29,15 +29,6 @@
 
 #define COT_CLAMP 1e5
 
-static uint32_t find_root(uint32_t *parent, uint32_t v)
-{
-    while (parent[v] != v) {
-        parent[v] = parent[parent[v]];
-        v = parent[v];
-    }
-    return v;
-}
-
 /* Edge list -> CSR adjacency with unique sorted neighbors. */
 static int cmp_u32(const void *a, const void *b)
 {
@@ -307,17 +298,17 @@ mk_result mk_surface_edit_create(const mk_raw_mesh *mesh, const mk_edit_params *
     for (uint32_t v = 0; v < n; v++) {
         if (s->offsets[v] == s->offsets[v + 1] && s->constraint[v] < 0) s->constraint[v] = 0;
         for (uint32_t q = s->offsets[v]; q < s->offsets[v + 1]; q++) {
-            uint32_t a = find_root(parent, v), b = find_root(parent, s->neighbors[q]);
+            uint32_t a = bake_find_root(parent, v), b = bake_find_root(parent, s->neighbors[q]);
             if (a != b) parent[a < b ? b : a] = a < b ? a : b;
         }
     }
     for (uint32_t v = 0; v < n; v++)
-        if (s->constraint[v] >= 0) has[find_root(parent, v)] = 1;
+        if (s->constraint[v] >= 0) has[bake_find_root(parent, v)] = 1;
     for (uint32_t v = 0; v < n; v++) {
-        uint32_t root = find_root(parent, v);
+        uint32_t root = bake_find_root(parent, v);
         if (!has[root]) {
             uint32_t size = 0, render = 0;
-            for (uint32_t u = 0; u < n; u++) size += find_root(parent, u) == root;
+            for (uint32_t u = 0; u < n; u++) size += bake_find_root(parent, u) == root;
             for (uint32_t u = 0; u < mesh->vertex_count; u++)
                 if (s->weld[u] == v) { render = u; break; }
             FAIL(mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,

@@ -49,15 +49,6 @@ struct mk_transfer {
     mk_transfer_stats stats;
 };
 
-static uint32_t find_root(uint32_t *parent, uint32_t v)
-{
-    while (parent[v] != v) {
-        parent[v] = parent[parent[v]];
-        v = parent[v];
-    }
-    return v;
-}
-
 /* Inverse of a 3x3 matrix from its cofactors; 0 when singular. */
 static int mat3_inverse(double out[9], const double m[9])
 {
@@ -112,7 +103,7 @@ static mk_result build_system(mk_transfer *x, mk_error *err)
         const uint32_t *tri = tg->triangles + 3 * (size_t)x->used[u];
         uint32_t a = x->weld[tri[0]];
         for (int k = 0; k < 3; k++) {
-            uint32_t ra = find_root(parent, a), rb = find_root(parent, x->weld[tri[k]]);
+            uint32_t ra = bake_find_root(parent, a), rb = bake_find_root(parent, x->weld[tri[k]]);
             if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
             x->component[x->weld[tri[k]]] = 0;  /* used; numbered below */
         }
@@ -133,7 +124,7 @@ static mk_result build_system(mk_transfer *x, mk_error *err)
     uint32_t welded_unknowns = 0;
     for (uint32_t v = 0; v < n; v++) {
         if (x->component[v] == UINT32_MAX) { x->unknown[v] = UINT32_MAX; continue; }
-        uint32_t root = find_root(parent, v);
+        uint32_t root = bake_find_root(parent, v);
         if (root == v) {
             x->component[v] = x->component_count++;
             x->unknown[v] = UINT32_MAX;  /* pinned */

@@ -110,7 +110,6 @@ typedef struct shell_params {
 
 /* What one frame measured (the log). */
 typedef struct shell_frame_stats {
-    uint32_t frame;
     double time;              /* seconds simulated */
     double volume_ratio;      /* V / V0 */
     double membrane, bending, aniso;  /* energies at the end of the frame */

@@ -15,6 +15,7 @@
  */
 #include <math.h>
 #include "shell.h"
+#include "bake_util.h"
 
 void shell_deformation_gradient(const double *x0, const double *x1, const double *x2,
                                 const double Dm_inv[4], double F[6])
@@ -48,12 +49,11 @@ static void f_times(const double F[6], const double S[4], double P[6])
     }
 }
 
-static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 double shell_material_psi(shell_material material, double mu, double lambda, const double F[6],
                           const double basis[6], double P[6])
 {
-    double C[4] = { dot3(F, F), dot3(F, F + 3), 0, dot3(F + 3, F + 3) };
+    double C[4] = { vec3_dot(F, F), vec3_dot(F, F + 3), 0, vec3_dot(F + 3, F + 3) };
     C[2] = C[1];
     switch (material) {
     case SHELL_STVK: {
@@ -83,7 +83,7 @@ double shell_material_psi(shell_material material, double mu, double lambda, con
     }
     case SHELL_LINEAR: {
         /* G = B^T F (2x2, row-major: G[i][j] = e_i . F_j). */
-        double G[4] = { dot3(basis, F), dot3(basis, F + 3), dot3(basis + 3, F), dot3(basis + 3, F + 3) };
+        double G[4] = { vec3_dot(basis, F), vec3_dot(basis, F + 3), vec3_dot(basis + 3, F), vec3_dot(basis + 3, F + 3) };
         double e[4] = { G[0] - 1, 0.5 * (G[1] + G[2]), 0.5 * (G[1] + G[2]), G[3] - 1 };
         double tr = e[0] + e[3];
         double S[4] = { 2 * mu * e[0] + lambda * tr, 2 * mu * e[1], 2 * mu * e[2], 2 * mu * e[3] + lambda * tr };

@@ -142,13 +142,13 @@ mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *a
     run->stats[0] = (shell_frame_stats){ .volume_ratio = 1, .membrane = energy[0], .bending = energy[1], .aniso = energy[2] };
     double alpha = 1 / (p->dt * p->dt);
     size_t nlambda = (size_t)m->tri_count + m->hinge_count + s.aniso_count;
+    shell_volume(m, x, grad);   /* then at the end of every frame, for the next one */
     for (uint32_t f = 1; f <= p->frames; f++) {
         double t0 = bake_now();
         shell_frame_stats *st = &run->stats[f];
         memset(st, 0, sizeof *st);
         /* Prediction: f_i = -P dV/dx_i (= -P sum over its triangles A_j n_j / 3), plus the
          * inward push k_A on the region's vertices. */
-        shell_volume(m, x, grad);
         double pressure = p->ramp > 0 && f * p->dt < p->ramp ? p->pressure * (f * p->dt) / p->ramp : p->pressure;
         if (s.aniso_count && p->aniso_kA != 0) shell_vertex_normals(m, x, normals);
         for (uint32_t i = 0; i < m->n; i++) {
@@ -183,9 +183,8 @@ mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *a
             run->positions[n3 * f + k] = (float)x[k];
         }
         sweep(&s, x, -1, energy);
-        st->frame = f;
         st->time = f * p->dt;
-        st->volume_ratio = shell_volume(m, x, NULL) / m->volume0;
+        st->volume_ratio = shell_volume(m, x, grad) / m->volume0;
         st->membrane = energy[0];
         st->bending = energy[1];
         st->aniso = energy[2];
