@@ -3,15 +3,16 @@
  * normals"; the API in morphkit.h).
  *
  * The topology, built once per mesh into caller memory, holds the smoothing groups (vertices
- * with the same control point and the same base normal within 1e-5 per component, numbered in
- * control-point order, then vertex order), each group's triangles (a triangle once per
- * distinct corner group, in triangle order), each triangle's distinct corner groups and each
- * group's rest normal. The rules and the order of every sum are those of the offline
- * importer's target normals (which sums in double precision; here single precision keeps the
- * per-frame pass small), so a single target at its full weight reproduces the normal deltas
- * the importer computed for it up to float rounding. A job sums each needed triangle's face
- * normal into its corner groups in one pass in triangle order, then finishes its vertices. A
- * vertex's normal depends only on the positions and the topology, never on the job's range. */
+ * with the same control point and the same base normal within 1e-5 per component), each
+ * group's triangles (a triangle once per distinct corner group, in triangle order) and each
+ * group's rest normal. The rules and the order of every sum are those of the offline importer's
+ * target normals (which sums in double precision; here single precision keeps the per-frame
+ * pass small), so a single target at its full weight reproduces the normal deltas the importer
+ * computed for it up to float rounding. A job computes the face normal of each triangle it
+ * needs once, then per vertex sums its group's face normals in the group's triangle order (a
+ * gather: no sum is shared between vertices, so no read-modify-write chains through memory)
+ * and finishes eight vertices at a time in lanes without branches. A vertex's normal depends
+ * only on the positions and the topology, never on the job's range. */
 #include <math.h>
 #include <string.h>
 #include "format.h"
@@ -19,8 +20,15 @@
 #include "error.h"
 #include "span.h"
 #include "determinism.h"
+/* The finishing lanes choose between values already computed. GCC by default moves a floating-
+ * point operation whose only use is one side of a choice into that side (it could trap), which
+ * keeps it from vector instructions there; traps are off everywhere, so this changes no result,
+ * only the instructions (clang does this by default). */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("no-trapping-math")
+#endif
 
-#define TOPOLOGY_MAGIC 0x54534b4du /* "MKST" */
+#define TOPOLOGY_MAGIC 0x32534b4du /* "MKS2" */
 #define NO_GROUP UINT32_MAX
 
 typedef struct topology_header {
@@ -28,37 +36,29 @@ typedef struct topology_header {
     uint32_t vertex_count, triangle_count, group_count, reserved;
     uint64_t size;                 /* bytes the topology was built for */
     uint64_t checksum;             /* the blob's, to refuse another asset's topology */
-    uint64_t group_of, group_tri_first, group_tris, rest, tri_groups; /* array offsets */
+    uint64_t group_of, group_tri_first, group_tris, rest; /* array offsets */
 } topology_header;
 
 static size_t align16(size_t n) { return (n + 15u) & ~(size_t)15u; }
 
 typedef struct layout {
-    size_t group_of, group_tri_first, group_tris, tri_groups, rest, size;
+    size_t group_of, group_tri_first, group_tris, rest, size;
 } layout;
 
-/* Per smoothing group: the sum of its face normals and whether a corner of its triangles moved
- * (a job's sums in its scratch; the rest normals in the topology, normalized, moved unused). */
-typedef struct group_sum {
-    float normal[3];
-    uint32_t moved;
-} group_sum;
-
-/* Offsets of the arrays; size 0 when the mesh cannot have a topology. The rest-normal region
- * (a group_sum per possible group) first serves as the build's scratch (control point lists). */
+/* Offsets of the arrays; size 0 when the mesh cannot have a topology. The rest normals are four
+ * floats per group (the fourth 0); their region first serves as the build's scratch. */
 static layout topology_layout(const mk_blob_mesh *m)
 {
-    layout l = { 0, 0, 0, 0, 0, 0 };
+    layout l = { 0, 0, 0, 0, 0 };
     if (!(m->flags & MK_MESH_HAS_NORMALS) || m->triangle_count == 0 || m->vertex_count == 0) return l;
     size_t v = m->vertex_count, t = m->triangle_count, c = m->control_point_count;
     if (v > SIZE_MAX / 64 || t > SIZE_MAX / 64 || c > SIZE_MAX / 64) return l;
     size_t scratch = mk_smoothing_groups_scratch_size((uint32_t)c, (uint32_t)v);
-    size_t rest = sizeof(group_sum) * v > scratch ? sizeof(group_sum) * v : scratch;
+    size_t rest = 16 * v > scratch ? 16 * v : scratch;
     l.group_of = align16(sizeof(topology_header));
     l.group_tri_first = l.group_of + align16(4 * v);
     l.group_tris = l.group_tri_first + align16(4 * (v + 1));
-    l.tri_groups = l.group_tris + align16(12 * t);
-    l.rest = l.tri_groups + align16(12 * t);
+    l.rest = l.group_tris + align16(12 * t);
     l.size = l.rest + align16(rest);
     return l;
 }
@@ -114,37 +114,29 @@ static void face_normal(const uint32_t *tri, const uint8_t *p, size_t stride, fl
     out[2] = e1[0] * e2[1] - e1[1] * e2[0];
 }
 
-/* Adds the face normal of every triangle in [t_lo, t_hi) (those with mark[t], mark NULL: all) at
- * positions p to each of its distinct corner groups, in triangle order (docs/semantics.md), and
- * with vmoved (per vertex, may be NULL) marks a group moved when a corner of one of its
- * triangles moved. The one sum behind both N(P0) (the build) and N(P) (every job). */
-static void add_face_normals(const uint32_t *triangles, const uint32_t *tri_groups, const uint8_t *mark, uint32_t t_lo,
-                             uint32_t t_hi, const uint8_t *p, size_t stride, const uint8_t *vmoved, group_sum *sums)
+/* The sum of the face normals of the triangles list[0, count) in that order (a group's: in
+ * triangle order), read from faces (a job's face pass) or, with faces NULL, computed from the
+ * positions p (the build): the same values either way, so N(P0) and N(P) are one sum. */
+static void sum_faces(const uint32_t *list, uint32_t count, const float (*faces)[3], const uint32_t *triangles,
+                      const uint8_t *p, size_t stride, float sum[3])
 {
-    for (uint32_t t = t_lo; t < t_hi; t++) {
-        if (mark && !mark[t]) continue;
-        const uint32_t *tri = &triangles[3u * t], *g = &tri_groups[3u * t];
-        float f[3];
-        face_normal(tri, p, stride, f);
-        uint32_t moved_corners = vmoved ? (uint32_t)vmoved[tri[0]] + vmoved[tri[1]] + vmoved[tri[2]] : 0;
-        for (int c = 0; c < 3; c++)
-            if (g[c] != NO_GROUP) {
-                group_sum *gs = &sums[g[c]];
-                gs->normal[0] += f[0]; gs->normal[1] += f[1]; gs->normal[2] += f[2]; gs->moved |= moved_corners != 0;
-            }
+    sum[0] = sum[1] = sum[2] = 0;
+    for (uint32_t k = 0; k < count; k++) {
+        float computed[3];
+        if (!faces) face_normal(&triangles[3u * list[k]], p, stride, computed);
+        const float *f = faces ? faces[list[k]] : computed;
+        for (int c = 0; c < 3; c++) sum[c] += f[c];
     }
 }
 
-/* N: a group's summed face normals, normalized; the fallback where the sum is zero. */
-static void normalize_sum(const float sum[3], const float fallback[3], float out[3])
+/* The distinct corner groups of triangle t, NO_GROUP for a repeated one. */
+static void corner_groups(const uint32_t *triangles, const uint32_t *group_of, uint32_t t, uint32_t g[3])
 {
-    float len = sqrtf(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
-    if (len > 0) {
-        float inv = 1.0f / len;
-        for (int d = 0; d < 3; d++) out[d] = sum[d] * inv;
-    } else {
-        for (int d = 0; d < 3; d++) out[d] = fallback[d];
-    }
+    g[0] = group_of[triangles[3u * t]];
+    g[1] = group_of[triangles[3u * t + 1]];
+    g[2] = group_of[triangles[3u * t + 2]];
+    if (g[1] == g[0]) g[1] = NO_GROUP;
+    if (g[2] == g[0] || g[2] == g[1]) g[2] = NO_GROUP;
 }
 
 mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *topology, size_t size, mk_error *err)
@@ -167,38 +159,48 @@ mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *
     uint32_t *group_of = (uint32_t *)(void *)(base + l.group_of);
     uint32_t *tri_first = (uint32_t *)(void *)(base + l.group_tri_first);
     uint32_t *group_tris = (uint32_t *)(void *)(base + l.group_tris);
-    uint32_t *tri_groups = (uint32_t *)(void *)(base + l.tri_groups);
-    /* The groups, with the rest-normal region as scratch; then a fill cursor there. */
+    /* The groups, with the rest-normal region as scratch; then a cursor there. */
     uint32_t *fill = (uint32_t *)(void *)(base + l.rest);
     uint32_t groups = mk_smoothing_groups(cp, cps, normals, n, group_of, fill);
-    /* Triangle -> its distinct corner groups (NO_GROUP for a repeated one), and the inverse:
-     * group -> its triangles in triangle order (CSR, counted first). */
+    /* Renumbered in the order of their first vertex, so that a job, which walks vertices in
+     * order, reads the groups' arrays nearly in order too (a private numbering: a group's sum
+     * is in triangle order whatever its number). */
+    for (uint32_t g = 0; g < groups; g++) fill[g] = NO_GROUP;
+    for (uint32_t v = 0, next = 0; v < n; v++) {
+        if (fill[group_of[v]] == NO_GROUP) fill[group_of[v]] = next++;
+        group_of[v] = fill[group_of[v]];
+    }
+    /* Group -> its triangles in triangle order (CSR, counted first). */
     memset(tri_first, 0, 4 * ((size_t)groups + 1));
     for (uint32_t t = 0; t < tri_count; t++) {
-        uint32_t g0 = group_of[triangles[3u * t]], g1 = group_of[triangles[3u * t + 1]], g2 = group_of[triangles[3u * t + 2]];
-        uint32_t *g = &tri_groups[3u * t];
-        g[0] = g0;
-        g[1] = g1 != g0 ? g1 : NO_GROUP;
-        g[2] = g2 != g0 && g2 != g1 ? g2 : NO_GROUP;
+        uint32_t g[3];
+        corner_groups(triangles, group_of, t, g);
         for (int c = 0; c < 3; c++)
             if (g[c] != NO_GROUP) tri_first[g[c] + 1]++;
     }
     for (uint32_t g = 0; g < groups; g++) tri_first[g + 1] += tri_first[g];
     memcpy(fill, tri_first, 4 * (size_t)groups);
-    for (uint32_t t = 0; t < tri_count; t++)
+    for (uint32_t t = 0; t < tri_count; t++) {
+        uint32_t g[3];
+        corner_groups(triangles, group_of, t, g);
         for (int c = 0; c < 3; c++)
-            if (tri_groups[3u * t + c] != NO_GROUP) group_tris[fill[tri_groups[3u * t + c]]++] = t;
+            if (g[c] != NO_GROUP) group_tris[fill[g[c]]++] = t;
+    }
     /* Rest normals N(P0) by the jobs' own sum (the scratch is no longer needed); (0,0,0) for a
      * group without area, whose vertices then take their own base normal as the rest normal. */
-    group_sum *rest = (group_sum *)(void *)(base + l.rest);
-    static const float none[3] = { 0, 0, 0 };
-    memset(rest, 0, sizeof(group_sum) * (size_t)groups);
-    add_face_normals(triangles, tri_groups, NULL, 0, tri_count, asset->data + m->positions, 12, NULL, rest);
-    for (uint32_t g = 0; g < groups; g++) normalize_sum(rest[g].normal, none, rest[g].normal);
+    float (*rest)[4] = (float (*)[4])(void *)(base + l.rest);
+    for (uint32_t g = 0; g < groups; g++) {
+        float sum[3];
+        sum_faces(&group_tris[tri_first[g]], tri_first[g + 1] - tri_first[g], NULL, triangles, asset->data + m->positions,
+                  12, sum);
+        float len = sqrtf(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]), inv = len > 0 ? 1.0f / len : 0;
+        for (int c = 0; c < 3; c++) rest[g][c] = sum[c] * inv;
+        rest[g][3] = 0;
+    }
     topology_header h = { .magic = TOPOLOGY_MAGIC, .mesh = mesh, .vertex_count = n, .triangle_count = tri_count,
                           .group_count = groups, .size = l.size, .checksum = asset->header->checksum,
                           .group_of = l.group_of, .group_tri_first = l.group_tri_first, .group_tris = l.group_tris,
-                          .tri_groups = l.tri_groups, .rest = l.rest };
+                          .rest = l.rest };
     memcpy(base, &h, sizeof h);
     return MK_OK;
 }
@@ -244,28 +246,59 @@ mk_result mk_surface_validate(const mk_surface_job *job, mk_error *err)
     return MK_OK;
 }
 
-/* A job's scratch: one mark byte per triangle (whether the job needs it), one per vertex
- * (whether it moved), then one
- * accumulator per possible group (the sum of its face normals at the evaluated positions and
- * whether a corner of its triangles moved). A job fills what it reads, so the scratch needs no
- * initialization and any job may use any scratch. */
+/* A job's scratch: one mark byte per triangle (whether a range job needs it), then the face
+ * normals of the triangles it needs. A job fills what it reads, so the
+ * scratch needs no initialization and any job may use any scratch. */
 
-static size_t marks_size(const mk_blob_mesh *m) { return align16(m->triangle_count) + align16(m->vertex_count); }
+static size_t marks_size(const mk_blob_mesh *m) { return align16(m->triangle_count); }
 
 size_t mk_surface_scratch_size(const mk_asset *asset, uint32_t mesh)
 {
     if (!mk_surface_topology_size(asset, mesh)) return 0;
     const mk_blob_mesh *m = &asset->meshes[mesh];
-    return marks_size(m) + sizeof(group_sum) * (size_t)m->vertex_count;
+    return marks_size(m) + 12 * (size_t)m->triangle_count;
 }
 
-/* Whether vertices [lo, hi) are not where they rest (-0 and +0 are the same place). */
-static void vertices_moved(uint8_t *moved, uint32_t lo, uint32_t hi, const uint8_t *p, size_t stride, const float *p0)
+/* Vertices are finished FINISH_BLOCK at a time in lanes (component-major): every operation is
+ * done in every lane and only the choices between computed values depend on the data, so the
+ * compiler can use vector instructions; the same IEEE operations per lane, so the same bytes
+ * as one vertex at a time. */
+#define FINISH_BLOCK 8
+typedef struct finish_block {
+    float sum[3][FINISH_BLOCK], base[3][FINISH_BLOCK], rest[3][FINISH_BLOCK], out[3][FINISH_BLOCK];
+    float changed[FINISH_BLOCK];
+} finish_block;
+
+/* Per lane, with sum the group's face normals at P, base B_n and rest N(P0) (zero for a group
+ * without area at rest): N(P) is the normalized sum (B_n where the sum is zero), and for a
+ * group without area at rest N(P0) is B_n. Where N(P) differs from N(P0) the normal is
+ * normalize(B_n + N(P) - N(P0)) (N(P) itself for a group without area at rest), B_n where that
+ * is shorter than 1e-8; where they are equal it is B_n and changed is 0. A divisor is offset by
+ * exactly 1 where its quotient is not used, so nothing divides by zero. */
+static void finish_normals(finish_block *k)
 {
-    for (uint32_t v = lo; v < hi; v++) {
-        const float *q = (const float *)(const void *)(p + stride * v);
-        const float *o = &p0[3u * v];
-        moved[v] = (uint8_t)((q[0] != o[0]) | (q[1] != o[1]) | (q[2] != o[2]));
+    for (int j = 0; j < FINISH_BLOCK; j++) {
+        float sx = k->sum[0][j], sy = k->sum[1][j], sz = k->sum[2][j];
+        float bx = k->base[0][j], by = k->base[1][j], bz = k->base[2][j];
+        float rx = k->rest[0][j], ry = k->rest[1][j], rz = k->rest[2][j];
+        float len = sqrtf(sx * sx + sy * sy + sz * sz);
+        float none = len == 0;
+        float inv = 1.0f / (len + none);
+        float ax = sx * inv, ay = sy * inv, az = sz * inv;
+        float nx = none != 0 ? bx : ax, ny = none != 0 ? by : ay, nz = none != 0 ? bz : az;
+        float flat = (rx == 0) & (ry == 0) & (rz == 0);
+        float wx = flat != 0 ? bx : rx, wy = flat != 0 ? by : ry, wz = flat != 0 ? bz : rz;
+        float changed = (nx != wx) | (ny != wy) | (nz != wz);
+        float ex = bx + (nx - rx), ey = by + (ny - ry), ez = bz + (nz - rz);
+        float dx = flat != 0 ? nx : ex, dy = flat != 0 ? ny : ey, dz = flat != 0 ? nz : ez;
+        float dlen = sqrtf(dx * dx + dy * dy + dz * dz);
+        float keep = (changed == 0) | (dlen <= 1e-8f);
+        float dinv = 1.0f / (dlen + keep);
+        float ox = dx * dinv, oy = dy * dinv, oz = dz * dinv;
+        k->out[0][j] = keep != 0 ? bx : ox;
+        k->out[1][j] = keep != 0 ? by : oy;
+        k->out[2][j] = keep != 0 ? bz : oz;
+        k->changed[j] = changed;
     }
 }
 
@@ -281,31 +314,25 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
     const uint32_t *group_of = (const uint32_t *)(const void *)(base + h.group_of);
     const uint32_t *tri_first = (const uint32_t *)(const void *)(base + h.group_tri_first);
     const uint32_t *group_tris = (const uint32_t *)(const void *)(base + h.group_tris);
-    const uint32_t *tri_groups = (const uint32_t *)(const void *)(base + h.tri_groups);
-    const group_sum *rest = (const group_sum *)(const void *)(base + h.rest);
+    const float (*rest)[4] = (const float (*)[4])(const void *)(base + h.rest);
     const uint32_t *triangles = (const uint32_t *)(const void *)(a->data + m->triangles);
-    const float *p0 = (const float *)(const void *)(a->data + m->positions);
     const float *normals = (const float *)(const void *)(a->data + m->normals);
     const float *tangents = m->tangents ? (const float *)(const void *)(a->data + m->tangents) : NULL;
     const uint8_t *p = (const uint8_t *)job->positions;
     const size_t ps = mk_stride_or(job->positions_stride, 12), ns = mk_stride_or(job->normals_stride, 12),
                  ts = mk_stride_or(job->tangents_stride, 16);
-    uint8_t *mark = job->scratch, *vmoved = mark + align16(m->triangle_count);
-    group_sum *sums = (group_sum *)(void *)((uint8_t *)job->scratch + marks_size(m));
+    uint8_t *mark = job->scratch;
+    float (*faces)[3] = (float (*)[3])(void *)((uint8_t *)job->scratch + marks_size(m));
     const uint32_t n = job->vertex_count == MK_VERTICES_TO_END ? m->vertex_count - job->first_vertex : job->vertex_count;
-    const uint32_t tri_count = m->triangle_count;
-    /* The triangles the range needs: those with a corner in a group of one of its vertices
-     * (all of them for the whole mesh), in [t_lo, t_hi). */
-    uint32_t t_lo = 0, t_hi = tri_count, v_lo = 0, v_hi = m->vertex_count;
-    const int whole = n == m->vertex_count;   /* every triangle: no marks needed */
-    if (whole) {
-        memset(sums, 0, sizeof(group_sum) * (size_t)h.group_count);
+    /* The face normals the range needs: those of the triangles of its vertices' groups (every
+     * triangle for the whole mesh, which needs no marks). */
+    if (n == m->vertex_count) {
+        for (uint32_t t = 0; t < m->triangle_count; t++) face_normal(&triangles[3u * t], p, ps, faces[t]);
     } else {
-        memset(mark, 0, tri_count);
-        t_lo = tri_count; t_hi = 0;
+        uint32_t t_lo = m->triangle_count, t_hi = 0;
+        memset(mark, 0, m->triangle_count);
         for (uint32_t i = 0; i < n; i++) {
             uint32_t g = group_of[job->first_vertex + i];
-            memset(&sums[g], 0, sizeof(group_sum));   /* a group without triangles stays unmoved */
             for (uint32_t k = tri_first[g]; k < tri_first[g + 1]; k++) {
                 uint32_t t = group_tris[k];
                 mark[t] = 1;
@@ -313,49 +340,40 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
                 if (t + 1 > t_hi) t_hi = t + 1;
             }
         }
-        v_lo = m->vertex_count; v_hi = 0;
         for (uint32_t t = t_lo; t < t_hi; t++)
-            if (mark[t])
-                for (int c = 0; c < 3; c++) {
-                    uint32_t v = triangles[3u * t + c];
-                    if (tri_groups[3u * t + c] != NO_GROUP) memset(&sums[tri_groups[3u * t + c]], 0, sizeof(group_sum));
-                    if (v < v_lo) v_lo = v;
-                    if (v + 1 > v_hi) v_hi = v + 1;
-                }
+            if (mark[t]) face_normal(&triangles[3u * t], p, ps, faces[t]);
     }
-    vertices_moved(vmoved, v_lo, v_hi, p, ps, p0);
-    add_face_normals(triangles, tri_groups, whole ? NULL : mark, t_lo, t_hi, p, ps, vmoved, sums);
-    for (uint32_t i = 0; i < n; i++) {
-        uint32_t v = job->first_vertex + i, g = group_of[v];
-        const float *b = &normals[3u * v];
-        /* Moved: a corner of one of the group's triangles is not where it rests. Unmoved groups
-         * keep their base normal. */
-        uint32_t moved = sums[g].moved;
-        float out[3] = { b[0], b[1], b[2] };
-        if (moved) {
-            float now[3], d[3];
-            normalize_sum(sums[g].normal, b, now);
-            const float *r0 = rest[g].normal;
-            int flat = r0[0] == 0 && r0[1] == 0 && r0[2] == 0;
-            for (int c = 0; c < 3; c++) d[c] = flat ? now[c] : b[c] + (now[c] - r0[c]);
-            float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-            if (len > 1e-8f) {
-                float inv = 1.0f / len;
-                for (int c = 0; c < 3; c++) out[c] = d[c] * inv;
+    for (uint32_t i0 = 0; i0 < n; i0 += FINISH_BLOCK) {
+        const uint32_t count = n - i0 < FINISH_BLOCK ? n - i0 : FINISH_BLOCK;
+        finish_block block;
+        for (uint32_t j = 0; j < FINISH_BLOCK; j++) {   /* lanes past the range repeat its first vertex */
+            uint32_t v = job->first_vertex + i0 + (j < count ? j : 0), g = group_of[v];
+            float sum[3];
+            sum_faces(&group_tris[tri_first[g]], tri_first[g + 1] - tri_first[g], (const float (*)[3])faces, NULL, NULL, 0,
+                      sum);
+            for (int c = 0; c < 3; c++) {
+                block.sum[c][j] = sum[c];
+                block.base[c][j] = normals[3u * v + (uint32_t)c];
+                block.rest[c][j] = rest[g][c];
             }
         }
-        memcpy((uint8_t *)job->normals + ns * i, out, sizeof out);
-        if (job->tangents) {
-            float t[4];
-            memcpy(t, &tangents[4u * v], sizeof t);
-            if (moved) {
-                float dot = t[0] * out[0] + t[1] * out[1] + t[2] * out[2];
-                float o[3] = { t[0] - out[0] * dot, t[1] - out[1] * dot, t[2] - out[2] * dot };
-                float len = sqrtf(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
-                if (len >= 1e-12f)
-                    for (int d = 0; d < 3; d++) t[d] = o[d] / len;
+        finish_normals(&block);
+        for (uint32_t j = 0; j < count; j++) {
+            const uint32_t i = i0 + j, v = job->first_vertex + i;
+            const float out[3] = { block.out[0][j], block.out[1][j], block.out[2][j] };
+            memcpy((uint8_t *)job->normals + ns * i, out, sizeof out);
+            if (job->tangents) {
+                float t[4];
+                memcpy(t, &tangents[4u * v], sizeof t);
+                if (block.changed[j] != 0) {
+                    float dot = t[0] * out[0] + t[1] * out[1] + t[2] * out[2];
+                    float o[3] = { t[0] - out[0] * dot, t[1] - out[1] * dot, t[2] - out[2] * dot };
+                    float len = sqrtf(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
+                    if (len >= 1e-12f)
+                        for (int d = 0; d < 3; d++) t[d] = o[d] / len;
+                }
+                memcpy((uint8_t *)job->tangents + ts * i, t, sizeof t);
             }
-            memcpy((uint8_t *)job->tangents + ts * i, t, sizeof t);
         }
     }
     return MK_OK;

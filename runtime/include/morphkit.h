@@ -258,11 +258,11 @@ uint64_t mk_eval_traffic(const mk_eval_job *job);
 /* ---- Surface normals ---- */
 
 /* Normals of the evaluated surface (docs/semantics.md, "Surface normals"): for every vertex
- * whose smoothing group has a triangle with a moved corner, n = normalize(B + N(P) - N(P0)),
- * N the normalized sum of the group's area-weighted face normals at the evaluated positions P
- * and at rest P0, B the stored base normal; every other vertex keeps B as stored. The exact
- * counterpart of nlerp/slerp where shapes combine, at the cost of one pass over the triangles
- * around moved vertices. Smoothing groups are the importer's: vertices with the same control
+ * whose N(P) differs from N(P0), n = normalize(B + N(P) - N(P0)), N the normalized sum of the
+ * vertex's smoothing group's area-weighted face normals at the evaluated positions P and at
+ * rest P0, B the stored base normal; every other vertex (among them all whose group's
+ * triangles did not move) keeps B as stored. The exact counterpart of nlerp/slerp where shapes
+ * combine, at the cost of one pass over the triangles and one over the vertices. Smoothing groups are the importer's: vertices with the same control
  * point and the same base normal (within 1e-5 per component), so UV seams stay smooth and hard
  * edges hard.
  *
@@ -301,7 +301,8 @@ typedef struct mk_surface_job {
     float *normals;               /* output (addresses first_vertex): 3 floats per vertex */
     size_t normals_stride, normals_size;
     float *tangents;              /* optional output: the base tangent re-orthogonalized against
-                                   * the new normal, w copied from the base; base where unmoved */
+                                   * the new normal, w copied from the base; base where the
+                                   * normal kept its base */
     size_t tangents_stride, tangents_size;
     void *scratch;                /* mk_surface_scratch_size() bytes, 16-byte aligned, one per
                                    * thread (no initialization needed) */
