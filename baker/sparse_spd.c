@@ -3,12 +3,16 @@
 #include "sparse_spd.h"
 #include "bake_util.h"
 
-void bake_spd_start(bake_spd *s, int simplicial)
+void bake_spd_start(bake_spd *s, int simplicial, int few_solves)
 {
     cholmod_start(&s->cm);
     s->started = 1;
     s->cm.print = 0;
     if (simplicial) s->cm.supernodal = CHOLMOD_SIMPLICIAL;
+    if (few_solves) {
+        s->cm.nmethods = 1;
+        s->cm.method[0].ordering = CHOLMOD_AMD;
+    }
 }
 
 mk_result bake_spd_factor(bake_spd *s, cholmod_triplet **T, uint32_t columns, mk_error *err)

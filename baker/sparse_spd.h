@@ -23,8 +23,10 @@ typedef struct bake_spd {
 } bake_spd;
 
 /* Starts CHOLMOD (quiet). simplicial: 1 forces a simplicial factor (stencils with little fill
- * solve faster that way), 0 leaves CHOLMOD's choice. */
-void bake_spd_start(bake_spd *s, int simplicial);
+ * solve faster that way), 0 leaves CHOLMOD's choice. few_solves: 1 orders with AMD only, for a
+ * system solved only a few times (CHOLMOD's default also tries METIS on large systems, whose
+ * analysis can cost more than the fill it saves), 0 leaves CHOLMOD's choice of ordering. */
+void bake_spd_start(bake_spd *s, int simplicial, int few_solves);
 /* Analyzes and factors the matrix of the triplets T (upper triangle, stype 1, duplicates summed;
  * T is freed here either way), then allocates the n x columns right-hand sides. Fails with a
  * clear message when the matrix is not positive definite or numerically singular

@@ -338,7 +338,7 @@ mk_result mk_surface_edit_create(const mk_raw_mesh *mesh, const mk_edit_params *
      * solved 2x faster than the supernodal one (bench_baker, 100k vertices: 0.015 vs 0.030 s
      * per 3-rhs solve) at the same factor time. L^T L (2-ring) fills in more and factors
      * faster supernodal (2.1 vs 3.8 s), so Laplacian editing keeps CHOLMOD's choice. */
-    bake_spd_start(&s->spd, s->params.method == MK_EDIT_ARAP);
+    bake_spd_start(&s->spd, s->params.method == MK_EDIT_ARAP, s->params.method != MK_EDIT_ARAP);
     if (s->unknown_count > 0) {
         cholmod_triplet *T = NULL;
         if ((r = assemble(s, &T, err)) != MK_OK) goto fail;

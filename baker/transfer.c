@@ -141,7 +141,7 @@ static mk_result build_system(mk_transfer *x, mk_error *err)
     mk_arena_release(&x->arena, parent);
 
     /* normal equations: sum over matched triangles and columns of a_c a_c^T (upper triangle) */
-    bake_spd_start(&x->spd, 0);
+    bake_spd_start(&x->spd, 0, 0);
     cholmod_triplet *T = cholmod_allocate_triplet(x->unknown_count, x->unknown_count, 30 * (size_t)x->used_count,
                                                   1, CHOLMOD_REAL, &x->spd.cm);
     if (!T) return mk_error_oom(err, "transfer system");

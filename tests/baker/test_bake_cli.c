@@ -81,6 +81,20 @@ static void transfer_sample_reads_its_source(void)
     mk_arena_free_all(&arena);
 }
 
+/* The solver bakes (Laplacian, ARAP: CHOLMOD on the BLAS) give the same bytes on every run. */
+static void solver_bakes_repeat_to_the_byte(void)
+{
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    mk_asset first, second;
+    if (bake_example("cli_tube4.morph", "laplacian.json", "cli_tube_laplacian1.morph", &arena, &first)
+        && bake_example("cli_tube4.morph", "laplacian.json", "cli_tube_laplacian2.morph", &arena, &second)) {
+        CHECK_EQ_INT(first.channel_count, 4);
+        CHECK(first.size == second.size && memcmp(first.data, second.data, first.size) == 0);
+    }
+    mk_arena_free_all(&arena);
+}
+
 static void bad_recipe_writes_nothing(void)
 {
     char in[1024], out[1024], recipe[1024];
@@ -104,6 +118,6 @@ int main(int argc, char **argv)
     if (argc < 5) { fprintf(stderr, "usage: test_bake_cli MORPHKIT MAKE_EXAMPLE RECIPES_DIR WORK_DIR\n"); return 2; }
     morphkit = argv[1]; make_example = argv[2]; recipes = argv[3]; work = argv[4];
     static const check_case cases[] = { CASE(bake_sample_and_open_it), CASE(transfer_sample_reads_its_source),
-                                        CASE(bad_recipe_writes_nothing) };
-    return check_run(cases, 3, 1, argv);
+                                        CASE(solver_bakes_repeat_to_the_byte), CASE(bad_recipe_writes_nothing) };
+    return check_run(cases, 4, 1, argv);
 }
