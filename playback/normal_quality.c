@@ -50,6 +50,14 @@ static double angle_deg(const float *a, const double *b)
     return atan2(s, d) * (180.0 / 3.14159265358979323846);
 }
 
+void pb_normal_angles(const float *a, const float *b, uint32_t count, float *degrees)
+{
+    for (uint32_t v = 0; v < count; v++) {
+        const double r[3] = { b[3 * v], b[3 * v + 1], b[3 * v + 2] };
+        degrees[v] = (float)angle_deg(&a[3 * v], r);
+    }
+}
+
 static int reserve(pb_normal_quality *q, size_t more)
 {
     if (q->count + more <= q->capacity) return 1;

@@ -48,6 +48,10 @@ mk_result pb_normal_quality_add(pb_normal_quality *q, const mk_asset *asset, con
 const char *pb_quality_name(int mode);
 const char *pb_quality_label(int mode);
 
+/* Per vertex, the angle in degrees between normal a[v] (any length) and the reference b[v]
+ * (unit length) — the angle the statistics are made of, for drawing it. */
+void pb_normal_angles(const float *a, const float *b, uint32_t count, float *degrees);
+
 /* Mean, 99th percentile and largest angle of one mode (zeros when nothing was measured). */
 pb_normal_stats pb_normal_quality_stats(const pb_normal_quality *q, int mode);
 

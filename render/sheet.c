@@ -280,7 +280,10 @@ static mk_result render(const mkr_sheet_desc *desc, int diff, mkr_image *out, mk
                 snprintf(where, sizeof where, " at m%lld v%lld", (long long)hot.mesh, (long long)hot.vertex);
             else if (hot.mesh >= 0)
                 snprintf(where, sizeof where, " at v%lld", (long long)hot.vertex);
-            if (diagonal > 0)
+            if (desc->scalar_caption)
+                snprintf(label + n, 112, "%smax %.3g%.8s%s", n ? "\n" : "", hot.value,
+                         desc->scalar_suffix ? desc->scalar_suffix : "", where);
+            else if (diagonal > 0)
                 snprintf(label + n, 112, "%smax %.3g (%.3g%%)%s", n ? "\n" : "", hot.value, 100.0 * hot.value / diagonal, where);
             else
                 snprintf(label + n, 112, "%smax %.3g%s", n ? "\n" : "", hot.value, where);
@@ -294,7 +297,10 @@ static mk_result render(const mkr_sheet_desc *desc, int diff, mkr_image *out, mk
     }
     if (r == MK_OK && diff) {
         char caption[160];
-        if (diagonal > 0)
+        const int distances = !desc->scalar_caption;
+        if (!distances)
+            snprintf(caption, sizeof caption, "%.150s", desc->scalar_caption);
+        else if (diagonal > 0)
             snprintf(caption, sizeof caption, "distance: mesh units, and %% of the bounding-box diagonal (%.4g)", diagonal);
         else
             snprintf(caption, sizeof caption, "distance: mesh units");
@@ -303,13 +309,15 @@ static mk_result render(const mkr_sheet_desc *desc, int diff, mkr_image *out, mk
         if (width > 640 * s) width = 640 * s;
         int caption_width;
         mkr_text_box(caption, s, &caption_width, NULL);
-        if (caption_width > width && diagonal > 0) /* a narrow sheet: the short form */
+        if (caption_width > width && diagonal > 0 && distances) /* a narrow sheet: the short form */
             snprintf(caption, sizeof caption, "distance (%% of diagonal %.4g)", diagonal);
         /* Labels like "0.000148%" are 9 characters: keep a tick per 80 font pixels. */
         int ticks = 1 + width / (80 * s);
         if (ticks > 5) ticks = 5;
         mkr_legend legend = { .lo = 0, .hi = scale_max, .ticks = ticks, .caption = caption, .text_scale = s,
-                              .second_scale = diagonal > 0 ? (float)(100.0 / diagonal) : 0, .second_suffix = "%" };
+                              .suffix = distances ? NULL : desc->scalar_suffix,
+                              .second_scale = diagonal > 0 && distances ? (float)(100.0 / diagonal) : 0,
+                              .second_suffix = "%" };
         mkr_legend_draw(out, pad, l.height - l.legend_height + pad, width, &legend, text_color);
     }
     if (r != MK_OK) mkr_image_destroy(out);

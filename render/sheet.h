@@ -9,7 +9,8 @@
  *
  * Cell labels: "t=0.50 s" (decimals added until distinct times read distinctly) when the
  * cell has a time; for diff sheets "max 0.0012 (0.07%)", the cell's largest scalar in mesh
- * units and as a percentage of the bounding-box diagonal; then the cell's own text lines. */
+ * units and as a percentage of the bounding-box diagonal (or "max 12.5°" with a scalar
+ * suffix); then the cell's own text lines. */
 #ifndef MKR_SHEET_H
 #define MKR_SHEET_H
 
@@ -37,6 +38,11 @@ typedef struct mkr_sheet_desc {
     const char *title;             /* title strip text ('\n'-separated lines), or NULL: no strip */
     int text_scale;                /* font scale; 0: 2 for cells at least 384 pixels wide, else 1 */
     float diff_max;                /* diff sheets: scalar drawn hottest; <= 0: largest in any cell */
+    const char *scalar_caption;    /* diff sheets whose scalars are not distances: the legend's
+                                    * caption (e.g. "angle to the surface normal, degrees"), with
+                                    * scalar_suffix after every value (e.g. "°") and no percent of
+                                    * the diagonal; NULL: distances in mesh units */
+    const char *scalar_suffix;
 } mkr_sheet_desc;
 
 /* Where things land on the sheet, in pixels. */

@@ -1,18 +1,20 @@
 /* SPDX-License-Identifier: MIT */
 /* morphkit render: a contact sheet of an asset's frames (docs/rendering.md), shaded with the
- * evaluated normals, or with --diff colored by the distance to another asset's frames. */
+ * evaluated normals, or with --diff colored by the distance to another asset's frames, or with
+ * --normal-error by the angle between the evaluated normals and the surface's. */
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include "asset.h"
 #include "frame_plan.h"
+#include "normal_quality.h"
 #include "pictures.h"
 
 typedef struct render_args {
     const char *input, *output, *clip, *times, *weights, *size, *diff;
     uint64_t frames, columns;
-    int view, stacking, stacking_given, normals, show_weights, scale_given;
+    int view, stacking, stacking_given, normals, show_weights, scale_given, normal_error;
     double scale_max;
 } render_args;
 
@@ -43,8 +45,14 @@ static const cli_option options[] = {
       "Color each cell by the distance from every vertex to the same vertex of B played at the same frame (B: a .morph "
       "blob or any file 'morphkit import' reads, with the same meshes and vertex counts).",
       NULL, NULL, 0, 0, 0, 0 },
+    { "--normal-error", NULL, CLI_FLAG, offsetof(render_args, normal_error),
+      "Color each vertex by the angle in degrees between its evaluated normal (--normals) and the normal of the "
+      "evaluated surface (docs/semantics.md, \"Normal quality\"), on one scale for all cells: where a normal mode "
+      "shades combined shapes wrongly.",
+      NULL, NULL, 0, 0, 0, 0 },
     { "--scale-max", "D", CLI_NUMBER, offsetof(render_args, scale_max),
-      "With --diff: the distance drawn hottest, in mesh units. Default: the largest distance in any cell.", NULL, NULL,
+      "With --diff: the distance drawn hottest, in mesh units; with --normal-error: the angle, in degrees. Default: "
+      "the largest in any cell.", NULL, NULL,
       1e-30, 1e30, 0, offsetof(render_args, scale_given) },
     { "--stacking", "MODE", CLI_CHOICE, offsetof(render_args, stacking),
       "Channel stacking. Default: each mesh's stored stacking.", NULL, "additive|sequential", 0, 0, 0,
@@ -62,7 +70,8 @@ const cli_verb cli_verb_render = {
                    "one orthographic camera framed on all frames (motion shows as change between cells), shaded with "
                    "the evaluated normals (a wrong normal shows as a wrong shade) and labelled with its time. With "
                    "--diff, each vertex is colored by its distance to B's same vertex instead, on one scale for all "
-                   "cells, with a legend in mesh units and in percent of the bounding-box diagonal.",
+                   "cells, with a legend in mesh units and in percent of the bounding-box diagonal. With "
+                   "--normal-error, by the angle between its normal and the evaluated surface's, in degrees.",
     .positional = "FILE",
     .positional_help = "A .morph blob, or any file 'morphkit import' reads.",
     .positional_offset = offsetof(render_args, input),
@@ -126,7 +135,9 @@ static int run_render(void *p)
     if (status >= 0) return status;
     int cell_width, cell_height;
     if ((status = cli_parse_size(verb, "--size", args->size, &cell_width, &cell_height)) >= 0) return status;
-    if (args->scale_given && !args->diff) return cli_usage_error(verb, "--scale-max needs --diff");
+    if (args->diff && args->normal_error) return cli_usage_error(verb, "--diff and --normal-error color by different things: pick one");
+    if (args->scale_given && !args->diff && !args->normal_error)
+        return cli_usage_error(verb, "--scale-max needs --diff or --normal-error");
 
     pb_asset la, lb;
     memset(&lb, 0, sizeof lb);
@@ -149,6 +160,9 @@ static int run_render(void *p)
         goto done;
     }
     const mk_asset *a = &la.asset, *b = args->diff ? &lb.asset : NULL;
+    /* Colored cells: by the distance to B's frames, or by the angle to the surface's normals
+     * (the same frames played again with surface normals). */
+    const int colored = b || args->normal_error;
     status = cli_frame_plan_make(verb, a, args->input, args->clip, args->times, args->weights, (uint32_t)args->frames, &plan);
     if (status >= 0) goto done;
     if (b && (status = check_same_meshes(verb, args, a, b)) >= 0) goto done;
@@ -165,37 +179,43 @@ static int run_render(void *p)
     n = plan.count;
     const uint32_t meshes = a->mesh_count;
     frames = calloc(n, sizeof *frames);
-    frames_b = b ? calloc(n, sizeof *frames_b) : NULL;
+    frames_b = colored ? calloc(n, sizeof *frames_b) : NULL;
     cells = calloc(n, sizeof *cells);
     views = calloc((size_t)n * meshes + 1, sizeof *views);
-    scalars = b ? calloc((size_t)n * meshes + 1, sizeof *scalars) : NULL;
+    scalars = colored ? calloc((size_t)n * meshes + 1, sizeof *scalars) : NULL;
     texts = calloc(n, sizeof *texts);
     status = CLI_EXIT_FAILURE;
-    if (!frames || (b && (!frames_b || !scalars)) || !cells || !views || !texts) {
+    if (!frames || (colored && (!frames_b || !scalars)) || !cells || !views || !texts) {
         fprintf(stderr, "morphkit render: out of memory for %u frames\n", n);
         goto done;
     }
     mk_stacking stacking = !args->stacking_given ? MK_STACKING_ASSET : args->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
     mk_normal_mode normals = args->normals == 1 ? MK_NORMALS_SLERP : MK_NORMALS_NLERP;
     int surface = args->normals == 2;
+    float largest = 0;   /* the largest scalar of any cell */
     for (uint32_t i = 0; i < n; i++) {
         frames[i] = (pb_frame){ .asset = a, .stacking = stacking, .normal_mode = normals, .surface_normals = surface,
                                 .world = 1, .skip_tangents = 1 };
         int played = cli_frame_play(verb, args->input, &plan, i, &frames[i]);
         if (played >= 0) { status = played; goto done; }
-        if (b) {
-            frames_b[i] = (pb_frame){ .asset = b, .stacking = stacking, .normal_mode = normals,
-                                      .surface_normals = surface, .world = 1, .skip_tangents = 1 };
-            played = cli_frame_play(verb, args->diff, &plan_b, i, &frames_b[i]);
+        if (colored) {
+            frames_b[i] = (pb_frame){ .asset = b ? b : a, .stacking = stacking, .normal_mode = normals,
+                                      .surface_normals = b ? surface : 1, .world = 1, .skip_tangents = 1 };
+            played = cli_frame_play(verb, b ? args->diff : args->input, b ? &plan_b : &plan, i, &frames_b[i]);
             if (played >= 0) { status = played; goto done; }
         }
         for (uint32_t k = 0; k < meshes; k++) {
             mkr_mesh_view *v = &views[(size_t)i * meshes + k];
             *v = cli_mesh_view(&frames[i], k);
-            if (!b) continue;
-            float *s = scalars[(size_t)i * meshes + k] = malloc(4 * (size_t)v->vertex_count + 4);
+            if (!colored) continue;
+            float *s = scalars[(size_t)i * meshes + k] = calloc((size_t)v->vertex_count + 1, 4);
             if (!s) { fprintf(stderr, "morphkit render: out of memory\n"); goto done; }
-            cli_distances(frames[i].positions[k], frames_b[i].positions[k], v->vertex_count, s);
+            if (b)
+                cli_distances(frames[i].positions[k], frames_b[i].positions[k], v->vertex_count, s);
+            else if (frames[i].normals[k] && frames_b[i].normals[k])   /* a mesh without normals: 0 */
+                pb_normal_angles(frames[i].normals[k], frames_b[i].normals[k], v->vertex_count, s);
+            for (uint32_t j = 0; j < v->vertex_count; j++)
+                if (s[j] > largest) largest = s[j];
             v->scalars = s;
         }
         if (args->show_weights && !(texts[i] = weights_text(a, frames[i].weights))) {
@@ -212,25 +232,37 @@ static int run_render(void *p)
         mk_clip_info ci;
         mk_clip_get(a, (uint32_t)plan.clip, &ci);
         snprintf(title, sizeof title, "%.200s%s%.200s  clip '%.100s'  %s view", args->input, b ? " vs " : "",
-                 b ? args->diff : "", ci.name, views_names[args->view]);
+                 b ? args->diff : args->normal_error ? "  normal error" : "", ci.name, views_names[args->view]);
     } else {
-        snprintf(title, sizeof title, "%.200s%s%.200s  %s  %s view", args->input, b ? " vs " : "", b ? args->diff : "",
+        snprintf(title, sizeof title, "%.200s%s%.200s  %s  %s view", args->input, b ? " vs " : "",
+                 b ? args->diff : args->normal_error ? "  normal error" : "",
                  plan.frames[0].weights ? "forced weights" : "default weights", views_names[args->view]);
     }
     mkr_sheet_desc desc = { .cells = cells, .cell_count = n, .cell_width = cell_width, .cell_height = cell_height,
                             .columns = (int)args->columns, .view = (mkr_view)args->view, .title = title,
                             .diff_max = args->scale_given ? (float)args->scale_max : 0 };
-    r = b ? mkr_diff_sheet_render(&desc, &img, &err) : mkr_sheet_render(&desc, &img, &err);
+    static const char *const mode_names[] = { "nlerp", "slerp", "surface" };
+    char caption[96];
+    if (args->normal_error) {
+        snprintf(caption, sizeof caption, "angle between the %s normals and the surface's: degrees", mode_names[args->normals]);
+        desc.scalar_caption = caption;
+        desc.scalar_suffix = " deg";
+    }
+    r = colored ? mkr_diff_sheet_render(&desc, &img, &err) : mkr_sheet_render(&desc, &img, &err);
     if (r != MK_OK) {
         status = cli_fail(verb->name, &err);
         goto done;
     }
     if ((status = cli_png_encode(verb, &img, &png, &out)) >= 0) goto done;
     status = cli_write_outputs(verb, &out, 1);
-    if (status == 0)
-        fprintf(out.to_stdout ? stderr : stdout, "%s -> %s: %u cell%s of %dx%d, %s view, %dx%d pixels, %zu bytes\n",
-                args->input, out.to_stdout ? "standard output" : args->output, n, n == 1 ? "" : "s", cell_width,
-                cell_height, views_names[args->view], img.width, img.height, png.size);
+    if (status == 0) {
+        FILE *to = out.to_stdout ? stderr : stdout;
+        fprintf(to, "%s -> %s: %u cell%s of %dx%d, %s view, %dx%d pixels, %zu bytes", args->input,
+                out.to_stdout ? "standard output" : args->output, n, n == 1 ? "" : "s", cell_width, cell_height,
+                views_names[args->view], img.width, img.height, png.size);
+        if (args->normal_error) fprintf(to, ", largest normal error %.4g degrees", (double)largest);
+        fprintf(to, "\n");
+    }
 done:
     for (uint32_t i = 0; i < n; i++) {
         if (frames) cli_frame_clear(&frames[i]);

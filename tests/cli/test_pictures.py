@@ -115,6 +115,24 @@ top = next(y for y in range(h3) if px3[y][1] == (18, 19, 22) and y > 40)
 hot_cells = [sum(1 for y in range(top) for x in range(x0, x0 + 200) if hot(px3[y][x])) for x0 in (2, 204)]
 check("only the cell that plays the moved target is hot", hot_cells[0] == 0 and hot_cells[1] > 10, hot_cells)
 
+# --normal-error: the angle to the surface's normals. The clip combines bend and bulge, where
+# nlerp leaves the surface by degrees; surface normals are the reference, so they have none. The
+# hot cells are the ones the summary's largest angle comes from.
+errors = {}
+for mode in ("nlerp", "surface"):
+    rc, out, err = run("render", path("ex.morph"), "--normal-error", "--normals", mode, "--frames", "6", "--columns", "6",
+                       "--size", "120x120", "-o", path("normals_%s.png" % mode))
+    m = re.search(r"largest normal error ([0-9.e+-]+) degrees", out)
+    check("render --normal-error --normals %s" % mode, rc == 0 and m is not None, (rc, out, err))
+    errors[mode] = float(m.group(1)) if m else -1
+check("nlerp is degrees off the surface where the shapes combine, surface normals are not",
+      errors["nlerp"] > 5 and 0 <= errors["surface"] < 1e-3, errors)
+if errors["nlerp"] > 0:
+    w4, h4, px4 = read_png(path("normals_nlerp.png"))
+    top4 = next(y for y in range(h4) if px4[y][1] == (18, 19, 22) and y > 40)
+    hot4 = [sum(1 for y in range(top4) for x in range(x0, x0 + 120) if hot(px4[y][x])) for x0 in range(2, 6 * 122, 122)]
+    check("the rest pose is cold and a combined pose is hot", hot4[0] == 0 and max(hot4) > 10, hot4)
+
 # Bad values: a clear message, exit 2 (usage) or 1 (failure), and no picture.
 for args, code, words in [
     (["--size", "0x0"], 2, "a cell must be 32 to 4096 pixels a side"),
@@ -123,7 +141,8 @@ for args, code, words in [
     (["--times", "0,nan"], 2, '"nan" is not a number of seconds'),
     (["--frames", "4000"], 1, "need more than 16384 pixels a side"),
     (["--diff", path("missing.morph")], 1, "missing.morph"),
-    (["--scale-max", "1"], 2, "--scale-max needs --diff"),
+    (["--scale-max", "1"], 2, "--scale-max needs --diff or --normal-error"),
+    (["--diff", path("ex.morph"), "--normal-error"], 2, "pick one"),
 ]:
     rc, out, err = run("render", path("ex.morph"), "-o", path("bad.png"), *args)
     check("render %s refused" % " ".join(args), rc == code and words in err and not os.path.exists(path("bad.png")),
