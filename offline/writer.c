@@ -43,17 +43,6 @@ static int bytes_reserve(bytes *b, size_t extra)
     return 1;
 }
 
-/* Appends n bytes (zeros if src is NULL) at a 16-aligned position; returns that position. */
-static size_t bytes_put(bytes *b, const void *src, size_t n)
-{
-    size_t at = pad16(b->size);
-    if (!bytes_reserve(b, at - b->size + n)) return 0;
-    memset(b->data + b->size, 0, at - b->size);
-    if (src && n) memcpy(b->data + at, src, n); else if (n) memset(b->data + at, 0, n);
-    b->size = at + n;
-    return at;
-}
-
 /* String table: offset of each string, appended in first-use order (deterministic). */
 static uint32_t put_string(bytes *strings, const char *s)
 {
@@ -267,85 +256,112 @@ static void layout_write(void *user, uint32_t item, uint32_t worker)
 typedef struct mesh_out {
     uint64_t positions, normals, tangents, triangles, control_points, block_entries, entries, target_data;
     uint64_t entry_count, target_data_size;
+    uint32_t target_count, blocks;
+    layout_loop l;                     /* the targets' layout, counted by plan_mesh_data */
 } mesh_out;
 
-/* Appends one mesh's arrays to data; offsets are relative to the data section. */
-static mk_result write_mesh_data(const mk_raw_asset *raw, uint32_t mi, uint32_t first_channel, uint32_t channel_count,
-                                 const target_plan *plans, uint32_t dense_threshold, uint32_t threads, bytes *data,
-                                 mesh_out *out, mk_write_report *report, mk_error *err)
+/* Offset of the next n bytes of the data section (16-aligned); advances the cursor. */
+static uint64_t place(uint64_t *cursor, uint64_t n)
+{
+    uint64_t at = (*cursor + 15u) & ~(uint64_t)15u;
+    *cursor = at + n;
+    return at;
+}
+
+/* Places one mesh's arrays in the data section (offsets relative to it, from *cursor on) and
+ * counts its targets' blocks and bytes; nothing is written yet.
+ *
+ * Delta data is laid out target-major (all blocks of target 0, then target 1, ...) while
+ * the entries stay block-major: a frame then reads each active target as one sequential
+ * stream, which the hardware prefetcher and the TLB handle well, and never touches the
+ * pages of inactive targets. Targets are independent: their sizes are counted here, their
+ * data written straight into the blob by write_mesh_data, both on worker threads (no
+ * allocation there); the entries are merged block by block afterwards. */
+static mk_result plan_mesh_data(const mk_raw_asset *raw, uint32_t mi, uint32_t first_channel, uint32_t channel_count,
+                                const target_plan *plans, uint32_t dense_threshold, uint32_t threads, mk_arena *arena,
+                                uint64_t *cursor, mesh_out *out, mk_error *err)
 {
     const mk_raw_mesh *m = &raw->meshes[mi];
-    mk_arena *arena = data->arena;
     memset(out, 0, sizeof *out);
-    out->positions = bytes_put(data, m->positions, 12u * (size_t)m->vertex_count);
-    if (m->normals) out->normals = bytes_put(data, m->normals, 12u * (size_t)m->vertex_count);
-    if (m->tangents) out->tangents = bytes_put(data, m->tangents, 16u * (size_t)m->vertex_count);
-    out->triangles = bytes_put(data, m->triangles, 12u * (size_t)m->triangle_count);
-    out->control_points = bytes_put(data, NULL, 4u * (size_t)m->vertex_count);
-    if (data->failed) return mk_error_oom(err, "writing mesh arrays");
-    uint32_t *cp = (uint32_t *)(void *)(data->data + out->control_points);
-    for (uint32_t v = 0; v < m->vertex_count; v++) cp[v] = m->control_points ? m->control_points[v] : v;
+    out->positions = place(cursor, 12u * (uint64_t)m->vertex_count);
+    if (m->normals) out->normals = place(cursor, 12u * (uint64_t)m->vertex_count);
+    if (m->tangents) out->tangents = place(cursor, 16u * (uint64_t)m->vertex_count);
+    out->triangles = place(cursor, 12u * (uint64_t)m->triangle_count);
+    out->control_points = place(cursor, 4u * (uint64_t)m->vertex_count);
 
-    /* Delta data is laid out target-major (all blocks of target 0, then target 1, ...) while
-     * the entries stay block-major: a frame then reads each active target as one sequential
-     * stream, which the hardware prefetcher and the TLB handle well, and never touches the
-     * pages of inactive targets. Targets are independent: their sizes are counted, then their
-     * data written straight into the final buffer, both on worker threads (no allocation
-     * there); the entries are merged block by block afterwards. */
     uint32_t target_count = 0;
     for (uint32_t c = first_channel; c < first_channel + channel_count; c++) target_count += raw->channels[c].target_count;
-    uint32_t blocks = (m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
-    layout_loop l = { m, plans, dense_threshold, NULL, NULL, NULL, NULL, NULL };
-    l.targets = mk_arena_array(arena, target_count + 1, sizeof *l.targets);
-    uint32_t *block_first = mk_arena_array(arena, (size_t)blocks + 1, sizeof *block_first);
-    if (!l.targets || !block_first) return mk_error_oom(err, "planning blocks");
+    layout_loop *l = &out->l;
+    *l = (layout_loop){ m, plans, dense_threshold, NULL, NULL, NULL, NULL, NULL };
+    l->targets = mk_arena_array(arena, target_count + 1, sizeof *l->targets);
+    if (!l->targets) return mk_error_oom(err, "planning blocks");
     uint32_t k = 0;
     for (uint32_t c = first_channel; c < first_channel + channel_count; c++)
-        for (uint32_t j = 0; j < raw->channels[c].target_count; j++) l.targets[k++].t = &raw->channels[c].targets[j];
-    mk_parallel_for(target_count, threads, layout_count, &l);
+        for (uint32_t j = 0; j < raw->channels[c].target_count; j++) l->targets[k++].t = &raw->channels[c].targets[j];
+    mk_parallel_for(target_count, threads, layout_count, l);
     uint64_t entry_count = 0, total = 0;
     for (uint32_t t = 0; t < target_count; t++) {
-        l.targets[t].first_entry = entry_count;
-        l.targets[t].base = total;
-        entry_count += l.targets[t].entry_count;
-        total += pad16(l.targets[t].data_size);
+        l->targets[t].first_entry = entry_count;
+        l->targets[t].base = total;
+        entry_count += l->targets[t].entry_count;
+        total += pad16(l->targets[t].data_size);
     }
     if (entry_count > UINT32_MAX)
         return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: more than 2^32 block entries", mi);
     if (total / MK_ALIGN > UINT32_MAX)
         return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: target data exceeds 64 GiB", mi);
-    /* Per target entry (target-major): its block, mask and data offset. */
-    l.entry_block = mk_arena_array(arena, entry_count + 1, sizeof *l.entry_block);
-    l.entry_mask = mk_arena_array(arena, entry_count + 1, sizeof *l.entry_mask);
-    l.entry_data = mk_arena_array(arena, entry_count + 1, sizeof *l.entry_data);
-    if (!l.entry_block || !l.entry_mask || !l.entry_data) return mk_error_oom(err, "planning blocks");
-    out->block_entries = bytes_put(data, NULL, 4u * ((size_t)blocks + 1));
-    out->entries = bytes_put(data, NULL, (size_t)entry_count * sizeof(mk_blob_entry));
+    out->target_count = target_count;
+    out->blocks = (m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
+    out->block_entries = place(cursor, 4u * ((uint64_t)out->blocks + 1));
+    out->entries = place(cursor, entry_count * sizeof(mk_blob_entry));
     out->entry_count = entry_count;
-    out->target_data = bytes_put(data, NULL, (size_t)total);
+    out->target_data = place(cursor, total);
     out->target_data_size = total;
-    if (data->failed) return mk_error_oom(err, "writing block data");
-    l.data = data->data + out->target_data;
-    mk_parallel_for(target_count, threads, layout_write, &l);
+    return MK_OK;
+}
+
+/* Writes one mesh's arrays, target data and entries into the data section `data` (zeroed:
+ * the padding is left as it is) at the offsets plan_mesh_data chose. */
+static mk_result write_mesh_data(const mk_raw_mesh *m, uint32_t threads, mk_arena *arena, uint8_t *data,
+                                 mesh_out *out, mk_write_report *report, mk_error *err)
+{
+    memcpy(data + out->positions, m->positions, 12u * (size_t)m->vertex_count);
+    if (m->normals) memcpy(data + out->normals, m->normals, 12u * (size_t)m->vertex_count);
+    if (m->tangents) memcpy(data + out->tangents, m->tangents, 16u * (size_t)m->vertex_count);
+    if (m->triangle_count) memcpy(data + out->triangles, m->triangles, 12u * (size_t)m->triangle_count);
+    uint32_t *cp = (uint32_t *)(void *)(data + out->control_points);
+    for (uint32_t v = 0; v < m->vertex_count; v++) cp[v] = m->control_points ? m->control_points[v] : v;
+
+    layout_loop *l = &out->l;
+    const uint32_t target_count = out->target_count, blocks = out->blocks;
+    const uint64_t entry_count = out->entry_count;
+    /* Per target entry (target-major): its block, mask and data offset. */
+    uint32_t *block_first = (uint32_t *)(void *)(data + out->block_entries);
+    l->entry_block = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_block);
+    l->entry_mask = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_mask);
+    l->entry_data = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_data);
+    if (!l->entry_block || !l->entry_mask || !l->entry_data) return mk_error_oom(err, "planning blocks");
+    l->data = data + out->target_data;
+    mk_parallel_for(target_count, threads, layout_write, l);
     /* Entries block-major, targets in blob order within a block. */
-    mk_blob_entry *entries = (mk_blob_entry *)(void *)(data->data + out->entries);
+    mk_blob_entry *entries = (mk_blob_entry *)(void *)(data + out->entries);
     uint64_t e = 0;
-    for (uint32_t t = 0; t < target_count; t++) l.targets[t].cursor = l.targets[t].first_entry;
+    for (uint32_t t = 0; t < target_count; t++) l->targets[t].cursor = l->targets[t].first_entry;
     for (uint32_t b = 0; b < blocks; b++) {
         block_first[b] = (uint32_t)e;
         for (uint32_t t = 0; t < target_count; t++) {
-            target_layout *tl = &l.targets[t];
-            if (tl->cursor == tl->first_entry + tl->entry_count || l.entry_block[tl->cursor] != b) continue;
-            mk_blob_entry be = { t, (uint32_t)(l.entry_data[tl->cursor] / MK_ALIGN), l.entry_mask[tl->cursor] };
+            target_layout *tl = &l->targets[t];
+            if (tl->cursor == tl->first_entry + tl->entry_count || l->entry_block[tl->cursor] != b) continue;
+            mk_blob_entry be = { t, (uint32_t)(l->entry_data[tl->cursor] / MK_ALIGN), l->entry_mask[tl->cursor] };
             entries[e++] = be;
             tl->cursor++;
         }
     }
     block_first[blocks] = (uint32_t)e;
-    memcpy(data->data + out->block_entries, block_first, 4u * ((size_t)blocks + 1));
-    report->target_bytes += entry_count * sizeof(mk_blob_entry) + total;
-    void *scratch[] = { l.targets, block_first, l.entry_block, l.entry_mask, l.entry_data };
+    report->target_bytes += entry_count * sizeof(mk_blob_entry) + out->target_data_size;
+    void *scratch[] = { l->targets, l->entry_block, l->entry_mask, l->entry_data };
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
+    l->targets = NULL;
     return MK_OK;
 }
 
@@ -370,7 +386,8 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
         for (uint32_t t = 0; t < raw->clips[c].track_count; t++) key_count += raw->clips[c].tracks[t].key_count;
     }
 
-    bytes strings = { arena, NULL, 0, 0, 0 }, data = { arena, NULL, 0, 0, 0 };
+    bytes strings = { arena, NULL, 0, 0, 0 };
+    uint64_t data_size = 0;   /* the data section, placed mesh by mesh before anything is written */
     mk_blob_mesh *meshes = mk_arena_array(arena, raw->mesh_count + 1, sizeof *meshes);
     mk_blob_channel *channels = mk_arena_array(arena, raw->channel_count + 1, sizeof *channels);
     mk_blob_target *targets = mk_arena_array(arena, target_count + 1, sizeof *targets);
@@ -441,8 +458,8 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
         }
         bm->target_count = t_index - bm->first_target;
         mk_phase_log_mark(opt.phases, "quantize");
-        r = write_mesh_data(raw, mi, bm->first_channel, bm->channel_count, &plans[bm->first_target],
-                            opt.dense_threshold, opt.threads, &data, &mesh_data[mi], &report, err);
+        r = plan_mesh_data(raw, mi, bm->first_channel, bm->channel_count, &plans[bm->first_target],
+                           opt.dense_threshold, opt.threads, arena, &data_size, &mesh_data[mi], err);
         mk_phase_log_mark(opt.phases, "lay out blocks");
         if (r) return r;
         bm->vertex_count = m->vertex_count;
@@ -473,7 +490,7 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
             }
         }
     }
-    if (strings.failed || data.failed) return mk_error_oom(err, "writing strings");
+    if (strings.failed) return mk_error_oom(err, "writing strings");
     if (strings.size > UINT32_MAX)
         return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "write: names exceed 4 GiB");
 
@@ -486,7 +503,7 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
         { MK_SECTION_CLIPS, sizeof(mk_blob_clip), raw->clip_count, clips },
         { MK_SECTION_TRACKS, sizeof(mk_blob_track), track_count, tracks },
         { MK_SECTION_KEYS, sizeof(mk_key), key_count, keys },
-        { MK_SECTION_DATA, 1, data.size, data.data },
+        { MK_SECTION_DATA, 1, data_size, NULL },  /* written in place below */
     };
     const uint32_t section_count = MK_SECTION_KIND_COUNT - 1;
     mk_blob_section table[MK_SECTION_KIND_COUNT - 1];
@@ -517,8 +534,15 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
         bm->target_data_size = o->target_data_size;
     }
     if (total > SIZE_MAX) return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "write: blob exceeds the address space");
+    /* One zeroed allocation for the whole blob: the meshes' data is written straight into it
+     * (no growing buffer copied at the end) and every padding byte stays zero. */
     uint8_t *blob = mk_arena_alloc(arena, (size_t)total);
     if (!blob) return mk_error_oom(err, "allocating the blob");
+    for (uint32_t mi = 0; mi < raw->mesh_count; mi++) {
+        r = write_mesh_data(&raw->meshes[mi], opt.threads, arena, blob + data_base, &mesh_data[mi], &report, err);
+        if (r) return r;
+    }
+    mk_phase_log_mark(opt.phases, "lay out blocks");
     mk_blob_header header;
     memset(&header, 0, sizeof header);
     memcpy(header.magic, MK_MAGIC, 8);
@@ -528,13 +552,12 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
     header.section_count = section_count;
     memcpy(blob + sizeof header, table, sizeof table);
     for (uint32_t i = 0; i < section_count; i++)
-        if (table[i].size) memcpy(blob + table[i].offset, parts[i].src, (size_t)table[i].size);
+        if (table[i].size && parts[i].src) memcpy(blob + table[i].offset, parts[i].src, (size_t)table[i].size);
     memcpy(blob, &header, sizeof header);
     header.checksum = mk_checksum(blob + 32, total - 32);
     memcpy(blob, &header, sizeof header);
 
     mk_arena_release(arena, strings.data);
-    mk_arena_release(arena, data.data);
     mk_arena_release(arena, meshes);
     mk_arena_release(arena, channels);
     mk_arena_release(arena, targets);
