@@ -151,5 +151,7 @@ uint32_t fbx_prop_payload(fbx_props props);
 
 /* ---- Interpretation (fbx_scene.c etc.) ---- */
 mk_result fbx_convert(fbx_doc *doc, const mk_import_options *options, mk_raw_asset *out);
+/* fbx_normals.c: target normals for the meshes from first_mesh on (after the parse data is released). */
+mk_result fbx_target_normals(mk_raw_asset *raw, uint32_t first_mesh, const mk_import_options *options, mk_error *err);
 
 #endif
