@@ -35,6 +35,8 @@ typedef struct work {
     int32_t *tri_slot;         /* per triangle: index in tris[], or -1 */
     uint8_t *vert_mark;        /* per vertex: joined the index set */
     uint32_t *groups, *tris, *extra;   /* affected groups, triangles; added vertices */
+    double *deformed;          /* per affected triangle: its deformed face normal */
+    float *group_new;          /* per affected group: its new unit normal */
 } work;
 
 static void face_normal(const float *p0, const float *p1, const float *p2, double out[3])
@@ -117,9 +119,8 @@ static mk_result compute_target(mk_arena *arena, const mk_raw_mesh *m, const top
             }
         }
     }
-    double *deformed = mk_arena_array(arena, (size_t)tri_count * 3 + 3, sizeof(double));
-    float *group_new = mk_arena_array(arena, (size_t)group_count * 3 + 3, sizeof(float));
-    if (!deformed || !group_new) return mk_error_oom(err, "computing target normals");
+    double *deformed = w->deformed;
+    float *group_new = w->group_new;
     for (uint32_t k = 0; k < tri_count; k++) {
         const uint32_t *c = &m->triangles[3u * w->tris[k]];
         float p[3][3];
@@ -176,8 +177,6 @@ static mk_result compute_target(mk_arena *arena, const mk_raw_mesh *m, const top
     for (uint32_t k = 0; k < tri_count; k++) w->tri_slot[w->tris[k]] = -1;
     for (uint32_t k = 0; k < group_count; k++) w->group_slot[w->groups[k]] = -1;
     for (uint32_t k = 0; k < extra; k++) w->vert_mark[w->extra[k]] = 0;
-    mk_arena_release(arena, deformed);
-    mk_arena_release(arena, group_new);
     /* The old arrays are replaced (they may belong to the importer: left to the arena). */
     t->indices = indices;
     t->positions = positions;
@@ -196,7 +195,12 @@ static mk_result alloc_work(mk_arena *arena, const mk_raw_mesh *m, const topolog
     w->groups = mk_arena_array(arena, topo->g.group_count + 1u, sizeof(uint32_t));
     w->tri_slot = mk_arena_array(arena, (size_t)m->triangle_count + 1, sizeof(int32_t));
     w->tris = mk_arena_array(arena, (size_t)m->triangle_count + 1, sizeof(uint32_t));
-    if (!w->moved || !w->vert_mark || !w->extra || !w->group_slot || !w->groups || !w->tri_slot || !w->tris)
+    /* Sized for a target that moves everything; only what the largest target uses is ever
+     * touched (allocating them per target cost a fresh zeroed page for every page, every time). */
+    w->deformed = mk_arena_array(arena, (size_t)m->triangle_count * 3 + 3, sizeof(double));
+    w->group_new = mk_arena_array(arena, (size_t)topo->g.group_count * 3 + 3, sizeof(float));
+    if (!w->moved || !w->vert_mark || !w->extra || !w->group_slot || !w->groups || !w->tri_slot || !w->tris ||
+        !w->deformed || !w->group_new)
         return mk_error_oom(err, "computing target normals");
     for (uint32_t v = 0; v < m->vertex_count; v++) w->moved[v] = -1;
     for (uint32_t g = 0; g < topo->g.group_count; g++) w->group_slot[g] = -1;
@@ -206,7 +210,8 @@ static mk_result alloc_work(mk_arena *arena, const mk_raw_mesh *m, const topolog
 
 static void release_work(mk_arena *arena, work *w)
 {
-    void *scratch[] = { w->moved, w->vert_mark, w->extra, w->group_slot, w->groups, w->tri_slot, w->tris };
+    void *scratch[] = { w->moved, w->vert_mark, w->extra, w->group_slot, w->groups, w->tri_slot, w->tris, w->deformed,
+                        w->group_new };
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
 }
 

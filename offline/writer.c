@@ -14,6 +14,7 @@
  *
  * Deterministic: fixed iteration order, all padding zero, nothing taken from pointers/time.
  */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 #include "blob_io.h"
@@ -66,24 +67,39 @@ static float max_abs(const float *p, size_t n)
 
 static float quant_scale(float maxabs) { return maxabs > 0 ? maxabs / 32767.0f : 0.0f; }
 
+/* roundf(v / scale) clamped to +-32767, without the libm call (a tenth of an import's time
+ * went to roundf): clamping first gives the same integer (both bounds are integers), and the
+ * clamped quotient converts to int32 exactly; its fraction (exact below 2^23) decides the
+ * rounding, halves away from zero as roundf. */
 static int16_t quantize(float v, float scale)
 {
     if (scale == 0) return 0;
-    float q = roundf(v / scale);
-    q = q > 32767.f ? 32767.f : q < -32767.f ? -32767.f : q;
-    return (int16_t)q;
+    float x = v / scale;
+    x = x > 32767.f ? 32767.f : x < -32767.f ? -32767.f : x;
+    int32_t i = (int32_t)x;
+    float frac = x - (float)i;
+    i += (frac >= 0.5f) - (frac <= -0.5f);
+    return (int16_t)i;
 }
+
+/* |dequantized - exact| of one value stored as q. */
+static double quant_error_of(float v, int16_t q, float scale) { return fabs((double)q * scale - (double)v); }
 
 /* Largest |dequantized - exact| over the array. */
 static double quant_error(const float *p, size_t n, float scale)
 {
     double e = 0;
     for (size_t i = 0; i < n; i++) {
-        double d = fabs((double)quantize(p[i], scale) * scale - (double)p[i]);
+        double d = quant_error_of(p[i], quantize(p[i], scale), scale);
         if (d > e) e = d;
     }
     return e;
 }
+
+/* An upper bound of quant_error for a normal (not subnormal) scale: v / scale rounds to within
+ * 2^-24 of |v / scale| <= 32767.002, i.e. within 2^-9, then to the nearest integer, so every
+ * value errs by at most scale (0.5 + 2^-9) before the last double rounding. */
+static double quant_error_bound(float scale) { return (double)scale * (0.5 + 1.0 / 256); }
 
 static float mesh_diagonal(const mk_raw_mesh *m)
 {
@@ -103,7 +119,6 @@ typedef struct target_plan {
     uint32_t flags;
     float position_scale, normal_scale, tangent_scale;
     double tolerance;                  /* the mesh's */
-    double error[3];                   /* largest quantization error: positions, normals, tangents */
 } target_plan;
 
 /* Decides a target's storage: int16 with per-attribute scales when the positions' error stays
@@ -114,19 +129,16 @@ static void plan_target(const mk_raw_target *t, mk_precision precision, target_p
     if (precision == MK_PRECISION_FLOAT) return;
     size_t n = 3 * (size_t)t->count;
     float ps = quant_scale(max_abs(t->positions, n));
-    double pe = quant_error(t->positions, n, ps);
-    if (pe > p->tolerance) return;
+    /* The error pass only where the bound cannot decide (the errors reported are measured
+     * while writing the data, in write_block). */
+    if (!(ps >= FLT_MIN && quant_error_bound(ps) <= p->tolerance) && ps != 0) {
+        double pe = quant_error(t->positions, n, ps);
+        if (pe > p->tolerance) return;
+    }
     p->flags |= MK_TARGET_QUANTIZED;
     p->position_scale = ps;
-    p->error[0] = pe;
-    if (t->normals) {
-        p->normal_scale = quant_scale(max_abs(t->normals, n));
-        p->error[1] = quant_error(t->normals, n, p->normal_scale);
-    }
-    if (t->tangents) {
-        p->tangent_scale = quant_scale(max_abs(t->tangents, n));
-        p->error[2] = quant_error(t->tangents, n, p->tangent_scale);
-    }
+    if (t->normals) p->normal_scale = quant_scale(max_abs(t->normals, n));
+    if (t->tangents) p->tangent_scale = quant_scale(max_abs(t->tangents, n));
 }
 
 typedef struct plan_loop {
@@ -142,22 +154,38 @@ static void plan_item(void *user, uint32_t item, uint32_t worker)
     plan_target(l->targets[item], l->precision, &l->plans[item]);
 }
 
-/* Writes one attribute's xyz triples for the vertices of `mask` in block `block`, in bit order.
- * src/index describe the target's sparse data; cursor is the first target entry in the block. */
-static void put_triples(uint8_t *dst, const mk_raw_target *t, const float *src, uint32_t cursor, uint64_t mask,
-                        uint32_t block, int quantized, float scale)
+/* Writes one entry's data for the vertices of `mask` in block `block`, in bit order: the
+ * position triples, then the normal triples, then the tangent triples (`attr` bytes each). A
+ * vertex the target does not move (a dense block) gets zeros. cursor is the target's first
+ * index in the block; each vertex is looked up once for all attributes. A quantized target's
+ * largest error per attribute is kept in error[] (every value is written once, so this is the
+ * error over the whole target). */
+static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p, uint32_t cursor, uint64_t mask,
+                      uint32_t block, size_t attr, double error[3])
 {
-    for (int c = 0; c < 3; c++) {
-        uint32_t j = 0, k = cursor;
-        for (uint64_t bits = mask; bits; bits &= bits - 1, j++) {
-            uint32_t v = block * MK_BLOCK_SIZE + mk_ctz64(bits);
-            while (k < t->count && t->indices[k] < v) k++;
-            float value = (k < t->count && t->indices[k] == v) ? src[3u * k + (uint32_t)c] : 0.0f;
+    static const float zero[3] = { 0, 0, 0 };
+    const int quantized = (p->flags & MK_TARGET_QUANTIZED) != 0;
+    const float *src[3] = { t->positions, t->normals, t->tangents };
+    const float scale[3] = { p->position_scale, p->normal_scale, p->tangent_scale };
+    uint8_t *out[3] = { dst, dst + attr, dst + (t->normals ? 2 * attr : attr) };
+    uint32_t k = cursor;
+    size_t j = 0;
+    for (uint64_t bits = mask; bits; bits &= bits - 1, j++) {
+        uint32_t v = block * MK_BLOCK_SIZE + mk_ctz64(bits);
+        while (k < t->count && t->indices[k] < v) k++;
+        int moved = k < t->count && t->indices[k] == v;
+        for (int a = 0; a < 3; a++) {
+            if (!src[a]) continue;
+            const float *value = moved ? &src[a][3u * k] : zero;
             if (quantized) {
-                int16_t q = quantize(value, scale);
-                memcpy(dst + (3 * (size_t)j + (size_t)c) * 2, &q, 2);
+                int16_t q[3] = { quantize(value[0], scale[a]), quantize(value[1], scale[a]), quantize(value[2], scale[a]) };
+                memcpy(out[a] + 6 * j, q, 6);
+                for (int c = 0; c < 3; c++) {
+                    double e = quant_error_of(value[c], q[c], scale[a]);
+                    error[a] = e > error[a] ? e : error[a];
+                }
             } else {
-                memcpy(dst + (3 * (size_t)j + (size_t)c) * 4, &value, 4);
+                memcpy(out[a] + 12 * j, value, 12);
             }
         }
     }
@@ -169,6 +197,7 @@ typedef struct target_layout {
     uint64_t entry_count, data_size;   /* counted first: blocks touched, bytes (entries 16-aligned) */
     uint64_t first_entry, base;        /* then placed: its first entry, its data's offset */
     uint64_t cursor;                   /* the entry merge's position */
+    double error[3];                   /* written: largest quantization error per attribute */
 } target_layout;
 
 typedef struct layout_loop {
@@ -235,12 +264,8 @@ static void write_block(void *user, uint32_t block, uint32_t first, uint64_t mas
     l->entry_block[e] = block;
     l->entry_mask[e] = mask;
     l->entry_data[e] = tl->base + at;
-    int q = (p->flags & MK_TARGET_QUANTIZED) != 0;
     size_t attr = (size_t)size / (1u + (tg->normals ? 1u : 0u) + (tg->tangents ? 1u : 0u));
-    uint8_t *dst = l->data + tl->base + at;
-    put_triples(dst, tg, tg->positions, first, mask, block, q, p->position_scale);
-    if (tg->normals) put_triples(dst += attr, tg, tg->normals, first, mask, block, q, p->normal_scale);
-    if (tg->tangents) put_triples(dst + attr, tg, tg->tangents, first, mask, block, q, p->tangent_scale);
+    put_entry(l->data + tl->base + at, tg, p, first, mask, block, attr, tl->error);
 }
 
 static void layout_write(void *user, uint32_t item, uint32_t worker)
@@ -359,6 +384,12 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, uint32_t threads, mk_aren
     }
     block_first[blocks] = (uint32_t)e;
     report->target_bytes += entry_count * sizeof(mk_blob_entry) + out->target_data_size;
+    for (uint32_t t = 0; t < target_count; t++) {
+        const double *te = l->targets[t].error;
+        if (te[0] > report->max_position_error) report->max_position_error = te[0];
+        if (te[1] > report->max_normal_error) report->max_normal_error = te[1];
+        if (te[2] > report->max_tangent_error) report->max_tangent_error = te[2];
+    }
     void *scratch[] = { l->targets, l->entry_block, l->entry_mask, l->entry_data };
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
     l->targets = NULL;
@@ -419,9 +450,6 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
     for (uint32_t k = 0; k < target_count; k++) {
         if (!(plans[k].flags & MK_TARGET_QUANTIZED)) { report.float_targets++; continue; }
         report.quantized_targets++;
-        if (plans[k].error[0] > report.max_position_error) report.max_position_error = plans[k].error[0];
-        if (plans[k].error[1] > report.max_normal_error) report.max_normal_error = plans[k].error[1];
-        if (plans[k].error[2] > report.max_tangent_error) report.max_tangent_error = plans[k].error[2];
     }
     mk_phase_log_mark(opt.phases, "quantize");
 
