@@ -19,6 +19,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <threads.h>
 #include "mesh_groups.h"
 #include "parallel.h"
 
@@ -226,16 +227,38 @@ typedef struct normals_loop {
     mk_error *errors;
     work *works;
     mk_arena *arenas;
+    mk_arena *owner;           /* replaced arrays go back here at once (NULL: left alone) */
+    mtx_t *owner_lock;         /* the owner arena is shared by the workers */
 } normals_loop;
 
 static void normals_item(void *user, uint32_t item, uint32_t worker)
 {
     normals_loop *l = user;
-    l->results[item] = compute_target(&l->arenas[worker], l->m, l->topo, l->targets[item], &l->works[worker],
-                                      &l->errors[item]);
+    mk_raw_target *t = l->targets[item];
+    void *old[] = { t->indices, t->positions, t->normals, t->tangents };
+    l->results[item] = compute_target(&l->arenas[worker], l->m, l->topo, t, &l->works[worker], &l->errors[item]);
+    if (!l->owner || l->results[item] != MK_OK) return;
+    mtx_lock(l->owner_lock);
+    for (size_t i = 0; i < sizeof old / sizeof old[0]; i++) mk_arena_release(l->owner, old[i]);
+    mtx_unlock(l->owner_lock);
 }
 
+static mk_result compute_normals(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads, int release,
+                                 mk_error *err);
+
 mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads, mk_error *err)
+{
+    return compute_normals(raw, mesh, force, threads, 0, err);
+}
+
+mk_result mk_raw_compute_target_normals_replacing(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads,
+                                                  mk_error *err)
+{
+    return compute_normals(raw, mesh, force, threads, 1, err);
+}
+
+static mk_result compute_normals(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads, int release,
+                                 mk_error *err)
 {
     if (mesh >= raw->mesh_count)
         return mk_error_set(err, MK_ERROR_OUT_OF_RANGE, UINT64_MAX, "compute normals: mesh %u does not exist", mesh);
@@ -252,7 +275,7 @@ mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int fo
     mk_result r = build_topology(arena, m, &topo, err);
     if (r != MK_OK) return r;
     uint32_t workers = mk_parallel_threads(threads, count);
-    normals_loop l = { m, &topo, NULL, NULL, NULL, NULL, NULL };
+    normals_loop l = { m, &topo, NULL, NULL, NULL, NULL, NULL, NULL, NULL };
     l.targets = mk_arena_array(arena, count, sizeof *l.targets);
     l.results = mk_arena_array(arena, count, sizeof *l.results);
     l.errors = mk_arena_array(arena, count, sizeof *l.errors);
@@ -269,7 +292,14 @@ mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int fo
         mk_arena_init(&l.arenas[ready], &arena->allocator);
         r = alloc_work(&l.arenas[ready], m, &topo, &l.works[ready], err);
     }
+    mtx_t lock;
+    if (r == MK_OK && release) {
+        if (mtx_init(&lock, mtx_plain) != thrd_success) r = mk_error_oom(err, "computing target normals");
+        l.owner = arena;
+        l.owner_lock = &lock;
+    }
     if (r == MK_OK) mk_parallel_for(count, workers, normals_item, &l);
+    if (l.owner) mtx_destroy(&lock);
     for (uint32_t i = 0; i < count && r == MK_OK; i++)
         if (l.results[i] != MK_OK) {  /* the first failing target in asset order, whatever the threads */
             r = l.results[i];

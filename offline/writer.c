@@ -17,6 +17,7 @@
 #include <float.h>
 #include <math.h>
 #include <string.h>
+#include <threads.h>
 #include "blob_io.h"
 #include "format.h"
 #include "parallel.h"
@@ -198,6 +199,7 @@ typedef struct target_layout {
     uint64_t first_entry, base;        /* then placed: its first entry, its data's offset */
     uint64_t cursor;                   /* the entry merge's position */
     double error[3];                   /* written: largest quantization error per attribute */
+    mk_raw_target *own;                /* consumed (mk_write_blob_consuming): emptied once written */
 } target_layout;
 
 typedef struct layout_loop {
@@ -208,6 +210,8 @@ typedef struct layout_loop {
     uint32_t *entry_block;             /* per entry, target-major */
     uint64_t *entry_mask, *entry_data; /* the entry's vertices; its data's offset in the target data */
     uint8_t *data;                     /* the mesh's target data */
+    mk_arena *owner;                   /* consuming: the raw arena the written targets go back to */
+    mtx_t *owner_lock;
 } layout_loop;
 
 /* Calls fn(user, block, mask) for each block a target touches, in block order; the mask has
@@ -276,6 +280,15 @@ static void layout_write(void *user, uint32_t item, uint32_t worker)
     it.tl->cursor = it.tl->first_entry;
     it.tl->data_size = 0;
     target_blocks(l, it.tl->t, write_block, &it);
+    mk_raw_target *own = it.tl->own;
+    if (!own) return;
+    void *arrays[] = { own->indices, own->positions, own->normals, own->tangents };
+    mtx_lock(l->owner_lock);
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++) mk_arena_release(l->owner, arrays[i]);
+    mtx_unlock(l->owner_lock);
+    own->indices = NULL;
+    own->positions = own->normals = own->tangents = NULL;
+    own->count = 0;
 }
 
 typedef struct mesh_out {
@@ -302,9 +315,9 @@ static uint64_t place(uint64_t *cursor, uint64_t n)
  * pages of inactive targets. Targets are independent: their sizes are counted here, their
  * data written straight into the blob by write_mesh_data, both on worker threads (no
  * allocation there); the entries are merged block by block afterwards. */
-static mk_result plan_mesh_data(const mk_raw_asset *raw, uint32_t mi, uint32_t first_channel, uint32_t channel_count,
-                                const target_plan *plans, uint32_t dense_threshold, uint32_t threads, mk_arena *arena,
-                                uint64_t *cursor, mesh_out *out, mk_error *err)
+static mk_result plan_mesh_data(const mk_raw_asset *raw, mk_raw_asset *consume, uint32_t mi, uint32_t first_channel,
+                                uint32_t channel_count, const target_plan *plans, uint32_t dense_threshold,
+                                uint32_t threads, mk_arena *arena, uint64_t *cursor, mesh_out *out, mk_error *err)
 {
     const mk_raw_mesh *m = &raw->meshes[mi];
     memset(out, 0, sizeof *out);
@@ -317,12 +330,15 @@ static mk_result plan_mesh_data(const mk_raw_asset *raw, uint32_t mi, uint32_t f
     uint32_t target_count = 0;
     for (uint32_t c = first_channel; c < first_channel + channel_count; c++) target_count += raw->channels[c].target_count;
     layout_loop *l = &out->l;
-    *l = (layout_loop){ m, plans, dense_threshold, NULL, NULL, NULL, NULL, NULL };
+    *l = (layout_loop){ m, plans, dense_threshold, NULL, NULL, NULL, NULL, NULL, consume ? &consume->arena : NULL, NULL };
     l->targets = mk_arena_array(arena, target_count + 1, sizeof *l->targets);
     if (!l->targets) return mk_error_oom(err, "planning blocks");
     uint32_t k = 0;
     for (uint32_t c = first_channel; c < first_channel + channel_count; c++)
-        for (uint32_t j = 0; j < raw->channels[c].target_count; j++) l->targets[k++].t = &raw->channels[c].targets[j];
+        for (uint32_t j = 0; j < raw->channels[c].target_count; j++, k++) {
+            l->targets[k].t = &raw->channels[c].targets[j];
+            if (consume) l->targets[k].own = &consume->channels[c].targets[j];
+        }
     mk_parallel_for(target_count, threads, layout_count, l);
     uint64_t entry_count = 0, total = 0;
     for (uint32_t t = 0; t < target_count; t++) {
@@ -367,7 +383,13 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, uint32_t threads, mk_aren
     l->entry_data = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_data);
     if (!l->entry_block || !l->entry_mask || !l->entry_data) return mk_error_oom(err, "planning blocks");
     l->data = data + out->target_data;
+    mtx_t lock;
+    if (l->owner) {
+        if (mtx_init(&lock, mtx_plain) != thrd_success) return mk_error_oom(err, "writing block data");
+        l->owner_lock = &lock;
+    }
     mk_parallel_for(target_count, threads, layout_write, l);
+    if (l->owner) mtx_destroy(&lock);
     /* Entries block-major, targets in blob order within a block. */
     mk_blob_entry *entries = (mk_blob_entry *)(void *)(data + out->entries);
     uint64_t e = 0;
@@ -396,8 +418,26 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, uint32_t threads, mk_aren
     return MK_OK;
 }
 
+static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, const mk_write_options *options,
+                            mk_arena *arena, void **blob_out, size_t *size_out, mk_write_report *report_out,
+                            mk_error *err);
+
 mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options, mk_arena *arena,
                         void **blob_out, size_t *size_out, mk_write_report *report_out, mk_error *err)
+{
+    return write_blob(raw, NULL, options, arena, blob_out, size_out, report_out, err);
+}
+
+mk_result mk_write_blob_consuming(mk_raw_asset *raw, const mk_write_options *options, void **blob_out, size_t *size_out,
+                                  mk_write_report *report_out, mk_error *err)
+{
+    return write_blob(raw, raw, options, &raw->arena, blob_out, size_out, report_out, err);
+}
+
+/* consume: NULL, or raw itself (its targets are emptied as they are written). */
+static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, const mk_write_options *options,
+                            mk_arena *arena, void **blob_out, size_t *size_out, mk_write_report *report_out,
+                            mk_error *err)
 {
     mk_write_options opt = options ? *options : (mk_write_options){ 0 };
     if (opt.dense_threshold == 0) opt.dense_threshold = 24;
@@ -486,7 +526,7 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
         }
         bm->target_count = t_index - bm->first_target;
         mk_phase_log_mark(opt.phases, "quantize");
-        r = plan_mesh_data(raw, mi, bm->first_channel, bm->channel_count, &plans[bm->first_target],
+        r = plan_mesh_data(raw, consume, mi, bm->first_channel, bm->channel_count, &plans[bm->first_target],
                            opt.dense_threshold, opt.threads, arena, &data_size, &mesh_data[mi], err);
         mk_phase_log_mark(opt.phases, "lay out blocks");
         if (r) return r;

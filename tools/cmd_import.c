@@ -107,7 +107,8 @@ static int run_import(void *p)
     size_t size = 0;
     mk_write_report report;
     cli_progress_update(&progress, "writing the blob", -1);
-    if (r == MK_OK) r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &report, &err);
+    /* The targets are only written once: the writer gives their memory back as it goes. */
+    if (r == MK_OK) r = mk_write_blob_consuming(&raw, &wo, &blob, &size, &report, &err);
     if (r != MK_OK) {
         mk_raw_free(&raw);
         cli_depfile_free(&deps);
