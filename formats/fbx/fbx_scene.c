@@ -676,9 +676,9 @@ static mk_result add_channel(scene *s, uint32_t mesh, fbx_mesh_map *map, const c
                             map->control_point_count);
             last_weight = fw;
         }
-        fbx_release(doc->arena, indexes);
-        fbx_release(doc->arena, positions);
-        fbx_release(doc->arena, normals);
+        fbx_recycle(doc, indexes, n_idx * sizeof *indexes);  /* the next shape's arrays reuse them */
+        fbx_recycle(doc, positions, n_pos * sizeof *positions);
+        fbx_recycle(doc, normals, n_nrm * sizeof *normals);
         fbx_release(doc->arena, weights);
         if (r != MK_OK) return r;
     }
