@@ -157,14 +157,14 @@ static void plan_item(void *user, uint32_t item, uint32_t worker)
 
 /* Writes one entry's data for the vertices of `mask` in block `block`, in bit order: the
  * position triples, then the normal triples, then the tangent triples (`attr` bytes each). A
- * vertex the target does not move (a dense block) gets zeros. cursor is the target's first
+ * vertex the target does not move (a dense block) keeps the zeros dst already holds (the blob
+ * is zeroed, and 0 quantizes to 0 without error). cursor is the target's first
  * index in the block; each vertex is looked up once for all attributes. A quantized target's
  * largest error per attribute is kept in error[] (every value is written once, so this is the
  * error over the whole target). */
 static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p, uint32_t cursor, uint64_t mask,
                       uint32_t block, size_t attr, double error[3])
 {
-    static const float zero[3] = { 0, 0, 0 };
     const int quantized = (p->flags & MK_TARGET_QUANTIZED) != 0;
     const float *src[3] = { t->positions, t->normals, t->tangents };
     const float scale[3] = { p->position_scale, p->normal_scale, p->tangent_scale };
@@ -174,10 +174,10 @@ static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p
     for (uint64_t bits = mask; bits; bits &= bits - 1, j++) {
         uint32_t v = block * MK_BLOCK_SIZE + mk_ctz64(bits);
         while (k < t->count && t->indices[k] < v) k++;
-        int moved = k < t->count && t->indices[k] == v;
+        if (k == t->count || t->indices[k] != v) continue;
         for (int a = 0; a < 3; a++) {
             if (!src[a]) continue;
-            const float *value = moved ? &src[a][3u * k] : zero;
+            const float *value = &src[a][3u * k];
             if (quantized) {
                 int16_t q[3] = { quantize(value[0], scale[a]), quantize(value[1], scale[a]), quantize(value[2], scale[a]) };
                 memcpy(out[a] + 6 * j, q, 6);
