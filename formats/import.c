@@ -46,6 +46,19 @@ mk_result mk_import_memory(const void *data, size_t size, const mk_import_option
                         "unknown file type: not a .morph blob, glTF (.gltf, .glb) or FBX");
 }
 
+/* The file's bytes, given back as soon as the importer is done with them (a lower peak). */
+typedef struct file_bytes {
+    mk_arena *arena;
+    void *data;
+} file_bytes;
+
+static void release_file_bytes(void *user)
+{
+    file_bytes *f = user;
+    mk_arena_release(f->arena, f->data);
+    f->data = NULL;
+}
+
 mk_result mk_import_file(const char *path, const mk_import_options *options, mk_raw_asset *out, mk_error *err)
 {
     if (!path || !out) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "import: invalid argument");
@@ -74,6 +87,9 @@ mk_result mk_import_file(const char *path, const mk_import_options *options, mk_
         }
         o.base_dir = dir;
     }
+    file_bytes bytes = { &tmp, data };
+    o.input_done = release_file_bytes;
+    o.input_done_user = &bytes;
     r = mk_import_memory(data, size, &o, out, err);
     if (r != MK_OK && err && strncmp(err->message, path, strlen(path)) != 0) {
         /* Name the file once, in front, unless the message already starts with it. */

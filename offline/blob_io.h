@@ -41,6 +41,14 @@ typedef struct mk_write_report {
  * model and options give byte-identical output). report may be NULL. */
 mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options, mk_arena *arena,
                         void **blob, size_t *size, mk_write_report *report, mk_error *err);
+/* mk_write_blob for a model that is written once (morphkit import): the blob comes from raw's
+ * own arena and each target's arrays go back to it as soon as its data is in the blob, so the
+ * targets and the blob are never both whole in memory. Every target array must be a block of
+ * raw's arena of its own, as the importers make them. Afterwards (after a failure too) targets
+ * may be left without data (count 0, NULL arrays): write the model once, then free it. Names,
+ * weights, channels, meshes and clips stay. The blob is the same as mk_write_blob's. */
+mk_result mk_write_blob_consuming(mk_raw_asset *raw, const mk_write_options *options, void **blob, size_t *size,
+                                  mk_write_report *report, mk_error *err);
 
 /* Reads an opened blob back into a raw model (dequantized). out must be mk_raw_init'ed. */
 mk_result mk_read_blob(const mk_asset *asset, mk_raw_asset *out, mk_error *err);

@@ -30,6 +30,11 @@ typedef struct mk_import_options {
      * core. The result is the same for any count. With more than one, the raw asset's
      * allocator is called from several threads (the default one, malloc, may be). */
     uint32_t threads;
+    /* Called at most once, when the importer will not read the input bytes again (FBX: before
+     * computing target normals), so a caller that owns them can free them early; may be NULL
+     * (glTF and .morph inputs never call it). mk_import_file sets its own. */
+    void (*input_done)(void *user);
+    void *input_done_user;
 } mk_import_options;
 
 #define MK_IMPORT_DEFAULT_MAX_INPUT ((size_t)4 << 30)

@@ -19,6 +19,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <threads.h>
 #include "mesh_groups.h"
 #include "parallel.h"
 
@@ -35,6 +36,8 @@ typedef struct work {
     int32_t *tri_slot;         /* per triangle: index in tris[], or -1 */
     uint8_t *vert_mark;        /* per vertex: joined the index set */
     uint32_t *groups, *tris, *extra;   /* affected groups, triangles; added vertices */
+    double *deformed;          /* per affected triangle: its deformed face normal */
+    float *group_new;          /* per affected group: its new unit normal */
 } work;
 
 static void face_normal(const float *p0, const float *p1, const float *p2, double out[3])
@@ -117,9 +120,8 @@ static mk_result compute_target(mk_arena *arena, const mk_raw_mesh *m, const top
             }
         }
     }
-    double *deformed = mk_arena_array(arena, (size_t)tri_count * 3 + 3, sizeof(double));
-    float *group_new = mk_arena_array(arena, (size_t)group_count * 3 + 3, sizeof(float));
-    if (!deformed || !group_new) return mk_error_oom(err, "computing target normals");
+    double *deformed = w->deformed;
+    float *group_new = w->group_new;
     for (uint32_t k = 0; k < tri_count; k++) {
         const uint32_t *c = &m->triangles[3u * w->tris[k]];
         float p[3][3];
@@ -176,8 +178,6 @@ static mk_result compute_target(mk_arena *arena, const mk_raw_mesh *m, const top
     for (uint32_t k = 0; k < tri_count; k++) w->tri_slot[w->tris[k]] = -1;
     for (uint32_t k = 0; k < group_count; k++) w->group_slot[w->groups[k]] = -1;
     for (uint32_t k = 0; k < extra; k++) w->vert_mark[w->extra[k]] = 0;
-    mk_arena_release(arena, deformed);
-    mk_arena_release(arena, group_new);
     /* The old arrays are replaced (they may belong to the importer: left to the arena). */
     t->indices = indices;
     t->positions = positions;
@@ -196,7 +196,12 @@ static mk_result alloc_work(mk_arena *arena, const mk_raw_mesh *m, const topolog
     w->groups = mk_arena_array(arena, topo->g.group_count + 1u, sizeof(uint32_t));
     w->tri_slot = mk_arena_array(arena, (size_t)m->triangle_count + 1, sizeof(int32_t));
     w->tris = mk_arena_array(arena, (size_t)m->triangle_count + 1, sizeof(uint32_t));
-    if (!w->moved || !w->vert_mark || !w->extra || !w->group_slot || !w->groups || !w->tri_slot || !w->tris)
+    /* Sized for a target that moves everything; only what the largest target uses is ever
+     * touched (allocating them per target cost a fresh zeroed page for every page, every time). */
+    w->deformed = mk_arena_array(arena, (size_t)m->triangle_count * 3 + 3, sizeof(double));
+    w->group_new = mk_arena_array(arena, (size_t)topo->g.group_count * 3 + 3, sizeof(float));
+    if (!w->moved || !w->vert_mark || !w->extra || !w->group_slot || !w->groups || !w->tri_slot || !w->tris ||
+        !w->deformed || !w->group_new)
         return mk_error_oom(err, "computing target normals");
     for (uint32_t v = 0; v < m->vertex_count; v++) w->moved[v] = -1;
     for (uint32_t g = 0; g < topo->g.group_count; g++) w->group_slot[g] = -1;
@@ -206,7 +211,8 @@ static mk_result alloc_work(mk_arena *arena, const mk_raw_mesh *m, const topolog
 
 static void release_work(mk_arena *arena, work *w)
 {
-    void *scratch[] = { w->moved, w->vert_mark, w->extra, w->group_slot, w->groups, w->tri_slot, w->tris };
+    void *scratch[] = { w->moved, w->vert_mark, w->extra, w->group_slot, w->groups, w->tri_slot, w->tris, w->deformed,
+                        w->group_new };
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
 }
 
@@ -221,16 +227,38 @@ typedef struct normals_loop {
     mk_error *errors;
     work *works;
     mk_arena *arenas;
+    mk_arena *owner;           /* replaced arrays go back here at once (NULL: left alone) */
+    mtx_t *owner_lock;         /* the owner arena is shared by the workers */
 } normals_loop;
 
 static void normals_item(void *user, uint32_t item, uint32_t worker)
 {
     normals_loop *l = user;
-    l->results[item] = compute_target(&l->arenas[worker], l->m, l->topo, l->targets[item], &l->works[worker],
-                                      &l->errors[item]);
+    mk_raw_target *t = l->targets[item];
+    void *old[] = { t->indices, t->positions, t->normals, t->tangents };
+    l->results[item] = compute_target(&l->arenas[worker], l->m, l->topo, t, &l->works[worker], &l->errors[item]);
+    if (!l->owner || l->results[item] != MK_OK) return;
+    mtx_lock(l->owner_lock);
+    for (size_t i = 0; i < sizeof old / sizeof old[0]; i++) mk_arena_release(l->owner, old[i]);
+    mtx_unlock(l->owner_lock);
 }
 
+static mk_result compute_normals(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads, int release,
+                                 mk_error *err);
+
 mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads, mk_error *err)
+{
+    return compute_normals(raw, mesh, force, threads, 0, err);
+}
+
+mk_result mk_raw_compute_target_normals_replacing(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads,
+                                                  mk_error *err)
+{
+    return compute_normals(raw, mesh, force, threads, 1, err);
+}
+
+static mk_result compute_normals(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads, int release,
+                                 mk_error *err)
 {
     if (mesh >= raw->mesh_count)
         return mk_error_set(err, MK_ERROR_OUT_OF_RANGE, UINT64_MAX, "compute normals: mesh %u does not exist", mesh);
@@ -247,7 +275,7 @@ mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int fo
     mk_result r = build_topology(arena, m, &topo, err);
     if (r != MK_OK) return r;
     uint32_t workers = mk_parallel_threads(threads, count);
-    normals_loop l = { m, &topo, NULL, NULL, NULL, NULL, NULL };
+    normals_loop l = { m, &topo, NULL, NULL, NULL, NULL, NULL, NULL, NULL };
     l.targets = mk_arena_array(arena, count, sizeof *l.targets);
     l.results = mk_arena_array(arena, count, sizeof *l.results);
     l.errors = mk_arena_array(arena, count, sizeof *l.errors);
@@ -264,7 +292,14 @@ mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int fo
         mk_arena_init(&l.arenas[ready], &arena->allocator);
         r = alloc_work(&l.arenas[ready], m, &topo, &l.works[ready], err);
     }
+    mtx_t lock;
+    if (r == MK_OK && release) {
+        if (mtx_init(&lock, mtx_plain) != thrd_success) r = mk_error_oom(err, "computing target normals");
+        l.owner = arena;
+        l.owner_lock = &lock;
+    }
     if (r == MK_OK) mk_parallel_for(count, workers, normals_item, &l);
+    if (l.owner) mtx_destroy(&lock);
     for (uint32_t i = 0; i < count && r == MK_OK; i++)
         if (l.results[i] != MK_OK) {  /* the first failing target in asset order, whatever the threads */
             r = l.results[i];

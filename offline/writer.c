@@ -14,8 +14,10 @@
  *
  * Deterministic: fixed iteration order, all padding zero, nothing taken from pointers/time.
  */
+#include <float.h>
 #include <math.h>
 #include <string.h>
+#include <threads.h>
 #include "blob_io.h"
 #include "format.h"
 #include "parallel.h"
@@ -43,17 +45,6 @@ static int bytes_reserve(bytes *b, size_t extra)
     return 1;
 }
 
-/* Appends n bytes (zeros if src is NULL) at a 16-aligned position; returns that position. */
-static size_t bytes_put(bytes *b, const void *src, size_t n)
-{
-    size_t at = pad16(b->size);
-    if (!bytes_reserve(b, at - b->size + n)) return 0;
-    memset(b->data + b->size, 0, at - b->size);
-    if (src && n) memcpy(b->data + at, src, n); else if (n) memset(b->data + at, 0, n);
-    b->size = at + n;
-    return at;
-}
-
 /* String table: offset of each string, appended in first-use order (deterministic). */
 static uint32_t put_string(bytes *strings, const char *s)
 {
@@ -77,24 +68,39 @@ static float max_abs(const float *p, size_t n)
 
 static float quant_scale(float maxabs) { return maxabs > 0 ? maxabs / 32767.0f : 0.0f; }
 
+/* roundf(v / scale) clamped to +-32767, without the libm call (a tenth of an import's time
+ * went to roundf): clamping first gives the same integer (both bounds are integers), and the
+ * clamped quotient converts to int32 exactly; its fraction (exact below 2^23) decides the
+ * rounding, halves away from zero as roundf. */
 static int16_t quantize(float v, float scale)
 {
     if (scale == 0) return 0;
-    float q = roundf(v / scale);
-    q = q > 32767.f ? 32767.f : q < -32767.f ? -32767.f : q;
-    return (int16_t)q;
+    float x = v / scale;
+    x = x > 32767.f ? 32767.f : x < -32767.f ? -32767.f : x;
+    int32_t i = (int32_t)x;
+    float frac = x - (float)i;
+    i += (frac >= 0.5f) - (frac <= -0.5f);
+    return (int16_t)i;
 }
+
+/* |dequantized - exact| of one value stored as q. */
+static double quant_error_of(float v, int16_t q, float scale) { return fabs((double)q * scale - (double)v); }
 
 /* Largest |dequantized - exact| over the array. */
 static double quant_error(const float *p, size_t n, float scale)
 {
     double e = 0;
     for (size_t i = 0; i < n; i++) {
-        double d = fabs((double)quantize(p[i], scale) * scale - (double)p[i]);
+        double d = quant_error_of(p[i], quantize(p[i], scale), scale);
         if (d > e) e = d;
     }
     return e;
 }
+
+/* An upper bound of quant_error for a normal (not subnormal) scale: v / scale rounds to within
+ * 2^-24 of |v / scale| <= 32767.002, i.e. within 2^-9, then to the nearest integer, so every
+ * value errs by at most scale (0.5 + 2^-9) before the last double rounding. */
+static double quant_error_bound(float scale) { return (double)scale * (0.5 + 1.0 / 256); }
 
 static float mesh_diagonal(const mk_raw_mesh *m)
 {
@@ -114,7 +120,6 @@ typedef struct target_plan {
     uint32_t flags;
     float position_scale, normal_scale, tangent_scale;
     double tolerance;                  /* the mesh's */
-    double error[3];                   /* largest quantization error: positions, normals, tangents */
 } target_plan;
 
 /* Decides a target's storage: int16 with per-attribute scales when the positions' error stays
@@ -125,19 +130,16 @@ static void plan_target(const mk_raw_target *t, mk_precision precision, target_p
     if (precision == MK_PRECISION_FLOAT) return;
     size_t n = 3 * (size_t)t->count;
     float ps = quant_scale(max_abs(t->positions, n));
-    double pe = quant_error(t->positions, n, ps);
-    if (pe > p->tolerance) return;
+    /* The error pass only where the bound cannot decide (the errors reported are measured
+     * while writing the data, in write_block). */
+    if (!(ps >= FLT_MIN && quant_error_bound(ps) <= p->tolerance) && ps != 0) {
+        double pe = quant_error(t->positions, n, ps);
+        if (pe > p->tolerance) return;
+    }
     p->flags |= MK_TARGET_QUANTIZED;
     p->position_scale = ps;
-    p->error[0] = pe;
-    if (t->normals) {
-        p->normal_scale = quant_scale(max_abs(t->normals, n));
-        p->error[1] = quant_error(t->normals, n, p->normal_scale);
-    }
-    if (t->tangents) {
-        p->tangent_scale = quant_scale(max_abs(t->tangents, n));
-        p->error[2] = quant_error(t->tangents, n, p->tangent_scale);
-    }
+    if (t->normals) p->normal_scale = quant_scale(max_abs(t->normals, n));
+    if (t->tangents) p->tangent_scale = quant_scale(max_abs(t->tangents, n));
 }
 
 typedef struct plan_loop {
@@ -153,22 +155,38 @@ static void plan_item(void *user, uint32_t item, uint32_t worker)
     plan_target(l->targets[item], l->precision, &l->plans[item]);
 }
 
-/* Writes one attribute's xyz triples for the vertices of `mask` in block `block`, in bit order.
- * src/index describe the target's sparse data; cursor is the first target entry in the block. */
-static void put_triples(uint8_t *dst, const mk_raw_target *t, const float *src, uint32_t cursor, uint64_t mask,
-                        uint32_t block, int quantized, float scale)
+/* Writes one entry's data for the vertices of `mask` in block `block`, in bit order: the
+ * position triples, then the normal triples, then the tangent triples (`attr` bytes each). A
+ * vertex the target does not move (a dense block) keeps the zeros dst already holds (the blob
+ * is zeroed, and 0 quantizes to 0 without error). cursor is the target's first
+ * index in the block; each vertex is looked up once for all attributes. A quantized target's
+ * largest error per attribute is kept in error[] (every value is written once, so this is the
+ * error over the whole target). */
+static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p, uint32_t cursor, uint64_t mask,
+                      uint32_t block, size_t attr, double error[3])
 {
-    for (int c = 0; c < 3; c++) {
-        uint32_t j = 0, k = cursor;
-        for (uint64_t bits = mask; bits; bits &= bits - 1, j++) {
-            uint32_t v = block * MK_BLOCK_SIZE + mk_ctz64(bits);
-            while (k < t->count && t->indices[k] < v) k++;
-            float value = (k < t->count && t->indices[k] == v) ? src[3u * k + (uint32_t)c] : 0.0f;
+    const int quantized = (p->flags & MK_TARGET_QUANTIZED) != 0;
+    const float *src[3] = { t->positions, t->normals, t->tangents };
+    const float scale[3] = { p->position_scale, p->normal_scale, p->tangent_scale };
+    uint8_t *out[3] = { dst, dst + attr, dst + (t->normals ? 2 * attr : attr) };
+    uint32_t k = cursor;
+    size_t j = 0;
+    for (uint64_t bits = mask; bits; bits &= bits - 1, j++) {
+        uint32_t v = block * MK_BLOCK_SIZE + mk_ctz64(bits);
+        while (k < t->count && t->indices[k] < v) k++;
+        if (k == t->count || t->indices[k] != v) continue;
+        for (int a = 0; a < 3; a++) {
+            if (!src[a]) continue;
+            const float *value = &src[a][3u * k];
             if (quantized) {
-                int16_t q = quantize(value, scale);
-                memcpy(dst + (3 * (size_t)j + (size_t)c) * 2, &q, 2);
+                int16_t q[3] = { quantize(value[0], scale[a]), quantize(value[1], scale[a]), quantize(value[2], scale[a]) };
+                memcpy(out[a] + 6 * j, q, 6);
+                for (int c = 0; c < 3; c++) {
+                    double e = quant_error_of(value[c], q[c], scale[a]);
+                    error[a] = e > error[a] ? e : error[a];
+                }
             } else {
-                memcpy(dst + (3 * (size_t)j + (size_t)c) * 4, &value, 4);
+                memcpy(out[a] + 12 * j, value, 12);
             }
         }
     }
@@ -180,6 +198,8 @@ typedef struct target_layout {
     uint64_t entry_count, data_size;   /* counted first: blocks touched, bytes (entries 16-aligned) */
     uint64_t first_entry, base;        /* then placed: its first entry, its data's offset */
     uint64_t cursor;                   /* the entry merge's position */
+    double error[3];                   /* written: largest quantization error per attribute */
+    mk_raw_target *own;                /* consumed (mk_write_blob_consuming): emptied once written */
 } target_layout;
 
 typedef struct layout_loop {
@@ -190,6 +210,8 @@ typedef struct layout_loop {
     uint32_t *entry_block;             /* per entry, target-major */
     uint64_t *entry_mask, *entry_data; /* the entry's vertices; its data's offset in the target data */
     uint8_t *data;                     /* the mesh's target data */
+    mk_arena *owner;                   /* consuming: the raw arena the written targets go back to */
+    mtx_t *owner_lock;
 } layout_loop;
 
 /* Calls fn(user, block, mask) for each block a target touches, in block order; the mask has
@@ -246,12 +268,8 @@ static void write_block(void *user, uint32_t block, uint32_t first, uint64_t mas
     l->entry_block[e] = block;
     l->entry_mask[e] = mask;
     l->entry_data[e] = tl->base + at;
-    int q = (p->flags & MK_TARGET_QUANTIZED) != 0;
     size_t attr = (size_t)size / (1u + (tg->normals ? 1u : 0u) + (tg->tangents ? 1u : 0u));
-    uint8_t *dst = l->data + tl->base + at;
-    put_triples(dst, tg, tg->positions, first, mask, block, q, p->position_scale);
-    if (tg->normals) put_triples(dst += attr, tg, tg->normals, first, mask, block, q, p->normal_scale);
-    if (tg->tangents) put_triples(dst + attr, tg, tg->tangents, first, mask, block, q, p->tangent_scale);
+    put_entry(l->data + tl->base + at, tg, p, first, mask, block, attr, tl->error);
 }
 
 static void layout_write(void *user, uint32_t item, uint32_t worker)
@@ -262,95 +280,164 @@ static void layout_write(void *user, uint32_t item, uint32_t worker)
     it.tl->cursor = it.tl->first_entry;
     it.tl->data_size = 0;
     target_blocks(l, it.tl->t, write_block, &it);
+    mk_raw_target *own = it.tl->own;
+    if (!own) return;
+    void *arrays[] = { own->indices, own->positions, own->normals, own->tangents };
+    mtx_lock(l->owner_lock);
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++) mk_arena_release(l->owner, arrays[i]);
+    mtx_unlock(l->owner_lock);
+    own->indices = NULL;
+    own->positions = own->normals = own->tangents = NULL;
+    own->count = 0;
 }
 
 typedef struct mesh_out {
     uint64_t positions, normals, tangents, triangles, control_points, block_entries, entries, target_data;
     uint64_t entry_count, target_data_size;
+    uint32_t target_count, blocks;
+    layout_loop l;                     /* the targets' layout, counted by plan_mesh_data */
 } mesh_out;
 
-/* Appends one mesh's arrays to data; offsets are relative to the data section. */
-static mk_result write_mesh_data(const mk_raw_asset *raw, uint32_t mi, uint32_t first_channel, uint32_t channel_count,
-                                 const target_plan *plans, uint32_t dense_threshold, uint32_t threads, bytes *data,
-                                 mesh_out *out, mk_write_report *report, mk_error *err)
+/* Offset of the next n bytes of the data section (16-aligned); advances the cursor. */
+static uint64_t place(uint64_t *cursor, uint64_t n)
+{
+    uint64_t at = (*cursor + 15u) & ~(uint64_t)15u;
+    *cursor = at + n;
+    return at;
+}
+
+/* Places one mesh's arrays in the data section (offsets relative to it, from *cursor on) and
+ * counts its targets' blocks and bytes; nothing is written yet.
+ *
+ * Delta data is laid out target-major (all blocks of target 0, then target 1, ...) while
+ * the entries stay block-major: a frame then reads each active target as one sequential
+ * stream, which the hardware prefetcher and the TLB handle well, and never touches the
+ * pages of inactive targets. Targets are independent: their sizes are counted here, their
+ * data written straight into the blob by write_mesh_data, both on worker threads (no
+ * allocation there); the entries are merged block by block afterwards. */
+static mk_result plan_mesh_data(const mk_raw_asset *raw, mk_raw_asset *consume, uint32_t mi, uint32_t first_channel,
+                                uint32_t channel_count, const target_plan *plans, uint32_t dense_threshold,
+                                uint32_t threads, mk_arena *arena, uint64_t *cursor, mesh_out *out, mk_error *err)
 {
     const mk_raw_mesh *m = &raw->meshes[mi];
-    mk_arena *arena = data->arena;
     memset(out, 0, sizeof *out);
-    out->positions = bytes_put(data, m->positions, 12u * (size_t)m->vertex_count);
-    if (m->normals) out->normals = bytes_put(data, m->normals, 12u * (size_t)m->vertex_count);
-    if (m->tangents) out->tangents = bytes_put(data, m->tangents, 16u * (size_t)m->vertex_count);
-    out->triangles = bytes_put(data, m->triangles, 12u * (size_t)m->triangle_count);
-    out->control_points = bytes_put(data, NULL, 4u * (size_t)m->vertex_count);
-    if (data->failed) return mk_error_oom(err, "writing mesh arrays");
-    uint32_t *cp = (uint32_t *)(void *)(data->data + out->control_points);
-    for (uint32_t v = 0; v < m->vertex_count; v++) cp[v] = m->control_points ? m->control_points[v] : v;
+    out->positions = place(cursor, 12u * (uint64_t)m->vertex_count);
+    if (m->normals) out->normals = place(cursor, 12u * (uint64_t)m->vertex_count);
+    if (m->tangents) out->tangents = place(cursor, 16u * (uint64_t)m->vertex_count);
+    out->triangles = place(cursor, 12u * (uint64_t)m->triangle_count);
+    out->control_points = place(cursor, 4u * (uint64_t)m->vertex_count);
 
-    /* Delta data is laid out target-major (all blocks of target 0, then target 1, ...) while
-     * the entries stay block-major: a frame then reads each active target as one sequential
-     * stream, which the hardware prefetcher and the TLB handle well, and never touches the
-     * pages of inactive targets. Targets are independent: their sizes are counted, then their
-     * data written straight into the final buffer, both on worker threads (no allocation
-     * there); the entries are merged block by block afterwards. */
     uint32_t target_count = 0;
     for (uint32_t c = first_channel; c < first_channel + channel_count; c++) target_count += raw->channels[c].target_count;
-    uint32_t blocks = (m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
-    layout_loop l = { m, plans, dense_threshold, NULL, NULL, NULL, NULL, NULL };
-    l.targets = mk_arena_array(arena, target_count + 1, sizeof *l.targets);
-    uint32_t *block_first = mk_arena_array(arena, (size_t)blocks + 1, sizeof *block_first);
-    if (!l.targets || !block_first) return mk_error_oom(err, "planning blocks");
+    layout_loop *l = &out->l;
+    *l = (layout_loop){ m, plans, dense_threshold, NULL, NULL, NULL, NULL, NULL, consume ? &consume->arena : NULL, NULL };
+    l->targets = mk_arena_array(arena, target_count + 1, sizeof *l->targets);
+    if (!l->targets) return mk_error_oom(err, "planning blocks");
     uint32_t k = 0;
     for (uint32_t c = first_channel; c < first_channel + channel_count; c++)
-        for (uint32_t j = 0; j < raw->channels[c].target_count; j++) l.targets[k++].t = &raw->channels[c].targets[j];
-    mk_parallel_for(target_count, threads, layout_count, &l);
+        for (uint32_t j = 0; j < raw->channels[c].target_count; j++, k++) {
+            l->targets[k].t = &raw->channels[c].targets[j];
+            if (consume) l->targets[k].own = &consume->channels[c].targets[j];
+        }
+    mk_parallel_for(target_count, threads, layout_count, l);
     uint64_t entry_count = 0, total = 0;
     for (uint32_t t = 0; t < target_count; t++) {
-        l.targets[t].first_entry = entry_count;
-        l.targets[t].base = total;
-        entry_count += l.targets[t].entry_count;
-        total += pad16(l.targets[t].data_size);
+        l->targets[t].first_entry = entry_count;
+        l->targets[t].base = total;
+        entry_count += l->targets[t].entry_count;
+        total += pad16(l->targets[t].data_size);
     }
     if (entry_count > UINT32_MAX)
         return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: more than 2^32 block entries", mi);
     if (total / MK_ALIGN > UINT32_MAX)
         return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: target data exceeds 64 GiB", mi);
-    /* Per target entry (target-major): its block, mask and data offset. */
-    l.entry_block = mk_arena_array(arena, entry_count + 1, sizeof *l.entry_block);
-    l.entry_mask = mk_arena_array(arena, entry_count + 1, sizeof *l.entry_mask);
-    l.entry_data = mk_arena_array(arena, entry_count + 1, sizeof *l.entry_data);
-    if (!l.entry_block || !l.entry_mask || !l.entry_data) return mk_error_oom(err, "planning blocks");
-    out->block_entries = bytes_put(data, NULL, 4u * ((size_t)blocks + 1));
-    out->entries = bytes_put(data, NULL, (size_t)entry_count * sizeof(mk_blob_entry));
+    out->target_count = target_count;
+    out->blocks = (m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
+    out->block_entries = place(cursor, 4u * ((uint64_t)out->blocks + 1));
+    out->entries = place(cursor, entry_count * sizeof(mk_blob_entry));
     out->entry_count = entry_count;
-    out->target_data = bytes_put(data, NULL, (size_t)total);
+    out->target_data = place(cursor, total);
     out->target_data_size = total;
-    if (data->failed) return mk_error_oom(err, "writing block data");
-    l.data = data->data + out->target_data;
-    mk_parallel_for(target_count, threads, layout_write, &l);
+    return MK_OK;
+}
+
+/* Writes one mesh's arrays, target data and entries into the data section `data` (zeroed:
+ * the padding is left as it is) at the offsets plan_mesh_data chose. */
+static mk_result write_mesh_data(const mk_raw_mesh *m, uint32_t threads, mk_arena *arena, uint8_t *data,
+                                 mesh_out *out, mk_write_report *report, mk_error *err)
+{
+    memcpy(data + out->positions, m->positions, 12u * (size_t)m->vertex_count);
+    if (m->normals) memcpy(data + out->normals, m->normals, 12u * (size_t)m->vertex_count);
+    if (m->tangents) memcpy(data + out->tangents, m->tangents, 16u * (size_t)m->vertex_count);
+    if (m->triangle_count) memcpy(data + out->triangles, m->triangles, 12u * (size_t)m->triangle_count);
+    uint32_t *cp = (uint32_t *)(void *)(data + out->control_points);
+    for (uint32_t v = 0; v < m->vertex_count; v++) cp[v] = m->control_points ? m->control_points[v] : v;
+
+    layout_loop *l = &out->l;
+    const uint32_t target_count = out->target_count, blocks = out->blocks;
+    const uint64_t entry_count = out->entry_count;
+    /* Per target entry (target-major): its block, mask and data offset. */
+    uint32_t *block_first = (uint32_t *)(void *)(data + out->block_entries);
+    l->entry_block = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_block);
+    l->entry_mask = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_mask);
+    l->entry_data = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_data);
+    if (!l->entry_block || !l->entry_mask || !l->entry_data) return mk_error_oom(err, "planning blocks");
+    l->data = data + out->target_data;
+    mtx_t lock;
+    if (l->owner) {
+        if (mtx_init(&lock, mtx_plain) != thrd_success) return mk_error_oom(err, "writing block data");
+        l->owner_lock = &lock;
+    }
+    mk_parallel_for(target_count, threads, layout_write, l);
+    if (l->owner) mtx_destroy(&lock);
     /* Entries block-major, targets in blob order within a block. */
-    mk_blob_entry *entries = (mk_blob_entry *)(void *)(data->data + out->entries);
+    mk_blob_entry *entries = (mk_blob_entry *)(void *)(data + out->entries);
     uint64_t e = 0;
-    for (uint32_t t = 0; t < target_count; t++) l.targets[t].cursor = l.targets[t].first_entry;
+    for (uint32_t t = 0; t < target_count; t++) l->targets[t].cursor = l->targets[t].first_entry;
     for (uint32_t b = 0; b < blocks; b++) {
         block_first[b] = (uint32_t)e;
         for (uint32_t t = 0; t < target_count; t++) {
-            target_layout *tl = &l.targets[t];
-            if (tl->cursor == tl->first_entry + tl->entry_count || l.entry_block[tl->cursor] != b) continue;
-            mk_blob_entry be = { t, (uint32_t)(l.entry_data[tl->cursor] / MK_ALIGN), l.entry_mask[tl->cursor] };
+            target_layout *tl = &l->targets[t];
+            if (tl->cursor == tl->first_entry + tl->entry_count || l->entry_block[tl->cursor] != b) continue;
+            mk_blob_entry be = { t, (uint32_t)(l->entry_data[tl->cursor] / MK_ALIGN), l->entry_mask[tl->cursor] };
             entries[e++] = be;
             tl->cursor++;
         }
     }
     block_first[blocks] = (uint32_t)e;
-    memcpy(data->data + out->block_entries, block_first, 4u * ((size_t)blocks + 1));
-    report->target_bytes += entry_count * sizeof(mk_blob_entry) + total;
-    void *scratch[] = { l.targets, block_first, l.entry_block, l.entry_mask, l.entry_data };
+    report->target_bytes += entry_count * sizeof(mk_blob_entry) + out->target_data_size;
+    for (uint32_t t = 0; t < target_count; t++) {
+        const double *te = l->targets[t].error;
+        if (te[0] > report->max_position_error) report->max_position_error = te[0];
+        if (te[1] > report->max_normal_error) report->max_normal_error = te[1];
+        if (te[2] > report->max_tangent_error) report->max_tangent_error = te[2];
+    }
+    void *scratch[] = { l->targets, l->entry_block, l->entry_mask, l->entry_data };
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
+    l->targets = NULL;
     return MK_OK;
 }
 
+static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, const mk_write_options *options,
+                            mk_arena *arena, void **blob_out, size_t *size_out, mk_write_report *report_out,
+                            mk_error *err);
+
 mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options, mk_arena *arena,
                         void **blob_out, size_t *size_out, mk_write_report *report_out, mk_error *err)
+{
+    return write_blob(raw, NULL, options, arena, blob_out, size_out, report_out, err);
+}
+
+mk_result mk_write_blob_consuming(mk_raw_asset *raw, const mk_write_options *options, void **blob_out, size_t *size_out,
+                                  mk_write_report *report_out, mk_error *err)
+{
+    return write_blob(raw, raw, options, &raw->arena, blob_out, size_out, report_out, err);
+}
+
+/* consume: NULL, or raw itself (its targets are emptied as they are written). */
+static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, const mk_write_options *options,
+                            mk_arena *arena, void **blob_out, size_t *size_out, mk_write_report *report_out,
+                            mk_error *err)
 {
     mk_write_options opt = options ? *options : (mk_write_options){ 0 };
     if (opt.dense_threshold == 0) opt.dense_threshold = 24;
@@ -370,7 +457,8 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
         for (uint32_t t = 0; t < raw->clips[c].track_count; t++) key_count += raw->clips[c].tracks[t].key_count;
     }
 
-    bytes strings = { arena, NULL, 0, 0, 0 }, data = { arena, NULL, 0, 0, 0 };
+    bytes strings = { arena, NULL, 0, 0, 0 };
+    uint64_t data_size = 0;   /* the data section, placed mesh by mesh before anything is written */
     mk_blob_mesh *meshes = mk_arena_array(arena, raw->mesh_count + 1, sizeof *meshes);
     mk_blob_channel *channels = mk_arena_array(arena, raw->channel_count + 1, sizeof *channels);
     mk_blob_target *targets = mk_arena_array(arena, target_count + 1, sizeof *targets);
@@ -402,9 +490,6 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
     for (uint32_t k = 0; k < target_count; k++) {
         if (!(plans[k].flags & MK_TARGET_QUANTIZED)) { report.float_targets++; continue; }
         report.quantized_targets++;
-        if (plans[k].error[0] > report.max_position_error) report.max_position_error = plans[k].error[0];
-        if (plans[k].error[1] > report.max_normal_error) report.max_normal_error = plans[k].error[1];
-        if (plans[k].error[2] > report.max_tangent_error) report.max_tangent_error = plans[k].error[2];
     }
     mk_phase_log_mark(opt.phases, "quantize");
 
@@ -441,8 +526,8 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
         }
         bm->target_count = t_index - bm->first_target;
         mk_phase_log_mark(opt.phases, "quantize");
-        r = write_mesh_data(raw, mi, bm->first_channel, bm->channel_count, &plans[bm->first_target],
-                            opt.dense_threshold, opt.threads, &data, &mesh_data[mi], &report, err);
+        r = plan_mesh_data(raw, consume, mi, bm->first_channel, bm->channel_count, &plans[bm->first_target],
+                           opt.dense_threshold, opt.threads, arena, &data_size, &mesh_data[mi], err);
         mk_phase_log_mark(opt.phases, "lay out blocks");
         if (r) return r;
         bm->vertex_count = m->vertex_count;
@@ -473,7 +558,7 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
             }
         }
     }
-    if (strings.failed || data.failed) return mk_error_oom(err, "writing strings");
+    if (strings.failed) return mk_error_oom(err, "writing strings");
     if (strings.size > UINT32_MAX)
         return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "write: names exceed 4 GiB");
 
@@ -486,7 +571,7 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
         { MK_SECTION_CLIPS, sizeof(mk_blob_clip), raw->clip_count, clips },
         { MK_SECTION_TRACKS, sizeof(mk_blob_track), track_count, tracks },
         { MK_SECTION_KEYS, sizeof(mk_key), key_count, keys },
-        { MK_SECTION_DATA, 1, data.size, data.data },
+        { MK_SECTION_DATA, 1, data_size, NULL },  /* written in place below */
     };
     const uint32_t section_count = MK_SECTION_KIND_COUNT - 1;
     mk_blob_section table[MK_SECTION_KIND_COUNT - 1];
@@ -517,8 +602,15 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
         bm->target_data_size = o->target_data_size;
     }
     if (total > SIZE_MAX) return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "write: blob exceeds the address space");
+    /* One zeroed allocation for the whole blob: the meshes' data is written straight into it
+     * (no growing buffer copied at the end) and every padding byte stays zero. */
     uint8_t *blob = mk_arena_alloc(arena, (size_t)total);
     if (!blob) return mk_error_oom(err, "allocating the blob");
+    for (uint32_t mi = 0; mi < raw->mesh_count; mi++) {
+        r = write_mesh_data(&raw->meshes[mi], opt.threads, arena, blob + data_base, &mesh_data[mi], &report, err);
+        if (r) return r;
+    }
+    mk_phase_log_mark(opt.phases, "lay out blocks");
     mk_blob_header header;
     memset(&header, 0, sizeof header);
     memcpy(header.magic, MK_MAGIC, 8);
@@ -528,13 +620,12 @@ mk_result mk_write_blob(const mk_raw_asset *raw, const mk_write_options *options
     header.section_count = section_count;
     memcpy(blob + sizeof header, table, sizeof table);
     for (uint32_t i = 0; i < section_count; i++)
-        if (table[i].size) memcpy(blob + table[i].offset, parts[i].src, (size_t)table[i].size);
+        if (table[i].size && parts[i].src) memcpy(blob + table[i].offset, parts[i].src, (size_t)table[i].size);
     memcpy(blob, &header, sizeof header);
     header.checksum = mk_checksum(blob + 32, total - 32);
     memcpy(blob, &header, sizeof header);
 
     mk_arena_release(arena, strings.data);
-    mk_arena_release(arena, data.data);
     mk_arena_release(arena, meshes);
     mk_arena_release(arena, channels);
     mk_arena_release(arena, targets);

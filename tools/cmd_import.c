@@ -37,7 +37,10 @@ static const cli_option options[] = {
       "Also keep meshes without morph targets (by default only meshes with targets are imported).", NULL, NULL, 0, 0, 0,
       0 },
     { "--timings", NULL, CLI_FLAG, offsetof(import_args, timings),
-      "Print where the import's time and memory went, phase by phase (to standard error).", NULL, NULL, 0, 0, 0, 0 },
+      "Print where the import's time and memory went, phase by phase, to standard error: each phase's seconds, "
+      "share of the total and the process's peak memory when it ended (read file, parse, meshes, shapes, target "
+      "normals, quantize, lay out blocks, write file, ...), then the total.",
+      NULL, NULL, 0, 0, 0, 0 },
     { "--threads", "N", CLI_UINT, offsetof(import_args, threads),
       "Threads for the parts of an import that run in parallel (target normals, quantization, block layout); 0 = "
       "one per core. The blob is the same for any count.",
@@ -107,7 +110,8 @@ static int run_import(void *p)
     size_t size = 0;
     mk_write_report report;
     cli_progress_update(&progress, "writing the blob", -1);
-    if (r == MK_OK) r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &report, &err);
+    /* The targets are only written once: the writer gives their memory back as it goes. */
+    if (r == MK_OK) r = mk_write_blob_consuming(&raw, &wo, &blob, &size, &report, &err);
     if (r != MK_OK) {
         mk_raw_free(&raw);
         cli_depfile_free(&deps);

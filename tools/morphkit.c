@@ -2,6 +2,9 @@
 /* morphkit: one command-line program with verbs; all logic lives in the libraries. */
 #include <string.h>
 #include "cli.h"
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 static const cli_verb *const verbs[] = {
     &cli_verb_import, &cli_verb_info, &cli_verb_play, &cli_verb_bake,
@@ -26,6 +29,13 @@ static const cli_verb *find_verb(const char *name)
 
 int main(int argc, char **argv)
 {
+#if defined(__GLIBC__)
+    /* glibc raises its trim threshold to twice the largest block freed so far (up to 64 MB) and
+     * keeps that much freed memory in the process. An import frees its input and parse data
+     * before its largest steps (target normals, the blob); a fixed threshold gives that memory
+     * back to the system and lowers the peak (blob8: 245 MB -> 167 MB). */
+    mallopt(M_TRIM_THRESHOLD, 1 << 20);
+#endif
     if (argc < 2) {
         usage(stderr);
         return CLI_EXIT_USAGE;

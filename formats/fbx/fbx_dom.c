@@ -30,6 +30,57 @@ void fbx_doc_free(fbx_doc *doc)
 {
     if (doc->inflater) libdeflate_free_decompressor(doc->inflater);
     doc->inflater = NULL;
+    for (size_t i = 0; i < sizeof doc->spare / sizeof doc->spare[0]; i++) fbx_release(doc->arena, doc->spare[i].ptr);
+    memset(doc->spare, 0, sizeof doc->spare);
+}
+
+/* Arrays smaller than this are allocated and released as usual. */
+#define FBX_SPARE_MIN ((size_t)64 << 10)
+
+/* Bytes allocated for a recyclable array of `size` bytes: the next power of two, so the next
+ * shape's slightly longer array still fits. */
+static size_t spare_capacity(size_t size)
+{
+    if (size < FBX_SPARE_MIN) return size;
+    size_t c = FBX_SPARE_MIN;
+    while (c < size && c <= SIZE_MAX / 2) c *= 2;
+    return c < size ? size : c;
+}
+
+void fbx_recycle(fbx_doc *doc, void *ptr, size_t size)
+{
+    if (!ptr) return;
+    if (size < FBX_SPARE_MIN) {
+        fbx_release(doc->arena, ptr);
+        return;
+    }
+    size_t slot = 0;  /* an empty slot, else the smallest spare */
+    for (size_t i = 0; i < sizeof doc->spare / sizeof doc->spare[0]; i++) {
+        if (!doc->spare[i].ptr) { slot = i; break; }
+        if (doc->spare[i].size < doc->spare[slot].size) slot = i;
+    }
+    if (doc->spare[slot].ptr && doc->spare[slot].size >= size) {  /* every spare is bigger: keep them */
+        fbx_release(doc->arena, ptr);
+        return;
+    }
+    fbx_release(doc->arena, doc->spare[slot].ptr);
+    doc->spare[slot].ptr = ptr;
+    doc->spare[slot].size = spare_capacity(size);  /* at least what array_buffer allocated for it */
+}
+
+/* The smallest spare of at least `size` bytes (taken out), or a new zeroed block. */
+static void *array_buffer(fbx_doc *doc, size_t size)
+{
+    const size_t n = sizeof doc->spare / sizeof doc->spare[0];
+    size_t best = n;
+    for (size_t i = 0; i < n && size >= FBX_SPARE_MIN; i++)
+        if (doc->spare[i].ptr && doc->spare[i].size >= size && (best == n || doc->spare[i].size < doc->spare[best].size))
+            best = i;
+    if (best == n) return mk_arena_alloc(doc->arena, spare_capacity(size));
+    void *p = doc->spare[best].ptr;
+    doc->spare[best].ptr = NULL;
+    doc->spare[best].size = 0;
+    return p;
 }
 
 void fbx_link_parents(fbx_node *node)
@@ -309,7 +360,7 @@ mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void
         const fbx_value *v = &node->values[0];
         if ((uint64_t)v->count * esize > FBX_MAX_ARRAY_BYTES)
             return array_error(doc, node, v->offset, MK_ERROR_LIMIT, "array too large");
-        void *data = mk_arena_alloc(doc->arena, (size_t)v->count * esize);
+        void *data = array_buffer(doc, (size_t)v->count * esize);  /* every element is written below */
         if (!data) return mk_error_oom(doc->err, "FBX array");
         mk_result r = v->type == 'a' ? decode_ascii(doc, node, v, elem, data) : decode_binary(doc, node, v, elem, data);
         if (r != MK_OK) { fbx_release(doc->arena, data); return r; }
@@ -317,8 +368,8 @@ mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void
         *count = v->count;
         return MK_OK;
     }
-    /* FBX 5.x/6.x: a run of scalar values. */
-    void *data = mk_arena_array(doc->arena, node->value_count, esize);
+    /* FBX 5.x/6.x: a run of scalar values (every one written below). */
+    void *data = node->value_count <= SIZE_MAX / esize ? array_buffer(doc, (size_t)node->value_count * esize) : NULL;
     if (!data) return mk_error_oom(doc->err, "FBX array");
     for (uint32_t i = 0; i < node->value_count; i++) {
         const fbx_value *v = &node->values[i];

@@ -3,8 +3,10 @@
  *
  * Steps: parse the file into a node tree (fbx_binary.c / fbx_ascii.c, with limits against
  * hostile input), then interpret it (fbx_scene.c: objects, connections, meshes, blend shapes,
- * curves). All parse memory comes from a scratch arena on the same allocator as the raw model
- * and is released before returning, on success and on error.
+ * curves), then compute the target normals the file does not store (fbx_normals.c). All parse
+ * memory comes from a scratch arena on the same allocator as the raw model and is released
+ * before the normals are computed, on success and on error; so are the input bytes when the
+ * caller offers (mk_import_options.input_done).
  */
 #include <string.h>
 #include "fbx_internal.h"
@@ -29,6 +31,7 @@ mk_result mk_import_fbx(const void *data, size_t size, const mk_import_options *
     doc.size = size;
     doc.err = err;
     doc.binary = fbx_is_binary(data, size);
+    const uint32_t first_mesh = out->mesh_count;
     r = doc.binary ? fbx_parse_binary(&doc) : fbx_parse_ascii(&doc);
     if (r == MK_OK && doc.root.child_count == 0)
         r = mk_error_set(err, MK_ERROR_PARSE, 0, "not an FBX file: no nodes found (%zu bytes)", size);
@@ -39,6 +42,11 @@ mk_result mk_import_fbx(const void *data, size_t size, const mk_import_options *
     }
     fbx_doc_free(&doc);
     mk_arena_free_all(&scratch);
+    if (options->input_done) options->input_done(options->input_done_user);  /* data is not read again */
     mk_phase_log_mark(options->phases, "release parse data");
+    if (r == MK_OK) {
+        r = fbx_target_normals(out, first_mesh, options, err);
+        mk_phase_log_mark(options->phases, "target normals");
+    }
     return r != MK_OK ? r : mk_import_finish(out, options, err);
 }

@@ -67,6 +67,7 @@ typedef struct fbx_doc {
     fbx_node root;          /* children = top-level nodes */
     mk_error *err;
     void *inflater;         /* libdeflate decompressor, made on first use, freed by fbx_doc_free */
+    struct { void *ptr; size_t size; } spare[4]; /* recycled array buffers (fbx_recycle) */
 } fbx_doc;
 
 void fbx_doc_free(fbx_doc *doc);
@@ -118,6 +119,11 @@ mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void
 /* Same for the child named `name`; *out NULL and count 0 when the child is absent (MK_OK). */
 mk_result fbx_child_array(fbx_doc *doc, const fbx_node *node, const char *name, fbx_elem elem,
                           void **out, size_t *count);
+/* Gives back an array of fbx_node_array (`size` bytes: its count times the element size) for
+ * the next arrays to reuse: a blend shape's arrays are decoded, expanded and dropped, and a
+ * fresh buffer for every shape costs a zeroed page for every page. Small arrays, and arrays
+ * with no room left among the spares, are released. ptr may be NULL. */
+void fbx_recycle(fbx_doc *doc, void *ptr, size_t size);
 /* Byte offset in the file of value `index` of a node's data: the element of a raw binary
  * array, the token of an ASCII array, the scalar of a value run (FBX 5.x/6.x, and any node's
  * plain values). Elements of a zlib array have no offset of their own: the array's is given
@@ -151,5 +157,7 @@ uint32_t fbx_prop_payload(fbx_props props);
 
 /* ---- Interpretation (fbx_scene.c etc.) ---- */
 mk_result fbx_convert(fbx_doc *doc, const mk_import_options *options, mk_raw_asset *out);
+/* fbx_normals.c: target normals for the meshes from first_mesh on (after the parse data is released). */
+mk_result fbx_target_normals(mk_raw_asset *raw, uint32_t first_mesh, const mk_import_options *options, mk_error *err);
 
 #endif

@@ -387,8 +387,14 @@ void fbx_mesh_map_free(fbx_doc *doc, fbx_mesh_map *map)
     fbx_release(doc->arena, map->first);
     fbx_release(doc->arena, map->vertices);
     fbx_release(doc->arena, map->cp_entry);
+    fbx_release(doc->arena, map->entry_cp);
+    fbx_release(doc->arena, map->sum_pos);
+    fbx_release(doc->arena, map->sum_nrm);
+    fbx_release(doc->arena, map->pairs);
     map->first = map->vertices = NULL;
-    map->cp_entry = NULL;
+    map->cp_entry = map->entry_cp = NULL;
+    map->sum_pos = map->sum_nrm = NULL;
+    map->pairs = NULL;
 }
 
 /* ---- Blend shape expansion ---- */
@@ -409,20 +415,23 @@ mk_result fbx_expand_shape(fbx_doc *doc, mk_raw_asset *raw, fbx_mesh_map *map, c
     *skipped = 0;
     size_t n = shape->count;
     /* Per control point: the summed delta of its entries (a file may list a point twice;
-     * evaluation adds every offset, as ufbx does). Dense accumulation keyed through cp_entry,
-     * which stays allocated across shapes of the mesh and is reset after each use. */
+     * evaluation adds every offset, as ufbx does). Dense accumulation keyed through cp_entry;
+     * the scratch stays allocated across shapes of the mesh and cp_entry is reset after each use. */
+    const size_t cps = map->control_point_count ? map->control_point_count : 1;
     if (!map->cp_entry) {
-        map->cp_entry = mk_arena_array(arena, map->control_point_count ? map->control_point_count : 1, sizeof(uint32_t));
-        if (!map->cp_entry) return mk_error_oom(doc->err, "FBX shape");
+        map->cp_entry = mk_arena_array(arena, cps, sizeof(uint32_t));
+        map->entry_cp = mk_arena_array(arena, cps, sizeof(uint32_t));
+        map->sum_pos = mk_arena_array(arena, cps, 3 * sizeof(double));
+        if (!map->cp_entry || !map->entry_cp || !map->sum_pos) return mk_error_oom(doc->err, "FBX shape");
         for (uint32_t i = 0; i < map->control_point_count; i++) map->cp_entry[i] = UINT32_MAX;
     }
-    double *sum_pos = mk_arena_array(arena, n ? n : 1, 3 * sizeof(double));
-    double *sum_nrm = shape->normals ? mk_arena_array(arena, n ? n : 1, 3 * sizeof(double)) : NULL;
-    uint32_t *entry_cp = mk_arena_array(arena, n ? n : 1, sizeof(uint32_t));
-    pair *pairs = NULL;
+    if (shape->normals && !map->sum_nrm && !(map->sum_nrm = mk_arena_array(arena, cps, 3 * sizeof(double))))
+        return mk_error_oom(doc->err, "FBX shape");
+    double *sum_pos = map->sum_pos;
+    double *sum_nrm = shape->normals ? map->sum_nrm : NULL;
+    uint32_t *entry_cp = map->entry_cp;
     mk_result r = MK_OK;
     size_t unique = 0;
-    if (!sum_pos || !entry_cp || (shape->normals && !sum_nrm)) { r = mk_error_oom(doc->err, "FBX shape"); goto done; }
     for (size_t i = 0; i < n; i++) {
         int32_t cp = shape->indexes[i];
         if (cp < 0 || (uint32_t)cp >= map->control_point_count) { (*skipped)++; continue; }
@@ -489,7 +498,8 @@ mk_result fbx_expand_shape(fbx_doc *doc, mk_raw_asset *raw, fbx_mesh_map *map, c
             w++;
         }
     } else {
-        pairs = mk_arena_array(arena, total ? total : 1, sizeof *pairs);
+        if (!map->pairs) map->pairs = mk_arena_array(arena, map->vertex_count ? map->vertex_count : 1, sizeof(pair));
+        pair *pairs = map->pairs;  /* total <= vertex_count: each render vertex has one control point */
         if (!pairs) { r = mk_error_oom(doc->err, "FBX shape"); goto done; }
         size_t np = 0;
         for (size_t e = 0; e < unique; e++) {
@@ -513,9 +523,5 @@ mk_result fbx_expand_shape(fbx_doc *doc, mk_raw_asset *raw, fbx_mesh_map *map, c
     target->count = (uint32_t)w;
 done:
     for (size_t e = 0; e < unique; e++) map->cp_entry[entry_cp[e]] = UINT32_MAX;
-    fbx_release(arena, sum_pos);
-    fbx_release(arena, sum_nrm);
-    fbx_release(arena, entry_cp);
-    fbx_release(arena, pairs);
     return r;
 }

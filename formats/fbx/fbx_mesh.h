@@ -11,7 +11,12 @@ typedef struct fbx_mesh_map {
     uint32_t *first;            /* control_point_count + 1 offsets into vertices */
     uint32_t *vertices;         /* render vertices grouped by control point, increasing */
     const uint32_t *vertex_cp;  /* render vertex -> control point (the raw mesh's array) */
-    uint32_t *cp_entry;         /* scratch for fbx_expand_shape */
+    /* Scratch for fbx_expand_shape, allocated at the mesh's first shape and reused by the
+     * others (fresh arrays for every shape cost a zeroed page for every page touched). */
+    uint32_t *cp_entry;         /* per control point: its entry in the shape, or a mark */
+    uint32_t *entry_cp;         /* per entry (at most one per control point): its control point */
+    double *sum_pos, *sum_nrm;  /* per entry: the summed position and normal deltas */
+    void *pairs;                /* (render vertex, entry) pairs of a sparse shape */
 } fbx_mesh_map;
 
 /* Reads Vertices, PolygonVertexIndex and the normal/UV layers of `geometry` into `mesh`

@@ -676,9 +676,9 @@ static mk_result add_channel(scene *s, uint32_t mesh, fbx_mesh_map *map, const c
                             map->control_point_count);
             last_weight = fw;
         }
-        fbx_release(doc->arena, indexes);
-        fbx_release(doc->arena, positions);
-        fbx_release(doc->arena, normals);
+        fbx_recycle(doc, indexes, n_idx * sizeof *indexes);  /* the next shape's arrays reuse them */
+        fbx_recycle(doc, positions, n_pos * sizeof *positions);
+        fbx_recycle(doc, normals, n_nrm * sizeof *normals);
         fbx_release(doc->arena, weights);
         if (r != MK_OK) return r;
     }
@@ -904,7 +904,6 @@ static mk_result convert_meshes(scene *s)
             return transform_not_finite(s, o, mesh->name);
         }
         s->objects[o].raw_mesh = (int32_t)mesh_index;
-        uint32_t first_channel = raw->channel_count;
         if (geometry_object >= 0) {
             r = blend_channels_7x(s, (uint32_t)geometry_object, mesh_index, &map);
             if (r == MK_OK && fbx_child(geometry, "Shape"))
@@ -915,15 +914,7 @@ static mk_result convert_meshes(scene *s)
         fbx_mesh_map_free(doc, &map);
         mk_phase_log_mark(s->options->phases, "shapes");
         if (r != MK_OK) return r;
-        int needs_normals = 0;
-        for (uint32_t c = first_channel; c < raw->channel_count; c++)
-            for (uint32_t k = 0; k < raw->channels[c].target_count; k++)
-                if (!raw->channels[c].targets[k].normals) needs_normals = 1;
-        if (needs_normals) {
-            r = mk_raw_compute_target_normals(raw, mesh_index, 0, s->options->threads, doc->err);
-            mk_phase_log_mark(s->options->phases, "target normals");
-            if (r != MK_OK) return r;
-        }
+        /* Target normals are computed by mk_import_fbx once the parse data is released. */
     }
     return MK_OK;
 }

@@ -186,31 +186,42 @@ static void test_hard_edge_stays_hard(void)
 }
 
 
-/* Targets are computed on worker threads: the result must not depend on how many. */
+/* Targets are computed on worker threads: the result must not depend on how many, nor on
+ * whether the replaced arrays go back to the arena at once (the importer's variant). */
 static void test_same_result_for_any_thread_count(void)
 {
-    mk_raw_asset one, many;
+    mk_raw_asset one, many, replacing;
     mk_raw_init(&one, NULL);
     mk_raw_init(&many, NULL);
+    mk_raw_init(&replacing, NULL);
     fixture_wavy_grid(&one, 48, 23);
     fixture_wavy_grid(&many, 48, 23);
+    fixture_wavy_grid(&replacing, 48, 23);
     mk_error err;
     CHECK(mk_raw_compute_target_normals(&one, 0, 0, 1, &err) == MK_OK);
     CHECK(mk_raw_compute_target_normals(&many, 0, 0, 5, &err) == MK_OK);
+    CHECK(mk_raw_compute_target_normals_replacing(&replacing, 0, 0, 5, &err) == MK_OK);
     uint32_t differ = 0, grew = 0;
     for (uint32_t c = 0; c < one.channel_count; c++) {
-        const mk_raw_target *a = &one.channels[c].targets[0], *b = &many.channels[c].targets[0];
-        CHECK(a->normals != NULL && b->normals != NULL);
-        if (a->count != b->count) { differ++; continue; }
+        const mk_raw_target *a = &one.channels[c].targets[0];
+        for (int k = 0; k < 2; k++) {
+            const mk_raw_target *b = k ? &replacing.channels[c].targets[0] : &many.channels[c].targets[0];
+            CHECK(a->normals != NULL && b->normals != NULL);
+            if (a->count != b->count) { differ++; continue; }
+            differ += memcmp(a->indices, b->indices, a->count * sizeof *a->indices) != 0;
+            differ += memcmp(a->positions, b->positions, 3 * a->count * sizeof(float)) != 0;
+            differ += memcmp(a->normals, b->normals, 3 * a->count * sizeof(float)) != 0;
+        }
         grew += a->count > 0;
-        differ += memcmp(a->indices, b->indices, a->count * sizeof *a->indices) != 0;
-        differ += memcmp(a->positions, b->positions, 3 * a->count * sizeof(float)) != 0;
-        differ += memcmp(a->normals, b->normals, 3 * a->count * sizeof(float)) != 0;
     }
-    CHECK_MSG(differ == 0, "%u targets differ between 1 and 5 threads", differ);
+    CHECK_MSG(differ == 0, "%u targets differ between 1 and 5 threads or the replacing variant", differ);
     CHECK(grew == one.channel_count);
+    /* The replacing variant keeps only the new arrays: the old ones (the fixture's) are gone. */
+    CHECK_MSG(replacing.arena.bytes_live < many.arena.bytes_live,
+              "live bytes %zu (replacing) vs %zu", replacing.arena.bytes_live, many.arena.bytes_live);
     mk_raw_free(&one);
     mk_raw_free(&many);
+    mk_raw_free(&replacing);
 }
 
 CHECK_MAIN(CASE(test_matches_recomputed_normals), CASE(test_authored_tangents_follow_their_vertex),

@@ -1,0 +1,19 @@
+/* SPDX-License-Identifier: MIT */
+/* Target normals for the meshes an FBX import added, computed after the parse data (and, with
+ * mk_import_options.input_done, the input bytes) is released: the normals are the import's
+ * largest step in memory, and by then nothing else of the file is needed. The shapes' arrays
+ * (fbx_expand_shape: one raw-arena block each) are given back as the grown ones replace them. */
+#include "fbx_internal.h"
+
+mk_result fbx_target_normals(mk_raw_asset *raw, uint32_t first_mesh, const mk_import_options *options, mk_error *err)
+{
+    for (uint32_t m = first_mesh; m < raw->mesh_count; m++) {
+        int needs = 0;
+        for (uint32_t c = 0; c < raw->channel_count && !needs; c++)
+            if (raw->channels[c].mesh == m)
+                for (uint32_t k = 0; k < raw->channels[c].target_count; k++) needs |= !raw->channels[c].targets[k].normals;
+        mk_result r = needs ? mk_raw_compute_target_normals_replacing(raw, m, 0, options->threads, err) : MK_OK;
+        if (r != MK_OK) return r;
+    }
+    return MK_OK;
+}
