@@ -73,6 +73,7 @@ typedef struct shell_mesh {
     double *hinge_K;          /* 4 per hinge */
     double *hinge_scale;      /* 3 / (A0 + A1) */
     double *hinge_rest;       /* |sum K_j X_j| at rest */
+    uint32_t *hinge_tri;      /* a triangle with the edge x0 x1 and the vertex x2 */
     double *inv_mass;         /* per welded vertex */
     double volume0;
 } shell_mesh;
@@ -144,12 +145,17 @@ mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *a
                          void (*progress)(void *user, double fraction), void *user, shell_run *run,
                          mk_error *err);
 
+/* Collision handling (shell_collide.c): the broad phase's hierarchy over the triangles, built
+ * once on the rest mesh and refitted every frame. NULL when out of memory. */
+typedef struct shell_collider shell_collider;
+shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena);
+
 /* Collision handling between the collision-free positions x and the new positions p: moves
  * colliding vertices back until no vertex-triangle or edge-edge pair crosses over the step and
  * no vertex is closer than thickness to a triangle it did not start closer to. Returns the hits
  * found (*vt, *ee) and rounds. */
-mk_result shell_collide(const shell_mesh *m, const double *x, double *p, double thickness, mk_arena *arena,
-                        uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err);
+mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *x, double *p, double thickness,
+                        mk_arena *arena, uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err);
 
 /* Writes the per-frame log as CSV (header line, then one line per frame). */
 int shell_write_log(FILE *f, const shell_run *run);

@@ -134,7 +134,8 @@ mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *a
     s.lambda = mk_arena_array(arena, (size_t)m->tri_count + m->hinge_count + s.aniso_count + 1, sizeof(double));
     run->positions = mk_arena_array(arena, n3 * ((size_t)p->frames + 1), sizeof(float));
     run->stats = mk_arena_array(arena, (size_t)p->frames + 1, sizeof(shell_frame_stats));
-    if (!x || !v || !q || !xs || !grad || !normals || !s.lambda || !run->positions || !run->stats)
+    shell_collider *collider = p->thickness > 0 ? shell_collider_create(m, arena) : NULL;
+    if (!x || !v || !q || !xs || !grad || !normals || !s.lambda || !run->positions || !run->stats || (p->thickness > 0 && !collider))
         return mk_error_oom(err, "shell simulation (positions of every frame)");
     memcpy(x, m->rest, n3 * sizeof(double));
     memset(v, 0, n3 * sizeof(double));
@@ -184,7 +185,7 @@ mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *a
         }
         double tc = bake_now();
         if (p->thickness > 0) {
-            r = shell_collide(m, x, q, p->thickness, arena, &st->vt_hits, &st->ee_hits, &st->collision_rounds, err);
+            r = shell_collide(collider, m, x, q, p->thickness, arena, &st->vt_hits, &st->ee_hits, &st->collision_rounds, err);
             if (r != MK_OK) return r;
         }
         st->ms_collision = 1000 * (bake_now() - tc);
