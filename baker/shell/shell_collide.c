@@ -122,17 +122,19 @@ static double pair_distance2(int kind, const double *const s[4], const double *c
     return kind == 0 ? point_triangle_distance2(q[3], q[0], q[1], q[2]) : segment_distance2(q[0], q[1], q[2], q[3]);
 }
 
-/* Are the pair's two parts (points 0-2 and 3, or 0-1 and 2-3) at least d apart on some axis at
- * the positions p? Then their distance is at least d. */
-static int apart_on_an_axis(int kind, const double *const p[4], double d)
+/* Are the pair's two parts (points 0-2 and 3, or 0-1 and 2-3) at least d apart on some axis
+ * over the positions p0 and p1 (and so over every position between, points moving on lines)?
+ * Then their distance is at least d meanwhile. */
+static int apart_on_an_axis(int kind, const double (*p0)[3], const double (*p1)[3], double d)
 {
     int split = kind == 0 ? 3 : 2;
     for (int c = 0; c < 3; c++) {
         double alo = INFINITY, ahi = -INFINITY, blo = INFINITY, bhi = -INFINITY;
         for (int i = 0; i < 4; i++) {
-            double v = p[i][c];
-            if (i < split) { alo = fmin(alo, v); ahi = fmax(ahi, v); }
-            else { blo = fmin(blo, v); bhi = fmax(bhi, v); }
+            double u = p0[i][c], w = p1[i][c], lo = u < w ? u : w, hi = u < w ? w : u;
+            double *plo = i < split ? &alo : &blo, *phi = i < split ? &ahi : &bhi;
+            if (lo < *plo) *plo = lo;
+            if (hi > *phi) *phi = hi;
         }
         if (blo - ahi >= d || alo - bhi >= d) return 1;
     }
@@ -175,6 +177,10 @@ static double time_of_impact(int kind, const double *const s[4], const double *c
     for (int i = 0; i + 1 < nc; i++) {
         double a = cuts[i], b = cuts[i + 1], fa = cubic(k, a), fb = cubic(k, b);
         if (fa != 0 && fb != 0 && (fa > 0) == (fb > 0)) continue;
+        /* No contact possible in [a, b] when the parts stay apart by more than tol. */
+        double qa[4][3], qb[4][3];
+        for (int j = 0; j < 4; j++) { lerp3(qa[j], s[j], e[j], a); lerp3(qb[j], s[j], e[j], b); }
+        if (apart_on_an_axis(kind, (const double (*)[3])qa, (const double (*)[3])qb, 1.0000001 * tol)) continue;
         double t = a;
         if (fa == 0) t = a;
         else if (fb == 0) t = b;
@@ -270,7 +276,10 @@ static void test_pair(collide_ctx *c, int kind, const uint32_t idx[4], int round
     double t = time_of_impact(kind, s, e, c->tol);
     if (t < 0 && c->thickness > 0) {
         double th2 = c->thickness * c->thickness;
-        if (!apart_on_an_axis(kind, e, c->thickness) && pair_distance2(kind, s, e, 1) < th2 && pair_distance2(kind, s, e, 0) >= th2)
+        double end[4][3];
+        for (int i = 0; i < 4; i++) memcpy(end[i], e[i], sizeof end[i]);
+        if (!apart_on_an_axis(kind, (const double (*)[3])end, (const double (*)[3])end, c->thickness) &&
+            pair_distance2(kind, s, e, 1) < th2 && pair_distance2(kind, s, e, 0) >= th2)
             t = 1;
     }
     if (t < 0) return;
