@@ -242,6 +242,12 @@ static void volume_falls_monotonically_and_bending_resists(void)
         printf("%u triangles:\n", m.tri_count);
         print_curve("  kB = 0.01", &soft);
         CHECK_EQ_INT(soft.frames, 100);
+        /* Automatic substeps: omega dt = 1.9 and 6.0 (h omega <= sqrt(5)); a set count is kept. */
+        printf("  omega dt = %.3f: %u substeps\n", p.dt * shell_membrane_frequency(&m, &p), soft.substeps);
+        CHECK_EQ_INT(soft.substeps, large ? 3 : 1);
+        shell_params fixed = p;
+        fixed.substeps = 7;
+        CHECK_EQ_INT(shell_substeps(&m, &fixed), 7);
         uint32_t rises = 0;
         for (uint32_t f = 1; f <= soft.frames; f++)
             if (!(soft.stats[f].volume_ratio < soft.stats[f - 1].volume_ratio)) rises++;
