@@ -21,7 +21,6 @@
  * rounds retest round 0's candidates that have a vertex moved in the round before, without a
  * broad phase. */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 #include "shell.h"
 #include "bake_util.h"
