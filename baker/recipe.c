@@ -50,8 +50,8 @@ static const char *const op_fields[][20] = {
     [OP_FFD_PRISM] = { "sides", "section", "degree", "layers", "axis", "center", "range", "radius", "reference",
                        "padding", "rest_moves", "moves", NULL },
     [OP_TRANSFER] = { "source", "source_mesh", "channels", "markers", "prefix", NULL },
-    [OP_SHELL] = { "pressure", "ramp", "dt", "frames", "iterations", "density", "damping", "material", "mu", "lambda", "kB",
-                   "anisotropic", "thickness", "epsilon", "at_frames", "at_volume_ratios", "log", "clip", NULL },
+    [OP_SHELL] = { "pressure", "ramp", "dt", "frames", "iterations", "substeps", "density", "damping", "material", "mu",
+                   "lambda", "kB", "anisotropic", "thickness", "epsilon", "at_frames", "at_volume_ratios", "log", "clip", NULL },
 };
 
 /* Everything parsed for one channel before baking. */
@@ -1077,6 +1077,7 @@ static mk_result parse_shell(recipe_ctx *ctx, channel_plan *plan, const cJSON *c
     if ((r = get_positive(ctx, ch, path, "dt", &p->dt, 0, 1, INFINITY, "> 0 seconds")) != MK_OK) return r;
     if ((r = get_uint(ctx, ch, path, "frames", &p->frames, 1, untrusted(ctx) ? 200 : 100000)) != MK_OK) return r;
     if ((r = get_uint(ctx, ch, path, "iterations", &p->iterations, 1, untrusted(ctx) ? 20 : 1000)) != MK_OK) return r;
+    if ((r = get_uint(ctx, ch, path, "substeps", &p->substeps, 0, untrusted(ctx) ? SHELL_MAX_SUBSTEPS : 1000)) != MK_OK) return r;
     p->ramp = p->frames * p->dt;
     if ((r = get_positive(ctx, ch, path, "ramp", &p->ramp, 0, 0, INFINITY, ">= 0 seconds")) != MK_OK) return r;
     if ((r = get_positive(ctx, ch, path, "density", &p->density, 0, 1, INFINITY, "> 0")) != MK_OK) return r;

@@ -2,11 +2,12 @@
 /* Thin shell contracting under external pressure: a position-based dynamics simulation
  * (docs/baking.md, "shell"). Internal to baker/.
  *
- * Everything works on the position-welded mesh in double precision. Per frame: symplectic Euler
- * prediction under the pressure force, a few nonlinear Gauss-Seidel sweeps projecting the
- * elastic, bending and anisotropic energies as XPBD constraints C = sqrt(2 W) with compliance 1
- * (so that (1/2) C^2 is the energy W itself), continuous collision handling, velocities from
- * positions.
+ * Everything works on the position-welded mesh in double precision. Per substep (a frame has
+ * enough of them for the sweeps to carry the membrane's stress across the mesh, shell_steps.c):
+ * symplectic Euler prediction under the pressure force, a few nonlinear Gauss-Seidel sweeps
+ * projecting the elastic, bending and anisotropic energies as XPBD constraints C = sqrt(2 W) with
+ * compliance 1 (so that (1/2) C^2 is the energy W itself), velocities from positions. Per frame:
+ * continuous collision handling over the frame's motion.
  *
  * The element energies are pure functions of positions (shell_elastic.c, shell_bending.c,
  * shell_aniso.c) returning W and its gradient, so tests compare them with finite differences.
@@ -72,6 +73,7 @@ typedef struct shell_mesh {
     double *hinge_K;          /* 4 per hinge */
     double *hinge_scale;      /* 3 / (A0 + A1) */
     double *hinge_rest;       /* |sum K_j X_j| at rest */
+    uint32_t *hinge_tri;      /* a triangle with the edge x0 x1 and the vertex x2 */
     double *inv_mass;         /* per welded vertex */
     double volume0;
 } shell_mesh;
@@ -91,7 +93,8 @@ typedef struct shell_params {
     double ramp;              /* seconds over which the pressure rises linearly from 0 to P (0: at once) */
     double dt;                /* seconds per frame */
     uint32_t frames;          /* frame limit */
-    uint32_t iterations;      /* Gauss-Seidel sweeps per frame */
+    uint32_t iterations;      /* Gauss-Seidel sweeps per substep */
+    uint32_t substeps;        /* substeps per frame; 0: shell_substeps chooses */
     double density;           /* mass per unit area */
     double damping;           /* velocities scaled by (1 - damping) each frame */
     shell_material material;
@@ -104,9 +107,20 @@ typedef struct shell_params {
     const unsigned char *aniso_region;
     shell_aniso_kind aniso_energy;
     double aniso_mu;          /* stiffness of the anisotropic energy */
-    double aniso_kA;          /* inward normal force on region vertices */
+    double aniso_kA;          /* inward pressure on region vertices (force k_A times the vertex's rest area) */
     double aniso_direction[3];/* fibre direction (world), projected into each triangle */
 } shell_params;
+
+/* Upper limit of the automatic substep count. */
+#define SHELL_MAX_SUBSTEPS 64
+
+/* Area-weighted mean over the triangles of their natural in-plane frequency (rad/s), from the
+ * membrane's (and the anisotropic region's) stiffness, the rest areas and the lumped masses
+ * (shell_steps.c). */
+double shell_membrane_frequency(const shell_mesh *m, const shell_params *p);
+/* p->substeps if set, else the fewest substeps h = dt / n with h omega <= sqrt(iterations)
+ * (omega from shell_membrane_frequency), at most SHELL_MAX_SUBSTEPS. */
+uint32_t shell_substeps(const shell_mesh *m, const shell_params *p);
 
 /* What one frame measured (the log). */
 typedef struct shell_frame_stats {
@@ -120,6 +134,7 @@ typedef struct shell_frame_stats {
 
 typedef struct shell_run {
     uint32_t frames;          /* frames simulated (the last one is frames) */
+    uint32_t substeps;        /* substeps per frame used */
     float *positions;         /* (frames + 1) * 3n floats: frame f at 3 n f (frame 0 = rest) */
     shell_frame_stats *stats; /* frames + 1 entries (entry 0: the rest state) */
     int stopped_by_epsilon;
@@ -130,12 +145,17 @@ mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *a
                          void (*progress)(void *user, double fraction), void *user, shell_run *run,
                          mk_error *err);
 
+/* Collision handling (shell_collide.c): the broad phase's hierarchy over the triangles, built
+ * once on the rest mesh and refitted every frame. NULL when out of memory. */
+typedef struct shell_collider shell_collider;
+shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena);
+
 /* Collision handling between the collision-free positions x and the new positions p: moves
  * colliding vertices back until no vertex-triangle or edge-edge pair crosses over the step and
  * no vertex is closer than thickness to a triangle it did not start closer to. Returns the hits
  * found (*vt, *ee) and rounds. */
-mk_result shell_collide(const shell_mesh *m, const double *x, double *p, double thickness, mk_arena *arena,
-                        uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err);
+mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *x, double *p, double thickness,
+                        mk_arena *arena, uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err);
 
 /* Writes the per-frame log as CSV (header line, then one line per frame). */
 int shell_write_log(FILE *f, const shell_run *run);

@@ -3,45 +3,30 @@
  * of collisions, contact and friction for cloth animation"): over a step every vertex moves on a
  * straight line x + t (p - x), t in [0, 1]. A vertex-triangle or edge-edge pair can only cross
  * when its four points are coplanar, which is a cubic in t; at each root in [0, 1] the pair is
- * checked for actual contact (distance within the tolerance). Broad phase: the swept boxes of
- * triangles and edges (inflated by the thickness) in a hashed uniform grid; pairs that share a
- * vertex are skipped. A pair that also ends closer than the thickness while it started farther
- * counts as a hit (a proximity test backing up the root finding).
+ * checked for actual contact (distance within the tolerance). A pair that also ends closer than
+ * the thickness while it started farther counts as a hit (a proximity test backing up the root
+ * finding).
+ *
+ * Broad phase: the swept boxes of vertices, edges and triangles (inflated by the thickness). A
+ * hierarchy over the triangles' boxes, built once on the rest mesh and refitted every step
+ * (shell_bvh.c), yields the pairs of triangles whose boxes overlap in one traversal of the tree
+ * against itself. Every vertex and every edge is owned by one of its triangles, whose box holds
+ * its own, so the vertex-triangle and edge-edge pairs whose boxes overlap are among those of
+ * owners that overlap, each met once. Pairs that share a vertex are skipped.
  *
  * Response: the vertices of a hit are moved back to 0.8 of their time of impact; hits that
  * remain after that are moved back to the start of the step (which was free of intersections),
- * round after round, so the result never crosses itself within the tests' resolution. */
+ * round after round, so the result never crosses itself within the tests' resolution. A round
+ * only shortens steps along their lines, so its swept boxes lie inside round 0's: the later
+ * rounds retest round 0's candidates that have a vertex moved in the round before, without a
+ * broad phase. */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 #include "shell.h"
 #include "bake_util.h"
+#include "shell_bvh.h"
 
 #define MAX_ROUNDS 64
-
-typedef struct cell_entry {
-    uint64_t key;
-    uint32_t item;
-} cell_entry;
-
-typedef struct grid {
-    cell_entry *entries;
-    size_t count, capacity;
-    double cell;
-    mk_arena *arena;
-} grid;
-
-static int compare_entries(const void *pa, const void *pb)
-{
-    const cell_entry *a = pa, *b = pb;
-    if (a->key != b->key) return a->key < b->key ? -1 : 1;
-    return a->item < b->item ? -1 : a->item > b->item;
-}
-
-static uint64_t cell_key(int64_t i, int64_t j, int64_t k)
-{
-    return ((uint64_t)(i & 0x1fffff) << 42) | ((uint64_t)(j & 0x1fffff) << 21) | (uint64_t)(k & 0x1fffff);
-}
 
 /* Box of the points idx[0..k) over the step (start x, end p), inflated by pad. */
 static void swept_box(const double *x, const double *p, const uint32_t *idx, int k, double pad, double lo[3], double hi[3])
@@ -55,35 +40,6 @@ static void swept_box(const double *x, const double *p, const uint32_t *idx, int
             if (h > hi[c]) hi[c] = h;
         }
     for (int c = 0; c < 3; c++) { lo[c] -= pad; hi[c] += pad; }
-}
-
-static int grid_add(grid *g, const double lo[3], const double hi[3], uint32_t item)
-{
-    int64_t a[3], b[3];
-    for (int c = 0; c < 3; c++) { a[c] = (int64_t)floor(lo[c] / g->cell); b[c] = (int64_t)floor(hi[c] / g->cell); }
-    for (int64_t i = a[0]; i <= b[0]; i++)
-        for (int64_t j = a[1]; j <= b[1]; j++)
-            for (int64_t k = a[2]; k <= b[2]; k++) {
-                if (g->count == g->capacity) {
-                    size_t nc = g->capacity ? 2 * g->capacity : 1024;
-                    cell_entry *ne = mk_arena_realloc(g->arena, g->entries, g->capacity * sizeof *ne, nc * sizeof *ne);
-                    if (!ne) return 0;
-                    g->entries = ne;
-                    g->capacity = nc;
-                }
-                g->entries[g->count++] = (cell_entry){ cell_key(i, j, k), item };
-            }
-    return 1;
-}
-
-static size_t lower_bound(const grid *g, uint64_t key)
-{
-    size_t lo = 0, hi = g->count;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (g->entries[mid].key < key) lo = mid + 1; else hi = mid;
-    }
-    return lo;
 }
 
 /* ---- narrow phase ---- */
@@ -165,6 +121,25 @@ static double pair_distance2(int kind, const double *const s[4], const double *c
     return kind == 0 ? point_triangle_distance2(q[3], q[0], q[1], q[2]) : segment_distance2(q[0], q[1], q[2], q[3]);
 }
 
+/* Are the pair's two parts (points 0-2 and 3, or 0-1 and 2-3) at least d apart on some axis
+ * over the positions p0 and p1 (and so over every position between, points moving on lines)?
+ * Then their distance is at least d meanwhile. */
+static int apart_on_an_axis(int kind, const double (*p0)[3], const double (*p1)[3], double d)
+{
+    int split = kind == 0 ? 3 : 2;
+    for (int c = 0; c < 3; c++) {
+        double alo = INFINITY, ahi = -INFINITY, blo = INFINITY, bhi = -INFINITY;
+        for (int i = 0; i < 4; i++) {
+            double u = p0[i][c], w = p1[i][c], lo = u < w ? u : w, hi = u < w ? w : u;
+            double *plo = i < split ? &alo : &blo, *phi = i < split ? &ahi : &bhi;
+            if (lo < *plo) *plo = lo;
+            if (hi > *phi) *phi = hi;
+        }
+        if (blo - ahi >= d || alo - bhi >= d) return 1;
+    }
+    return 0;
+}
+
 static double cubic(const double k[4], double t) { return ((k[3] * t + k[2]) * t + k[1]) * t + k[0]; }
 
 /* Earliest time in [0, 1] at which the pair touches (within tol), or -1. */
@@ -201,6 +176,10 @@ static double time_of_impact(int kind, const double *const s[4], const double *c
     for (int i = 0; i + 1 < nc; i++) {
         double a = cuts[i], b = cuts[i + 1], fa = cubic(k, a), fb = cubic(k, b);
         if (fa != 0 && fb != 0 && (fa > 0) == (fb > 0)) continue;
+        /* No contact possible in [a, b] when the parts stay apart by more than tol. */
+        double qa[4][3], qb[4][3];
+        for (int j = 0; j < 4; j++) { lerp3(qa[j], s[j], e[j], a); lerp3(qb[j], s[j], e[j], b); }
+        if (apart_on_an_axis(kind, (const double (*)[3])qa, (const double (*)[3])qb, 1.0000001 * tol)) continue;
         double t = a;
         if (fa == 0) t = a;
         else if (fb == 0) t = b;
@@ -216,16 +195,72 @@ static double time_of_impact(int kind, const double *const s[4], const double *c
     return -1;
 }
 
+struct shell_collider {
+    shell_bvh tree;           /* over the triangles' boxes */
+    double *tri_boxes;        /* 6 per triangle: this step's swept boxes, inflated */
+    double *vertex_boxes;     /* 6 per vertex */
+    double *edge_boxes;       /* 6 per edge */
+    /* Every vertex and edge belongs to one of its triangles, whose box holds its own: the
+     * vertices of triangle t are owned_vertices[vertex_start[t] .. vertex_start[t + 1]), its
+     * edges likewise. */
+    uint32_t *vertex_start, *owned_vertices, *edge_start, *owned_edges;
+};
+
+/* Lists items[0..n) by owner (counting sort): start[owner .. owner + 1) in list. */
+static void group_by_owner(const uint32_t *owner, uint32_t n, uint32_t owners, uint32_t *start, uint32_t *list)
+{
+    memset(start, 0, ((size_t)owners + 1) * sizeof(uint32_t));
+    for (uint32_t i = 0; i < n; i++) start[owner[i] + 1]++;
+    for (uint32_t t = 0; t < owners; t++) start[t + 1] += start[t];
+    for (uint32_t i = 0; i < n; i++) list[start[owner[i]]++] = i;
+    for (uint32_t t = owners; t > 0; t--) start[t] = start[t - 1];
+    start[0] = 0;
+}
+
+shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena)
+{
+    shell_collider *c = mk_arena_array(arena, 1, sizeof *c);
+    if (!c) return NULL;
+    c->tri_boxes = mk_arena_array(arena, 6 * (size_t)m->tri_count, sizeof(double));
+    c->vertex_boxes = mk_arena_array(arena, 6 * (size_t)m->n, sizeof(double));
+    c->edge_boxes = mk_arena_array(arena, 6 * (size_t)m->hinge_count + 6, sizeof(double));
+    c->vertex_start = mk_arena_array(arena, (size_t)m->tri_count + 1, sizeof(uint32_t));
+    c->edge_start = mk_arena_array(arena, (size_t)m->tri_count + 1, sizeof(uint32_t));
+    c->owned_vertices = mk_arena_array(arena, m->n, sizeof(uint32_t));
+    c->owned_edges = mk_arena_array(arena, (size_t)m->hinge_count + 1, sizeof(uint32_t));
+    uint32_t *owner = mk_arena_array(arena, (size_t)m->n + 1, sizeof(uint32_t));
+    if (!c->tri_boxes || !c->vertex_boxes || !c->edge_boxes || !c->vertex_start || !c->edge_start || !c->owned_vertices ||
+        !c->owned_edges || !owner)
+        return NULL;
+    /* A vertex's owner: its first triangle. */
+    for (uint32_t v = 0; v < m->n; v++) owner[v] = UINT32_MAX;
+    for (uint32_t t = m->tri_count; t-- > 0;)
+        for (int k = 0; k < 3; k++) owner[m->tris[3 * (size_t)t + k]] = t;
+    group_by_owner(owner, m->n, m->tri_count, c->vertex_start, c->owned_vertices);
+    group_by_owner(m->hinge_tri, m->hinge_count, m->tri_count, c->edge_start, c->owned_edges);
+    mk_arena_release(arena, owner);
+    /* The hierarchy's shape from the rest mesh (neighbours on the surface stay neighbours). */
+    for (uint32_t t = 0; t < m->tri_count; t++)
+        swept_box(m->rest, m->rest, m->tris + 3 * (size_t)t, 3, 0, c->tri_boxes + 6 * (size_t)t, c->tri_boxes + 6 * (size_t)t + 3);
+    if (!shell_bvh_build(&c->tree, c->tri_boxes, m->tri_count, arena)) return NULL;
+    return c;
+}
+
 typedef struct collide_ctx {
     const shell_mesh *m;
+    const shell_collider *col;
     const double *x;
     double *p;
     double thickness, tol;
     double *scale;            /* per vertex: fraction of its step kept this round (1: untouched) */
-    uint32_t *stamp;          /* per triangle or edge: query + 1 of the last visit */
     unsigned char *moved;     /* per vertex: pulled back in the previous round */
-    double *boxes[2];         /* this round's swept boxes (lo, hi: 6 doubles) of triangles, edges */
     uint32_t vt, ee;
+    /* Round 0's candidates (pairs whose swept boxes overlap), 2 per pair: triangle and vertex,
+     * or edge and edge. */
+    uint32_t *pairs[2];
+    size_t pair_count[2], pair_capacity[2];
+    mk_arena *arena;
+    int oom;
 } collide_ctx;
 
 /* One pair: on a hit, the four vertices keep at most 0.8 of the time of impact (round 0) or
@@ -240,7 +275,11 @@ static void test_pair(collide_ctx *c, int kind, const uint32_t idx[4], int round
     double t = time_of_impact(kind, s, e, c->tol);
     if (t < 0 && c->thickness > 0) {
         double th2 = c->thickness * c->thickness;
-        if (pair_distance2(kind, s, e, 1) < th2 && pair_distance2(kind, s, e, 0) >= th2) t = 1;
+        double end[4][3];
+        for (int i = 0; i < 4; i++) memcpy(end[i], e[i], sizeof end[i]);
+        if (!apart_on_an_axis(kind, (const double (*)[3])end, (const double (*)[3])end, c->thickness) &&
+            pair_distance2(kind, s, e, 1) < th2 && pair_distance2(kind, s, e, 0) >= th2)
+            t = 1;
     }
     if (t < 0) return;
     if (kind == 0) c->vt++; else c->ee++;
@@ -249,88 +288,120 @@ static void test_pair(collide_ctx *c, int kind, const uint32_t idx[4], int round
         if (keep < c->scale[idx[i]]) c->scale[idx[i]] = keep;
 }
 
-/* The candidates of one query item (kind 0: vertex `query` against the triangles of g; 1: edge
- * `query` against the edges of g with a larger index) whose swept boxes overlap, each once
- * (c->stamp), without pairs that share a vertex; each goes to test_pair. */
-static void visit_cells(collide_ctx *c, const grid *g, int kind, uint32_t query, int round)
+/* The four vertices of a candidate: triangle then vertex (kind 0), or edge then edge (kind 1). */
+static void pair_vertices(const shell_mesh *m, int kind, uint32_t a, uint32_t b, uint32_t idx[4])
 {
-    const shell_mesh *m = c->m;
-    const uint32_t *qa = kind == 0 ? &query : m->hinges + 4 * (size_t)query;
-    double lo[3], hi[3];
-    swept_box(c->x, c->p, qa, kind == 0 ? 1 : 2, c->thickness, lo, hi);
-    int64_t a[3], b[3];
-    for (int k = 0; k < 3; k++) { a[k] = (int64_t)floor(lo[k] / g->cell); b[k] = (int64_t)floor(hi[k] / g->cell); }
-    for (int64_t i = a[0]; i <= b[0]; i++)
-        for (int64_t j = a[1]; j <= b[1]; j++)
-            for (int64_t k = a[2]; k <= b[2]; k++) {
-                uint64_t key = cell_key(i, j, k);
-                for (size_t q = lower_bound(g, key); q < g->count && g->entries[q].key == key; q++) {
-                    uint32_t item = g->entries[q].item;
-                    if ((kind == 1 && item <= query) || c->stamp[item] == query + 1) continue;
-                    c->stamp[item] = query + 1;
-                    const uint32_t *ib = kind == 0 ? m->tris + 3 * (size_t)item : m->hinges + 4 * (size_t)item;
-                    int nb = kind == 0 ? 3 : 2, shared = 0;
-                    for (int u = 0; u < (kind == 0 ? 1 : 2); u++)
-                        for (int w = 0; w < nb; w++) shared |= qa[u] == ib[w];
-                    if (shared) continue;
-                    const double *blo = c->boxes[kind] + 6 * (size_t)item, *bhi = blo + 3;
-                    if (blo[0] > hi[0] || bhi[0] < lo[0] || blo[1] > hi[1] || bhi[1] < lo[1] || blo[2] > hi[2] || bhi[2] < lo[2])
-                        continue;
-                    uint32_t idx[4];
-                    if (kind == 0) { idx[0] = ib[0]; idx[1] = ib[1]; idx[2] = ib[2]; idx[3] = query; }
-                    else { idx[0] = qa[0]; idx[1] = qa[1]; idx[2] = ib[0]; idx[3] = ib[1]; }
-                    test_pair(c, kind, idx, round);
-                }
-            }
+    if (kind == 0) {
+        const uint32_t *t = m->tris + 3 * (size_t)a;
+        idx[0] = t[0]; idx[1] = t[1]; idx[2] = t[2]; idx[3] = b;
+    } else {
+        const uint32_t *e = m->hinges + 4 * (size_t)a, *f = m->hinges + 4 * (size_t)b;
+        idx[0] = e[0]; idx[1] = e[1]; idx[2] = f[0]; idx[3] = f[1];
+    }
 }
 
-mk_result shell_collide(const shell_mesh *m, const double *x, double *p, double thickness, mk_arena *arena,
-                        uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err)
+static int boxes_overlap(const double *a, const double *b)
+{
+    return !(a[0] > b[3] || a[3] < b[0] || a[1] > b[4] || a[4] < b[1] || a[2] > b[5] || a[5] < b[2]);
+}
+
+/* Round 0 meets a pair whose boxes overlap: unless the two share a vertex, it is kept for the
+ * later rounds and tested. */
+static void add_candidate(collide_ctx *c, int kind, uint32_t a, uint32_t b)
+{
+    if (kind == 1 && b < a) { uint32_t t = a; a = b; b = t; }  /* the smaller edge first: the same rounding either way round */
+    uint32_t idx[4];
+    pair_vertices(c->m, kind, a, b, idx);
+    if (kind == 0 ? (idx[3] == idx[0] || idx[3] == idx[1] || idx[3] == idx[2])
+                  : (idx[0] == idx[2] || idx[0] == idx[3] || idx[1] == idx[2] || idx[1] == idx[3]))
+        return;
+    if (c->pair_count[kind] == c->pair_capacity[kind]) {
+        size_t nc = c->pair_capacity[kind] ? 2 * c->pair_capacity[kind] : 4096;
+        uint32_t *np = mk_arena_realloc(c->arena, c->pairs[kind], 2 * c->pair_capacity[kind] * sizeof *np, 2 * nc * sizeof *np);
+        if (!np) { c->oom = 1; return; }
+        c->pairs[kind] = np;
+        c->pair_capacity[kind] = nc;
+    }
+    c->pairs[kind][2 * c->pair_count[kind]] = a;
+    c->pairs[kind][2 * c->pair_count[kind] + 1] = b;
+    c->pair_count[kind]++;
+    test_pair(c, kind, idx, 0);
+}
+
+/* The vertices owned by triangle u against triangle t. */
+static void owned_vertices_against(collide_ctx *c, uint32_t u, uint32_t t)
+{
+    const shell_collider *col = c->col;
+    const double *tb = col->tri_boxes + 6 * (size_t)t;
+    for (uint32_t i = col->vertex_start[u]; i < col->vertex_start[u + 1]; i++) {
+        uint32_t v = col->owned_vertices[i];
+        if (boxes_overlap(col->vertex_boxes + 6 * (size_t)v, tb)) add_candidate(c, 0, t, v);
+    }
+}
+
+/* Two triangles whose boxes overlap (possibly the same one): every vertex-triangle and edge-edge
+ * pair whose vertex or edges they own. Each candidate is met once: a vertex's box lies in its
+ * owner's, an edge's in its owner's. */
+static void visit_triangles(void *user, uint32_t t, uint32_t u)
+{
+    collide_ctx *c = user;
+    const shell_collider *col = c->col;
+    owned_vertices_against(c, u, t);
+    if (t != u) owned_vertices_against(c, t, u);
+    for (uint32_t i = col->edge_start[t]; i < col->edge_start[t + 1]; i++) {
+        uint32_t e = col->owned_edges[i];
+        const double *eb = col->edge_boxes + 6 * (size_t)e;
+        for (uint32_t j = t == u ? i + 1 : col->edge_start[u]; j < col->edge_start[u + 1]; j++) {
+            uint32_t f = col->owned_edges[j];
+            if (boxes_overlap(eb, col->edge_boxes + 6 * (size_t)f)) add_candidate(c, 1, e, f);
+        }
+    }
+}
+
+mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *x, double *p, double thickness,
+                        mk_arena *arena, uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err)
 {
     *vt = *ee = *rounds = 0;
     mk_arena local;
     mk_arena_init(&local, &arena->allocator);
     double *scale = mk_arena_array(&local, m->n, sizeof(double));
-    uint32_t *stamp = mk_arena_array(&local, (size_t)m->tri_count + m->hinge_count, sizeof(uint32_t));
     unsigned char *moved = mk_arena_array(&local, m->n, 1);
-    double *tri_boxes = mk_arena_array(&local, 6 * (size_t)m->tri_count, sizeof(double));
-    double *edge_boxes = mk_arena_array(&local, 6 * (size_t)m->hinge_count, sizeof(double));
-    mk_result r = MK_OK;
-    if (!scale || !stamp || !moved || !tri_boxes || !edge_boxes) { mk_arena_free_all(&local); return mk_error_oom(err, "shell collisions"); }
-    /* Cell size: the mean edge length at the step's start. */
+    if (!scale || !moved) { mk_arena_free_all(&local); return mk_error_oom(err, "shell collisions"); }
+    /* Contact tolerance: the thickness, at least 1e-9 of the mean edge length at the step's start. */
     double mean = 0;
     for (uint32_t h = 0; h < m->hinge_count; h++) {
         double d[3];
         vec3_sub(d, x + 3 * (size_t)m->hinges[4 * (size_t)h], x + 3 * (size_t)m->hinges[4 * (size_t)h + 1]);
         mean += vec3_length(d) / m->hinge_count;
     }
-    collide_ctx c = { m, x, p, thickness, fmax(thickness, 1e-9 * mean), scale, stamp, moved, { tri_boxes, edge_boxes }, 0, 0 };
+    collide_ctx c;
+    memset(&c, 0, sizeof c);
+    c.m = m; c.col = col; c.x = x; c.p = p; c.thickness = thickness; c.tol = fmax(thickness, 1e-9 * mean);
+    c.scale = scale; c.moved = moved; c.arena = &local;
+    /* Broad phase, once: later rounds only pull vertices back along their steps, so their swept
+     * boxes lie inside round 0's and round 0's candidates are all the pairs that can meet. */
+    for (uint32_t t = 0; t < m->tri_count; t++)
+        swept_box(x, p, m->tris + 3 * (size_t)t, 3, thickness, col->tri_boxes + 6 * (size_t)t, col->tri_boxes + 6 * (size_t)t + 3);
+    for (uint32_t v = 0; v < m->n; v++)
+        swept_box(x, p, &v, 1, thickness, col->vertex_boxes + 6 * (size_t)v, col->vertex_boxes + 6 * (size_t)v + 3);
+    for (uint32_t h = 0; h < m->hinge_count; h++)
+        swept_box(x, p, m->hinges + 4 * (size_t)h, 2, thickness, col->edge_boxes + 6 * (size_t)h, col->edge_boxes + 6 * (size_t)h + 3);
+    shell_bvh_refit(&col->tree);
     for (int round = 0; round < MAX_ROUNDS; round++) {
-        grid tg = { NULL, 0, 0, fmax(2 * mean, 4 * thickness), &local }, eg = tg;
-        int ok = 1;
-        for (uint32_t t = 0; t < m->tri_count && ok; t++) {
-            double *box = c.boxes[0] + 6 * (size_t)t;
-            swept_box(x, p, m->tris + 3 * (size_t)t, 3, thickness, box, box + 3);
-            ok = grid_add(&tg, box, box + 3, t);
-        }
-        for (uint32_t h = 0; h < m->hinge_count && ok; h++) {
-            double *box = c.boxes[1] + 6 * (size_t)h;
-            swept_box(x, p, m->hinges + 4 * (size_t)h, 2, thickness, box, box + 3);
-            ok = grid_add(&eg, box, box + 3, h);
-        }
-        if (!ok) { r = mk_error_oom(err, "shell collisions"); break; }
-        qsort(tg.entries, tg.count, sizeof *tg.entries, compare_entries);
-        qsort(eg.entries, eg.count, sizeof *eg.entries, compare_entries);
         for (uint32_t v = 0; v < m->n; v++) scale[v] = 1;
-        memset(stamp, 0, ((size_t)m->tri_count + m->hinge_count) * sizeof(uint32_t));
         uint32_t before = c.vt + c.ee;
-        /* Vertex against triangle, then edge against edge (each unordered pair once). */
-        for (uint32_t v = 0; v < m->n; v++) visit_cells(&c, &tg, 0, v, round);
-        memset(stamp, 0, ((size_t)m->tri_count + m->hinge_count) * sizeof(uint32_t));
-        for (uint32_t e = 0; e < m->hinge_count; e++) visit_cells(&c, &eg, 1, e, round);
+        if (round == 0) {
+            shell_bvh_self_pairs(&col->tree, visit_triangles, &c);
+            if (c.oom) { mk_arena_free_all(&local); return mk_error_oom(err, "shell collisions (candidate pairs)"); }
+        } else {
+            for (int kind = 0; kind < 2; kind++)
+                for (size_t i = 0; i < c.pair_count[kind]; i++) {
+                    uint32_t idx[4];
+                    pair_vertices(m, kind, c.pairs[kind][2 * i], c.pairs[kind][2 * i + 1], idx);
+                    test_pair(&c, kind, idx, round);
+                }
+        }
         *rounds = (uint32_t)round + 1;
-        mk_arena_release(&local, tg.entries);
-        mk_arena_release(&local, eg.entries);
         if (c.vt + c.ee == before) break;
         /* Response: pull the hit vertices back along their step. */
         for (uint32_t v = 0; v < m->n; v++) {
@@ -346,5 +417,5 @@ mk_result shell_collide(const shell_mesh *m, const double *x, double *p, double 
     *vt = c.vt;
     *ee = c.ee;
     mk_arena_free_all(&local);
-    return r;
+    return MK_OK;
 }

@@ -129,7 +129,8 @@ mk_result shell_mesh_build(const mk_raw_mesh *mesh, double density, mk_arena *ar
     m->hinge_K = mk_arena_array(arena, 4 * edges, sizeof(double));
     m->hinge_scale = mk_arena_array(arena, edges, sizeof(double));
     m->hinge_rest = mk_arena_array(arena, edges, sizeof(double));
-    if (!m->hinges || !m->hinge_K || !m->hinge_scale || !m->hinge_rest) return mk_error_oom(err, "shell hinges");
+    m->hinge_tri = mk_arena_array(arena, edges, sizeof(uint32_t));
+    if (!m->hinges || !m->hinge_K || !m->hinge_scale || !m->hinge_rest || !m->hinge_tri) return mk_error_oom(err, "shell hinges");
     for (size_t i = 0; i < 3 * (size_t)nt;) {
         size_t j = i;
         while (j < 3 * (size_t)nt && he[j].lo == he[i].lo && he[j].hi == he[i].hi) j++;
@@ -141,6 +142,7 @@ mk_result shell_mesh_build(const mk_raw_mesh *mesh, double density, mk_arena *ar
         uint32_t h = m->hinge_count++;
         uint32_t *q = m->hinges + 4 * (size_t)h;
         q[0] = he[i].lo; q[1] = he[i].hi; q[2] = he[i].opposite; q[3] = he[i + 1].opposite;
+        m->hinge_tri[h] = he[i].tri;
         const double *x0 = m->rest + 3 * (size_t)q[0], *x1 = m->rest + 3 * (size_t)q[1];
         const double *x2 = m->rest + 3 * (size_t)q[2], *x3 = m->rest + 3 * (size_t)q[3];
         double e0[3], e1[3], e2[3], e3[3], e4[3], me0[3];

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
-/* The frame loop of the shell simulation (shell.h): prediction under pressure, Gauss-Seidel
- * sweeps over the energy constraints (XPBD, C = sqrt(2 W), compliance 1), collision handling,
- * velocities from positions, and the per-frame record. Single-threaded and in a fixed order, so
+/* The frame loop of the shell simulation (shell.h): per substep (shell_steps.c) prediction under
+ * pressure, Gauss-Seidel sweeps over the energy constraints (XPBD, C = sqrt(2 W), compliance 1)
+ * and velocities from positions; per frame collision handling over the frame's motion and the
+ * per-frame record. Single-threaded and in a fixed order, so
  * a run is reproducible bit for bit. */
 #include <math.h>
 #include <string.h>
@@ -129,10 +130,12 @@ mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *a
     double *q = mk_arena_array(arena, n3, sizeof(double));
     double *grad = mk_arena_array(arena, n3, sizeof(double));
     double *normals = mk_arena_array(arena, n3, sizeof(double));
+    double *xs = mk_arena_array(arena, n3, sizeof(double));
     s.lambda = mk_arena_array(arena, (size_t)m->tri_count + m->hinge_count + s.aniso_count + 1, sizeof(double));
     run->positions = mk_arena_array(arena, n3 * ((size_t)p->frames + 1), sizeof(float));
     run->stats = mk_arena_array(arena, (size_t)p->frames + 1, sizeof(shell_frame_stats));
-    if (!x || !v || !q || !grad || !normals || !s.lambda || !run->positions || !run->stats)
+    shell_collider *collider = p->thickness > 0 ? shell_collider_create(m, arena) : NULL;
+    if (!x || !v || !q || !xs || !grad || !normals || !s.lambda || !run->positions || !run->stats || (p->thickness > 0 && !collider))
         return mk_error_oom(err, "shell simulation (positions of every frame)");
     memcpy(x, m->rest, n3 * sizeof(double));
     memset(v, 0, n3 * sizeof(double));
@@ -140,47 +143,65 @@ mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *a
     double energy[3];
     sweep(&s, x, -1, energy);
     run->stats[0] = (shell_frame_stats){ .volume_ratio = 1, .membrane = energy[0], .bending = energy[1], .aniso = energy[2] };
-    double alpha = 1 / (p->dt * p->dt);
+    uint32_t substeps = run->substeps = shell_substeps(m, p);
+    double h = p->dt / substeps, alpha = 1 / (h * h), keep = pow(1 - p->damping, 1.0 / substeps);
     size_t nlambda = (size_t)m->tri_count + m->hinge_count + s.aniso_count;
     shell_volume(m, x, grad);   /* then at the end of every frame, for the next one */
     for (uint32_t f = 1; f <= p->frames; f++) {
         double t0 = bake_now();
         shell_frame_stats *st = &run->stats[f];
         memset(st, 0, sizeof *st);
-        /* Prediction: f_i = -P dV/dx_i (= -P sum over its triangles A_j n_j / 3), plus the
-         * inward push k_A on the region's vertices. */
-        double pressure = p->ramp > 0 && f * p->dt < p->ramp ? p->pressure * (f * p->dt) / p->ramp : p->pressure;
-        if (s.aniso_count && p->aniso_kA != 0) shell_vertex_normals(m, x, normals);
-        for (uint32_t i = 0; i < m->n; i++) {
-            double w = m->inv_mass[i];
-            for (int c = 0; c < 3; c++) {
-                size_t k = 3 * (size_t)i + (size_t)c;
-                double force = -pressure * grad[k];
-                if (s.aniso_count && p->aniso_kA != 0 && p->aniso_region[i]) force -= p->aniso_kA * normals[k];
-                v[k] = (1 - p->damping) * (v[k] + p->dt * w * force);
-                q[k] = x[k] + p->dt * v[k];
+        /* Substeps: prediction under the pressure force -P dV/dx_i (= -P sum over its triangles
+         * A_j n_j / 3) plus the inward push k_A on the region's vertices, then the sweeps, then
+         * velocities from positions. */
+        memcpy(xs, x, n3 * sizeof(double));
+        for (uint32_t sub = 1; sub <= substeps; sub++) {
+            double time = (f - 1) * p->dt + sub * h;
+            double pressure = p->ramp > 0 && time < p->ramp ? p->pressure * time / p->ramp : p->pressure;
+            if (sub > 1) shell_volume(m, xs, grad);
+            if (s.aniso_count && p->aniso_kA != 0) shell_vertex_normals(m, xs, normals);
+            for (uint32_t i = 0; i < m->n; i++) {
+                double w = m->inv_mass[i];
+                for (int c = 0; c < 3; c++) {
+                    size_t k = 3 * (size_t)i + (size_t)c;
+                    double force = -pressure * grad[k];
+                    /* k_A is a pressure: times the vertex's rest area (its mass / density). */
+                    if (s.aniso_count && p->aniso_kA != 0 && p->aniso_region[i])
+                        force -= p->aniso_kA * normals[k] / (p->density * w);
+                    v[k] = keep * (v[k] + h * w * force);
+                    q[k] = xs[k] + h * v[k];
+                }
+            }
+            if (s.aniso_count) {
+                shell_vertex_normals(m, q, normals);
+                update_signs(&s, q, normals);
+            }
+            memset(s.lambda, 0, nlambda * sizeof(double));
+            for (uint32_t it = 0; it < p->iterations; it++) sweep(&s, q, alpha, energy);
+            for (size_t k = 0; k < n3; k++) {
+                v[k] = (q[k] - xs[k]) / h;
+                xs[k] = q[k];
             }
         }
-        if (s.aniso_count) {
-            shell_vertex_normals(m, q, normals);
-            update_signs(&s, q, normals);
-        }
-        memset(s.lambda, 0, nlambda * sizeof(double));
-        for (uint32_t it = 0; it < p->iterations; it++) sweep(&s, q, alpha, energy);
         double tc = bake_now();
         if (p->thickness > 0) {
-            r = shell_collide(m, x, q, p->thickness, arena, &st->vt_hits, &st->ee_hits, &st->collision_rounds, err);
+            r = shell_collide(collider, m, x, q, p->thickness, arena, &st->vt_hits, &st->ee_hits, &st->collision_rounds, err);
             if (r != MK_OK) return r;
         }
         st->ms_collision = 1000 * (bake_now() - tc);
-        for (size_t k = 0; k < n3; k++) {
+        for (size_t k = 0; k < n3; k++)
             if (!isfinite(q[k]))
                 return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX,
                                     "the simulation diverged at frame %u (positions not finite): lower dt or pressure, "
                                     "or raise the stiffness", f);
-            v[k] = (q[k] - x[k]) / p->dt;
-            x[k] = q[k];
-            run->positions[n3 * f + k] = (float)x[k];
+        for (size_t k = 0; k < n3; k += 3) {
+            /* A vertex the collisions moved gets its mean velocity over the frame (inelastic). */
+            if (q[k] != xs[k] || q[k + 1] != xs[k + 1] || q[k + 2] != xs[k + 2])
+                for (size_t c = k; c < k + 3; c++) v[c] = (q[c] - x[c]) / p->dt;
+            for (size_t c = k; c < k + 3; c++) {
+                x[c] = q[c];
+                run->positions[n3 * f + c] = (float)x[c];
+            }
         }
         sweep(&s, x, -1, energy);
         st->time = f * p->dt;

@@ -9,9 +9,9 @@
  * iterations, plain to convergence and Anderson to convergence, and the time each run took to
  * come within 1 % of the reference energy.
  *
- * Shell: bench_baker shell SEGMENTS RINGS [THICKNESS [FRAMES [KB]]] (UV sphere of 2 x SEGMENTS x (RINGS - 1)
- * triangles; 100 51: 10 000, 250 101: 50 000): FRAMES (100) frames of the default shell recipe, ms per
- * frame and the collision part (THICKNESS > 0 turns collisions on). */
+ * Shell: bench_baker shell SEGMENTS RINGS [THICKNESS [FRAMES [KB [PRESSURE]]]] (UV sphere of 2 x SEGMENTS x
+ * (RINGS - 1) triangles; 100 51: 10 000, 250 101: 50 000): FRAMES (100) frames of the default shell recipe
+ * (pressure 20 ramped over 1 s), ms per frame and the collision part (THICKNESS > 0 turns collisions on). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -143,14 +143,14 @@ static int arap_convergence(uint32_t levels)
 
 /* The shell simulation on a UV sphere: ms per frame with and without collision handling, the
  * collision part separately (docs/performance.md). */
-static int shell_bench(uint32_t segments, uint32_t rings, double thickness, uint32_t frames, double kB)
+static int shell_bench(uint32_t segments, uint32_t rings, double thickness, uint32_t frames, double kB, double pressure)
 {
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_raw_mesh *mesh = fixture_sphere(&raw, "ball", 1, segments, rings);
     shell_params p;
     memset(&p, 0, sizeof p);
-    p.pressure = 20; p.dt = 0.01; p.frames = frames; p.ramp = 1; p.iterations = 5; p.density = 1; p.damping = 0.02;
+    p.pressure = pressure; p.dt = 0.01; p.frames = frames; p.ramp = 1; p.iterations = 5; p.density = 1; p.damping = 0.02;
     p.material = SHELL_STVK; p.mu = 100; p.lambda = 100; p.kB = kB; p.epsilon = 0.05; p.thickness = thickness;
     shell_mesh m;
     shell_run run;
@@ -170,10 +170,10 @@ static int shell_bench(uint32_t segments, uint32_t rings, double thickness, uint
         collision_ms += run.stats[f].ms_collision;
         hits += run.stats[f].vt_hits + run.stats[f].ee_hits;
     }
-    printf("shell: %u triangles, %u vertices, kB %g, thickness %g: setup %.1f ms; %u frames, %.2f ms per frame of which "
-           "collisions %.2f ms (%u hits, %.1f rounds per frame, at most %u); V/V0 after the run %.4f\n", m.tri_count, m.n,
-           kB, thickness, 1000 * (t1 - t0), run.frames, frame_ms / run.frames, collision_ms / run.frames, hits,
-           (double)rounds / run.frames, most, run.stats[run.frames].volume_ratio);
+    printf("shell: %u triangles, %u vertices, kB %g, P %g, thickness %g: setup %.1f ms; %u frames (%u substeps each), %.2f ms "
+           "per frame of which collisions %.2f ms (%u hits, %.1f rounds per frame, at most %u); V/V0 after the run %.4f\n",
+           m.tri_count, m.n, kB, pressure, thickness, 1000 * (t1 - t0), run.frames, run.substeps, frame_ms / run.frames,
+           collision_ms / run.frames, hits, (double)rounds / run.frames, most, run.stats[run.frames].volume_ratio);
     printf("  V/V0 at frames 0, 10, ...:");
     for (uint32_t f = 0; f <= run.frames; f += 10) printf(" %.4f", run.stats[f].volume_ratio);
     printf("; %u frames did not lower the volume\n", rises);
@@ -185,7 +185,8 @@ int main(int argc, char **argv)
 {
     if (argc >= 4 && !strcmp(argv[1], "shell"))
         return shell_bench((uint32_t)atoi(argv[2]), (uint32_t)atoi(argv[3]), argc > 4 ? atof(argv[4]) : 0,
-                           argc > 5 ? (uint32_t)atoi(argv[5]) : 100, argc > 6 ? atof(argv[6]) : 0.01);
+                           argc > 5 ? (uint32_t)atoi(argv[5]) : 100, argc > 6 ? atof(argv[6]) : 0.01,
+                           argc > 7 ? atof(argv[7]) : 20);
     if (argc == 3 && !strcmp(argv[1], "arap")) return arap_convergence((uint32_t)atoi(argv[2])) ? 1 : 0;
     uint32_t rings = 250, segments = 400;
     if (argc == 3) { rings = (uint32_t)atoi(argv[1]); segments = (uint32_t)atoi(argv[2]); }

@@ -1693,6 +1693,7 @@ static void bad_shell_recipes_name_the_field(void)
         { SHELL("\"kB\": 1e999"), "channels[0].kB: is not a finite number" },
         { SHELL("\"material\": \"rubber\""), "channels[0].material: must be \"stvk\"" },
         { SHELL("\"iterations\": 0"), "channels[0].iterations: must be an integer" },
+        { SHELL("\"substeps\": 1001"), "channels[0].substeps: must be an integer in 0..1000" },
         { SHELL("\"inbetweens\": 3"), "channels[0].inbetweens: is not used by shell" },
         { SHELL("\"at_frames\": [3, 2]"), "channels[0].at_frames: entry 1" },
         { SHELL("\"at_frames\": [6]"), "channels[0].at_frames: entry 0 must be a frame in 1..5" },

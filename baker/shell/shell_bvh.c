@@ -1,0 +1,178 @@
+/* SPDX-License-Identifier: MIT */
+/* The shell's box hierarchy (shell_bvh.h): top-down median splits, iterative traversal. */
+#include <math.h>
+#include "shell_bvh.h"
+#include "alloc.h"
+
+#define LEAF_SIZE 4
+#define STACK_SIZE 96
+
+/* Key of an item along an axis: its box centre (times 2), ties broken by the index. */
+static int key_less(const double *boxes, int axis, uint32_t a, uint32_t b)
+{
+    double ka = boxes[6 * (size_t)a + axis] + boxes[6 * (size_t)a + 3 + axis];
+    double kb = boxes[6 * (size_t)b + axis] + boxes[6 * (size_t)b + 3 + axis];
+    return ka < kb || (ka == kb && a < b);
+}
+
+/* Reorders items[0..n) so that items[k] is the k-th smallest by key, smaller ones before it and
+ * larger ones after (quickselect, median-of-three pivot). */
+static void select_kth(const double *boxes, int axis, uint32_t *items, uint32_t n, uint32_t k)
+{
+    uint32_t lo = 0, hi = n - 1;
+    while (hi > lo) {
+        uint32_t mid = lo + (hi - lo) / 2, t;
+        /* Median of three into items[mid]. */
+        if (key_less(boxes, axis, items[mid], items[lo])) { t = items[mid]; items[mid] = items[lo]; items[lo] = t; }
+        if (key_less(boxes, axis, items[hi], items[lo])) { t = items[hi]; items[hi] = items[lo]; items[lo] = t; }
+        if (key_less(boxes, axis, items[hi], items[mid])) { t = items[hi]; items[hi] = items[mid]; items[mid] = t; }
+        uint32_t pivot = items[mid];
+        uint32_t i = lo, j = hi;
+        while (i <= j) {
+            while (key_less(boxes, axis, items[i], pivot)) i++;
+            while (key_less(boxes, axis, pivot, items[j])) j--;
+            if (i <= j) {
+                t = items[i]; items[i] = items[j]; items[j] = t;
+                i++;
+                if (j == 0) break;
+                j--;
+            }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else return;
+    }
+}
+
+typedef struct build_task { uint32_t node, start, count; } build_task;
+
+int shell_bvh_build(shell_bvh *bvh, const double *boxes, uint32_t count, mk_arena *arena)
+{
+    bvh->boxes = boxes;
+    bvh->node_count = 0;
+    bvh->items = mk_arena_array(arena, (size_t)count + 1, sizeof(uint32_t));
+    bvh->nodes = mk_arena_array(arena, 2 * (size_t)count + 1, sizeof(shell_bvh_node));
+    if (!bvh->items || !bvh->nodes) return 0;
+    if (count == 0) return 1;
+    for (uint32_t i = 0; i < count; i++) bvh->items[i] = i;
+    build_task stack[STACK_SIZE];
+    int top = 0;
+    bvh->node_count = 1;
+    stack[top++] = (build_task){ 0, 0, count };
+    while (top > 0) {
+        uint32_t node = stack[top - 1].node, start = stack[top - 1].start, n = stack[top - 1].count;
+        top--;
+        shell_bvh_node *b = &bvh->nodes[node];
+        double clo[3], chi[3];
+        for (int c = 0; c < 3; c++) { b->lo[c] = clo[c] = INFINITY; b->hi[c] = chi[c] = -INFINITY; }
+        for (uint32_t i = start; i < start + n; i++) {
+            const double *box = boxes + 6 * (size_t)bvh->items[i];
+            for (int c = 0; c < 3; c++) {
+                double centre = box[c] + box[3 + c];
+                if (box[c] < b->lo[c]) b->lo[c] = box[c];
+                if (box[3 + c] > b->hi[c]) b->hi[c] = box[3 + c];
+                if (centre < clo[c]) clo[c] = centre;
+                if (centre > chi[c]) chi[c] = centre;
+            }
+        }
+        if (n <= LEAF_SIZE || top + 2 > STACK_SIZE) {
+            b->start = start;
+            b->count = n;
+            continue;
+        }
+        int axis = 0;
+        for (int c = 1; c < 3; c++)
+            if (chi[c] - clo[c] > chi[axis] - clo[axis]) axis = c;
+        uint32_t half = n / 2;
+        select_kth(boxes, axis, bvh->items + start, n, half);
+        uint32_t left = bvh->node_count;
+        bvh->node_count += 2;
+        b->start = left;
+        b->count = 0;
+        stack[top++] = (build_task){ left + 1, start + half, n - half };
+        stack[top++] = (build_task){ left, start, half };
+    }
+    return 1;
+}
+
+static int overlaps(const double *alo, const double *ahi, const double *blo, const double *bhi)
+{
+    return !(alo[0] > bhi[0] || ahi[0] < blo[0] || alo[1] > bhi[1] || ahi[1] < blo[1] || alo[2] > bhi[2] || ahi[2] < blo[2]);
+}
+
+void shell_bvh_refit(shell_bvh *bvh)
+{
+    /* Children come after their parent: refit from the last node back. */
+    for (uint32_t k = bvh->node_count; k-- > 0;) {
+        shell_bvh_node *b = &bvh->nodes[k];
+        for (int c = 0; c < 3; c++) { b->lo[c] = INFINITY; b->hi[c] = -INFINITY; }
+        if (b->count) {
+            for (uint32_t i = b->start; i < b->start + b->count; i++) {
+                const double *box = bvh->boxes + 6 * (size_t)bvh->items[i];
+                for (int c = 0; c < 3; c++) {
+                    if (box[c] < b->lo[c]) b->lo[c] = box[c];
+                    if (box[3 + c] > b->hi[c]) b->hi[c] = box[3 + c];
+                }
+            }
+            continue;
+        }
+        for (uint32_t child = b->start; child < b->start + 2; child++)
+            for (int c = 0; c < 3; c++) {
+                if (bvh->nodes[child].lo[c] < b->lo[c]) b->lo[c] = bvh->nodes[child].lo[c];
+                if (bvh->nodes[child].hi[c] > b->hi[c]) b->hi[c] = bvh->nodes[child].hi[c];
+            }
+    }
+}
+
+typedef struct pair_walk {
+    const shell_bvh *bvh;
+    void (*visit)(void *user, uint32_t a, uint32_t b);
+    void *user;
+} pair_walk;
+
+/* The overlapping item pairs of two leaves (the same leaf: each unordered pair once, with
+ * itself too). */
+static void leaf_pairs(const pair_walk *w, const shell_bvh_node *a, const shell_bvh_node *b)
+{
+    const shell_bvh *bvh = w->bvh;
+    for (uint32_t i = a->start; i < a->start + a->count; i++) {
+        uint32_t ia = bvh->items[i];
+        const double *ba = bvh->boxes + 6 * (size_t)ia;
+        for (uint32_t j = a == b ? i : b->start; j < b->start + b->count; j++) {
+            uint32_t ib = bvh->items[j];
+            const double *bb = bvh->boxes + 6 * (size_t)ib;
+            if (overlaps(ba, ba + 3, bb, bb + 3)) w->visit(w->user, ia, ib);
+        }
+    }
+}
+
+static void node_pairs(const pair_walk *w, uint32_t na, uint32_t nb)
+{
+    const shell_bvh_node *a = &w->bvh->nodes[na], *b = &w->bvh->nodes[nb];
+    if (na == nb) {
+        if (a->count) { leaf_pairs(w, a, a); return; }
+        node_pairs(w, a->start, a->start);
+        node_pairs(w, a->start + 1, a->start + 1);
+        node_pairs(w, a->start, a->start + 1);
+        return;
+    }
+    if (!overlaps(a->lo, a->hi, b->lo, b->hi)) return;
+    if (a->count && b->count) { leaf_pairs(w, a, b); return; }
+    /* Descend into the inner node with the larger box (or the only inner one). */
+    double va = 0, vb = 0;
+    for (int c = 0; c < 3; c++) { va += a->hi[c] - a->lo[c]; vb += b->hi[c] - b->lo[c]; }
+    if (b->count || (!a->count && va >= vb)) {
+        node_pairs(w, a->start, nb);
+        node_pairs(w, a->start + 1, nb);
+    } else {
+        node_pairs(w, na, b->start);
+        node_pairs(w, na, b->start + 1);
+    }
+}
+
+void shell_bvh_self_pairs(const shell_bvh *bvh, void (*visit)(void *user, uint32_t a, uint32_t b), void *user)
+{
+    if (bvh->node_count == 0) return;
+    pair_walk w = { bvh, visit, user };
+    node_pairs(&w, 0, 0);
+}

@@ -1,0 +1,36 @@
+/* SPDX-License-Identifier: MIT */
+/* A bounding volume hierarchy over axis-aligned boxes (the shell's collision broad phase,
+ * shell_collide.c). Internal to baker/. */
+#ifndef SHELL_BVH_H
+#define SHELL_BVH_H
+
+#include <stdint.h>
+#include "alloc.h"
+
+typedef struct shell_bvh_node {
+    double lo[3], hi[3];
+    uint32_t start;           /* leaf: first entry of items; inner node: index of the left child (right = start + 1) */
+    uint32_t count;           /* leaf: number of items (> 0); inner node: 0 */
+} shell_bvh_node;
+
+typedef struct shell_bvh {
+    shell_bvh_node *nodes;
+    uint32_t node_count;
+    uint32_t *items;          /* item indices, grouped by leaf */
+    const double *boxes;      /* 6 doubles per item (lo, hi), as given to shell_bvh_build */
+} shell_bvh;
+
+/* Builds the hierarchy over count boxes (6 doubles each: lo[3], hi[3]; kept by reference) by
+ * median splits along the longest axis of the box centres, at most 4 items per leaf. The tree
+ * depends only on the boxes (ties broken by item index). Memory from arena; 0 when out of memory. */
+int shell_bvh_build(shell_bvh *bvh, const double *boxes, uint32_t count, mk_arena *arena);
+
+/* Recomputes every node's box after the items' boxes (the same array) changed; the tree's
+ * shape stays (it is only as tight as the items stay near their neighbours at build time). */
+void shell_bvh_refit(shell_bvh *bvh);
+
+/* Calls visit(user, a, b) for every unordered pair of items whose boxes overlap (closed boxes),
+ * each item with itself too, in a fixed order. */
+void shell_bvh_self_pairs(const shell_bvh *bvh, void (*visit)(void *user, uint32_t a, uint32_t b), void *user);
+
+#endif
