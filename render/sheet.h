@@ -9,7 +9,7 @@
  *
  * Cell labels: "t=0.50 s" (decimals added until distinct times read distinctly) when the
  * cell has a time; for diff sheets "max 0.0012 (0.07%)", the cell's largest scalar in mesh
- * units and as a percentage of the bounding-box diagonal (or "max 12.5°" with a scalar
+ * units and as a percentage of the bounding-box diagonal (or "max 12.5 deg" with a scalar
  * suffix); then the cell's own text lines. */
 #ifndef MKR_SHEET_H
 #define MKR_SHEET_H
@@ -40,8 +40,9 @@ typedef struct mkr_sheet_desc {
     float diff_max;                /* diff sheets: scalar drawn hottest; <= 0: largest in any cell */
     const char *scalar_caption;    /* diff sheets whose scalars are not distances: the legend's
                                     * caption (e.g. "angle to the surface normal, degrees"), with
-                                    * scalar_suffix after every value (e.g. "°") and no percent of
-                                    * the diagonal; NULL: distances in mesh units */
+                                    * scalar_suffix (up to 8 characters, e.g. " deg") after every
+                                    * value and no percent of the diagonal; NULL: distances in
+                                    * mesh units */
     const char *scalar_suffix;
 } mkr_sheet_desc;
 

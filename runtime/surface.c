@@ -13,6 +13,7 @@
  * gather: no sum is shared between vertices, so no read-modify-write chains through memory)
  * and finishes eight vertices at a time in lanes without branches. A vertex's normal depends
  * only on the positions and the topology, never on the job's range. */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 #include "format.h"
@@ -20,13 +21,6 @@
 #include "error.h"
 #include "span.h"
 #include "determinism.h"
-/* The finishing lanes choose between values already computed. GCC by default moves a floating-
- * point operation whose only use is one side of a choice into that side (it could trap), which
- * keeps it from vector instructions there; traps are off everywhere, so this changes no result,
- * only the instructions (clang does this by default). */
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC optimize("no-trapping-math")
-#endif
 
 #define TOPOLOGY_MAGIC 0x32534b4du /* "MKS2" */
 #define NO_GROUP UINT32_MAX
@@ -45,14 +39,18 @@ typedef struct layout {
     size_t group_of, group_tri_first, group_tris, rest, size;
 } layout;
 
-/* Offsets of the arrays; size 0 when the mesh cannot have a topology. The rest normals are four
- * floats per group (the fourth 0); their region first serves as the build's scratch. */
+/* Offsets of the arrays; size 0 when the mesh cannot have a topology (no normals, no
+ * triangles, or too large for 32-bit indices into its per-corner and per-vertex arrays: more
+ * than 1,431,655,765 triangles or 1,073,741,823 vertices). The rest normals are four floats per
+ * group (the fourth 0); their region first serves as the build's scratch. */
 static layout topology_layout(const mk_blob_mesh *m)
 {
     layout l = { 0, 0, 0, 0, 0 };
     if (!(m->flags & MK_MESH_HAS_NORMALS) || m->triangle_count == 0 || m->vertex_count == 0) return l;
     size_t v = m->vertex_count, t = m->triangle_count, c = m->control_point_count;
-    if (v > SIZE_MAX / 64 || t > SIZE_MAX / 64 || c > SIZE_MAX / 64) return l;
+    if (3 * (uint64_t)t > UINT32_MAX || 4 * (uint64_t)v > UINT32_MAX || v > SIZE_MAX / 64 || t > SIZE_MAX / 64
+        || c > SIZE_MAX / 64)
+        return l;
     size_t scratch = mk_smoothing_groups_scratch_size((uint32_t)c, (uint32_t)v);
     size_t rest = 16 * v > scratch ? 16 * v : scratch;
     l.group_of = align16(sizeof(topology_header));
@@ -146,7 +144,7 @@ mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *
     const mk_blob_mesh *m = &asset->meshes[mesh];
     layout l = topology_layout(m);
     if (!l.size)
-        return mk_error_fail(err, MK_ERROR_UNSUPPORTED, MK_NO_OFFSET, "surface topology: the mesh has no normals or no triangles");
+        return mk_error_fail(err, MK_ERROR_UNSUPPORTED, MK_NO_OFFSET, "surface topology: the mesh has no normals or no triangles, or more than 1,431,655,765 triangles or 1,073,741,823 vertices");
     if (!topology || (uintptr_t)topology % 16)
         return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "surface topology: memory is NULL or not 16-byte aligned");
     if (size < l.size)
@@ -193,8 +191,8 @@ mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *
         float sum[3];
         sum_faces(&group_tris[tri_first[g]], tri_first[g + 1] - tri_first[g], NULL, triangles, asset->data + m->positions,
                   12, sum);
-        float len = sqrtf(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]), inv = len > 0 ? 1.0f / len : 0;
-        for (int c = 0; c < 3; c++) rest[g][c] = sum[c] * inv;
+        float len = sqrtf(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+        for (int c = 0; c < 3; c++) rest[g][c] = len > 0 && len <= FLT_MAX ? sum[c] * (1.0f / len) : 0;
         rest[g][3] = 0;
     }
     topology_header h = { .magic = TOPOLOGY_MAGIC, .mesh = mesh, .vertex_count = n, .triangle_count = tri_count,
@@ -261,8 +259,9 @@ size_t mk_surface_scratch_size(const mk_asset *asset, uint32_t mesh)
 
 /* Vertices are finished FINISH_BLOCK at a time in lanes (component-major): every operation is
  * done in every lane and only the choices between computed values depend on the data, so the
- * compiler can use vector instructions; the same IEEE operations per lane, so the same bytes
- * as one vertex at a time. */
+ * compiler can use vector instructions (with -fno-math-errno, which the build adds: otherwise a
+ * square root may set errno, a branch that keeps the loop scalar); the same IEEE operations per
+ * lane, so the same bytes as one vertex at a time. */
 #define FINISH_BLOCK 8
 typedef struct finish_block {
     float sum[3][FINISH_BLOCK], base[3][FINISH_BLOCK], rest[3][FINISH_BLOCK], out[3][FINISH_BLOCK];
@@ -270,11 +269,20 @@ typedef struct finish_block {
 } finish_block;
 
 /* Per lane, with sum the group's face normals at P, base B_n and rest N(P0) (zero for a group
- * without area at rest): N(P) is the normalized sum (B_n where the sum is zero), and for a
- * group without area at rest N(P0) is B_n. Where N(P) differs from N(P0) the normal is
- * normalize(B_n + N(P) - N(P0)) (N(P) itself for a group without area at rest), B_n where that
- * is shorter than 1e-8; where they are equal it is B_n and changed is 0. A divisor is offset by
- * exactly 1 where its quotient is not used, so nothing divides by zero. */
+ * without area at rest): N(P) is the normalized sum (B_n where its length is zero or not
+ * finite), and for a group without area at rest N(P0) is B_n. Where N(P) differs from N(P0)
+ * the normal is d / |d| with d = B_n + (N(P) - N(P0)) (d = N(P) for a group without area at
+ * rest), B_n unless |d| > 1e-8; where they are equal it is B_n and changed is 0. A divisor is
+ * offset by exactly 1 where its quotient is not used, so nothing divides by zero and no
+ * non-finite value is chosen.
+ *
+ * GCC by default moves a floating-point operation whose only use is one side of a choice into
+ * that side (it could trap), which keeps the loop from vector instructions; for this function
+ * only, that is turned off. The result is the same (clang does this by default). */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC push_options
+#pragma GCC optimize("no-trapping-math")
+#endif
 static void finish_normals(finish_block *k)
 {
     for (int j = 0; j < FINISH_BLOCK; j++) {
@@ -282,7 +290,7 @@ static void finish_normals(finish_block *k)
         float bx = k->base[0][j], by = k->base[1][j], bz = k->base[2][j];
         float rx = k->rest[0][j], ry = k->rest[1][j], rz = k->rest[2][j];
         float len = sqrtf(sx * sx + sy * sy + sz * sz);
-        float none = len == 0;
+        float none = !(len > 0) | !(len <= FLT_MAX);
         float inv = 1.0f / (len + none);
         float ax = sx * inv, ay = sy * inv, az = sz * inv;
         float nx = none != 0 ? bx : ax, ny = none != 0 ? by : ay, nz = none != 0 ? bz : az;
@@ -292,7 +300,7 @@ static void finish_normals(finish_block *k)
         float ex = bx + (nx - rx), ey = by + (ny - ry), ez = bz + (nz - rz);
         float dx = flat != 0 ? nx : ex, dy = flat != 0 ? ny : ey, dz = flat != 0 ? nz : ez;
         float dlen = sqrtf(dx * dx + dy * dy + dz * dz);
-        float keep = (changed == 0) | (dlen <= 1e-8f);
+        float keep = (changed == 0) | !(dlen > 1e-8f);
         float dinv = 1.0f / (dlen + keep);
         float ox = dx * dinv, oy = dy * dinv, oz = dz * dinv;
         k->out[0][j] = keep != 0 ? bx : ox;
@@ -301,6 +309,9 @@ static void finish_normals(finish_block *k)
         k->changed[j] = changed;
     }
 }
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC pop_options
+#endif
 
 mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
 {
@@ -346,7 +357,7 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
     for (uint32_t i0 = 0; i0 < n; i0 += FINISH_BLOCK) {
         const uint32_t count = n - i0 < FINISH_BLOCK ? n - i0 : FINISH_BLOCK;
         finish_block block;
-        for (uint32_t j = 0; j < FINISH_BLOCK; j++) {   /* lanes past the range repeat its first vertex */
+        for (uint32_t j = 0; j < FINISH_BLOCK; j++) {   /* lanes past the range repeat the block's first vertex */
             uint32_t v = job->first_vertex + i0 + (j < count ? j : 0), g = group_of[v];
             float sum[3];
             sum_faces(&group_tris[tri_first[g]], tri_first[g + 1] - tri_first[g], (const float (*)[3])faces, NULL, NULL, 0,

@@ -218,6 +218,7 @@ static int run_render(void *p)
                 if (s[j] > largest) largest = s[j];
             v->scalars = s;
         }
+        if (colored) cli_frame_clear(&frames_b[i]);   /* only its scalars are drawn */
         if (args->show_weights && !(texts[i] = weights_text(a, frames[i].weights))) {
             fprintf(stderr, "morphkit render: out of memory\n");
             goto done;

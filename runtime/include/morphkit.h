@@ -283,8 +283,8 @@ size_t mk_smoothing_groups_scratch_size(uint32_t key_count, uint32_t vertex_coun
 uint32_t mk_smoothing_groups(const uint32_t *keys, uint32_t key_count, const float *normals, uint32_t vertex_count,
                              uint32_t *group_of, void *scratch);
 
-/* Bytes of a mesh's surface topology; 0 when the mesh has no normals or no triangles (or the
- * mesh index is invalid). */
+/* Bytes of a mesh's surface topology; 0 when the mesh has no normals or no triangles, has more
+ * than 1,431,655,765 triangles or 1,073,741,823 vertices, or the mesh index is invalid. */
 size_t mk_surface_topology_size(const mk_asset *asset, uint32_t mesh);
 mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *topology, size_t size, mk_error *err);
 
@@ -300,9 +300,9 @@ typedef struct mk_surface_job {
     uint32_t vertex_count;        /* 0: none; MK_VERTICES_TO_END: the rest of the mesh */
     float *normals;               /* output (addresses first_vertex): 3 floats per vertex */
     size_t normals_stride, normals_size;
-    float *tangents;              /* optional output: the base tangent re-orthogonalized against
-                                   * the new normal, w copied from the base; base where the
-                                   * normal kept its base */
+    float *tangents;              /* optional output: the base tangent, re-orthogonalized against
+                                   * the output normal where N(P) differs from N(P0), w copied
+                                   * from the base */
     size_t tangents_stride, tangents_size;
     void *scratch;                /* mk_surface_scratch_size() bytes, 16-byte aligned, one per
                                    * thread (no initialization needed) */

@@ -272,4 +272,33 @@ static void test_refuses_wrong_topology(void)
     mk_raw_free(&raw);
 }
 
-CHECK_MAIN(CASE(test_matches_brute_force), CASE(test_ranges_same_bytes), CASE(test_refuses_wrong_topology))
+/* Non-finite positions (a caller's own, or weights far past a target's range) give finite
+ * normals and tangents: a group whose sum is not finite takes its base normal as N(P). */
+static void test_non_finite_positions(void)
+{
+    opened o;
+    open_grid(&o, 16, 5, 1);
+    const uint32_t nv = o.raw.meshes[0].vertex_count;
+    float w[5] = { 1, 0.5f, 0, 0.8f, 1 }, *p = malloc(12 * (size_t)nv), *nrm = malloc(12 * (size_t)nv),
+          *tan = malloc(16 * (size_t)nv), *split = malloc(12 * (size_t)nv);
+    eval_positions(&o, w, p);
+    p[3 * 40] = NAN;
+    p[3 * 90 + 1] = INFINITY;
+    p[3 * 91 + 2] = 3e38f;   /* finite, but its face normals overflow */
+    mk_error err;
+    CHECK_MSG(surface(&o, p, 0, MK_VERTICES_TO_END, nrm, tan, &err) == MK_OK, "%s", err.message);
+    uint32_t bad = 0;
+    for (uint32_t i = 0; i < 3 * nv; i++) bad += !isfinite(nrm[i]);
+    for (uint32_t i = 0; i < 4 * nv; i++) bad += !isfinite(tan[i]);
+    CHECK_MSG(bad == 0, "%u non-finite normal or tangent components", bad);
+    for (uint32_t first = 0; first < nv; first += 29) {
+        uint32_t count = nv - first < 29 ? nv - first : 29;
+        CHECK(surface(&o, p, first, count, split + 3 * first, NULL, &err) == MK_OK);
+    }
+    CHECK(memcmp(nrm, split, 12 * (size_t)nv) == 0);
+    free(p); free(nrm); free(tan); free(split);
+    close_grid(&o);
+}
+
+CHECK_MAIN(CASE(test_matches_brute_force), CASE(test_ranges_same_bytes), CASE(test_non_finite_positions),
+           CASE(test_refuses_wrong_topology))
