@@ -198,7 +198,9 @@ static int run_render(void *p)
                                 .world = 1, .skip_tangents = 1 };
         int played = cli_frame_play(verb, args->input, &plan, i, &frames[i]);
         if (played >= 0) { status = played; goto done; }
-        if (colored) {
+        /* Surface normals are the reference itself: their angles are 0 without a second play. */
+        const int reference = colored && (b || !surface);
+        if (reference) {
             frames_b[i] = (pb_frame){ .asset = b ? b : a, .stacking = stacking, .normal_mode = normals,
                                       .surface_normals = b ? surface : 1, .world = 1, .skip_tangents = 1 };
             played = cli_frame_play(verb, b ? args->diff : args->input, b ? &plan_b : &plan, i, &frames_b[i]);
@@ -212,13 +214,18 @@ static int run_render(void *p)
             if (!s) { fprintf(stderr, "morphkit render: out of memory\n"); goto done; }
             if (b)
                 cli_distances(frames[i].positions[k], frames_b[i].positions[k], v->vertex_count, s);
-            else if (frames[i].normals[k] && frames_b[i].normals[k])   /* a mesh without normals: 0 */
+            else if (reference && frames[i].normals[k] && frames_b[i].normals[k])
                 pb_normal_angles(frames[i].normals[k], frames_b[i].normals[k], v->vertex_count, s);
+            else if (i == 0 && !frames[i].normals[k]) {
+                mk_mesh_info mi;
+                mk_mesh_get(a, k, &mi);
+                fprintf(stderr, "morphkit render: mesh %u '%s' has no normals; its angles are drawn as 0\n", k, mi.name);
+            }
             for (uint32_t j = 0; j < v->vertex_count; j++)
                 if (s[j] > largest) largest = s[j];
             v->scalars = s;
         }
-        if (colored) cli_frame_clear(&frames_b[i]);   /* only its scalars are drawn */
+        if (reference) cli_frame_clear(&frames_b[i]);   /* only its scalars are drawn */
         if (args->show_weights && !(texts[i] = weights_text(a, frames[i].weights))) {
             fprintf(stderr, "morphkit render: out of memory\n");
             goto done;
