@@ -300,5 +300,81 @@ static void test_non_finite_positions(void)
     close_grid(&o);
 }
 
+/* Degenerate pieces: a triangle whose corners coincide at rest (each corner a group without
+ * area at rest, N(P0) = B_n) that a target opens, a vertex in no triangle, and an ordinary
+ * triangle the target leaves alone. Opened: the coinciding corners take the opened face's own
+ * normal (d = N(P)); the lone vertex and the untouched triangle keep their base bytes; at
+ * weight 0 every vertex keeps them. */
+static void test_degenerate_pieces(void)
+{
+    mk_raw_asset raw;
+    mk_arena arena;
+    mk_raw_init(&raw, NULL);
+    mk_arena_init(&arena, NULL);
+    mk_raw_mesh *m = mk_raw_add_meshes(&raw, 1);
+    m->name = "pieces";
+    m->vertex_count = m->control_point_count = 7;
+    static const float p0[21] = { 0, 0, 0, 1, 0, 0, 0, 1, 0,  5, 5, 1, 5, 5, 1, 5, 5, 1,  9, 9, 9 };
+    static const float n0[21] = { 0, 0, 1, 0, 0, 1, 0, 0, 1,  0.6f, 0, 0.8f, 0, 0.6f, 0.8f, 0, 0, 1,  1, 0, 0 };
+    static const uint32_t tris[6] = { 0, 1, 2, 3, 4, 5 };
+    m->positions = mk_arena_array(&raw.arena, 21, sizeof(float));
+    m->normals = mk_arena_array(&raw.arena, 21, sizeof(float));
+    m->control_points = mk_arena_array(&raw.arena, 7, sizeof(uint32_t));
+    m->triangles = mk_arena_array(&raw.arena, 6, sizeof(uint32_t));
+    memcpy(m->positions, p0, sizeof p0);
+    memcpy(m->normals, n0, sizeof n0);
+    memcpy(m->triangles, tris, sizeof tris);
+    for (uint32_t v = 0; v < 7; v++) m->control_points[v] = v;
+    m->triangle_count = 2;
+    mk_raw_channel *ch = mk_raw_add_channels(&raw, 1);
+    ch->name = "open";
+    mk_raw_target *tg = mk_raw_add_targets(&raw, ch, 1);
+    tg->name = "open";
+    tg->count = 3;
+    tg->indices = mk_arena_array(&raw.arena, 3, sizeof(uint32_t));
+    tg->positions = mk_arena_array(&raw.arena, 9, sizeof(float));
+    static const uint32_t moved[3] = { 4, 5, 6 };
+    static const float deltas[9] = { 1, 0, 0.5f, 0, 1, 0.25f, 0.5f, 0.5f, 0.5f };
+    memcpy(tg->indices, moved, sizeof moved);
+    memcpy(tg->positions, deltas, sizeof deltas);
+    size_t size;
+    mk_error err;
+    mk_asset a;
+    void *blob = fixture_blob(&raw, MK_PRECISION_FLOAT, &arena, &size);
+    CHECK(blob && mk_asset_open(blob, size, &a, &err) == MK_OK);
+    if (!blob) goto done;
+    size_t ts = mk_surface_topology_size(&a, 0), ss = mk_surface_scratch_size(&a, 0);
+    void *topology = mk_arena_alloc(&arena, ts), *scratch = mk_arena_alloc(&arena, ss);
+    CHECK_MSG(mk_surface_topology_build(&a, 0, topology, ts, &err) == MK_OK, "%s", err.message);
+    for (int opened_up = 0; opened_up < 2; opened_up++) {
+        float p[21], nrm[21];
+        memcpy(p, p0, sizeof p);
+        if (opened_up)
+            for (int k = 0; k < 3; k++)
+                for (int d = 0; d < 3; d++) p[3 * moved[k] + (uint32_t)d] += deltas[3 * k + d];
+        mk_surface_job job = { .asset = &a, .topology = topology, .topology_size = ts, .positions = p,
+                               .positions_size = sizeof p, .vertex_count = MK_VERTICES_TO_END, .normals = nrm,
+                               .normals_size = sizeof nrm, .scratch = scratch, .scratch_size = ss };
+        CHECK_MSG(mk_surface_run(&job, &err) == MK_OK, "%s", err.message);
+        CHECK_MSG(memcmp(nrm, n0, 9 * sizeof(float)) == 0, "opened %d: the untouched triangle changed", opened_up);
+        CHECK_MSG(memcmp(nrm + 18, n0 + 18, 3 * sizeof(float)) == 0, "opened %d: the lone vertex changed", opened_up);
+        if (!opened_up) {
+            CHECK(memcmp(nrm + 9, n0 + 9, 9 * sizeof(float)) == 0);
+            continue;
+        }
+        /* The opened face's normal: (b - a) x (c - a) normalized. */
+        const float *A = &p[9], *B = &p[12], *C = &p[15];
+        double e1[3] = { B[0] - A[0], B[1] - A[1], B[2] - A[2] }, e2[3] = { C[0] - A[0], C[1] - A[1], C[2] - A[2] };
+        double f[3] = { e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0] };
+        double l = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]), worst = 0;
+        for (uint32_t v = 3; v < 6; v++)
+            for (int d = 0; d < 3; d++) worst = fmax(worst, fabs(nrm[3 * v + (uint32_t)d] - f[d] / l));
+        CHECK_MSG(worst < 1e-6, "the opened corners are %g from their face's normal", worst);
+    }
+done:
+    mk_arena_free_all(&arena);
+    mk_raw_free(&raw);
+}
+
 CHECK_MAIN(CASE(test_matches_brute_force), CASE(test_ranges_same_bytes), CASE(test_non_finite_positions),
-           CASE(test_refuses_wrong_topology))
+           CASE(test_degenerate_pieces), CASE(test_refuses_wrong_topology))
