@@ -41,8 +41,8 @@ typedef struct layout {
 
 /* Offsets of the arrays; size 0 when the mesh cannot have a topology (no normals, no
  * triangles, or too large for 32-bit indices into its per-corner and per-vertex arrays: more
- * than 1,431,655,765 triangles or 1,073,741,823 vertices). The rest normals are four floats per
- * group (the fourth 0); their region first serves as the build's scratch. */
+ * than 1,431,655,765 triangles or 1,073,741,823 vertices). The rest normals are three floats per
+ * group; their region first serves as the build's scratch. */
 static layout topology_layout(const mk_blob_mesh *m)
 {
     layout l = { 0, 0, 0, 0, 0 };
@@ -52,7 +52,7 @@ static layout topology_layout(const mk_blob_mesh *m)
         || c > SIZE_MAX / 64)
         return l;
     size_t scratch = mk_smoothing_groups_scratch_size((uint32_t)c, (uint32_t)v);
-    size_t rest = 16 * v > scratch ? 16 * v : scratch;
+    size_t rest = 12 * v > scratch ? 12 * v : scratch;
     l.group_of = align16(sizeof(topology_header));
     l.group_tri_first = l.group_of + align16(4 * v);
     l.group_tris = l.group_tri_first + align16(4 * (v + 1));
@@ -186,14 +186,13 @@ mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *
     }
     /* Rest normals N(P0) by the jobs' own sum (the scratch is no longer needed); (0,0,0) for a
      * group without area, whose vertices then take their own base normal as the rest normal. */
-    float (*rest)[4] = (float (*)[4])(void *)(base + l.rest);
+    float (*rest)[3] = (float (*)[3])(void *)(base + l.rest);
     for (uint32_t g = 0; g < groups; g++) {
         float sum[3];
         sum_faces(&group_tris[tri_first[g]], tri_first[g + 1] - tri_first[g], NULL, triangles, asset->data + m->positions,
                   12, sum);
         float len = sqrtf(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
         for (int c = 0; c < 3; c++) rest[g][c] = len > 0 && len <= FLT_MAX ? sum[c] * (1.0f / len) : 0;
-        rest[g][3] = 0;
     }
     topology_header h = { .magic = TOPOLOGY_MAGIC, .mesh = mesh, .vertex_count = n, .triangle_count = tri_count,
                           .group_count = groups, .size = l.size, .checksum = asset->header->checksum,
@@ -325,7 +324,7 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
     const uint32_t *group_of = (const uint32_t *)(const void *)(base + h.group_of);
     const uint32_t *tri_first = (const uint32_t *)(const void *)(base + h.group_tri_first);
     const uint32_t *group_tris = (const uint32_t *)(const void *)(base + h.group_tris);
-    const float (*rest)[4] = (const float (*)[4])(const void *)(base + h.rest);
+    const float (*rest)[3] = (const float (*)[3])(const void *)(base + h.rest);
     const uint32_t *triangles = (const uint32_t *)(const void *)(a->data + m->triangles);
     const float *normals = (const float *)(const void *)(a->data + m->normals);
     const float *tangents = m->tangents ? (const float *)(const void *)(a->data + m->tangents) : NULL;
