@@ -106,6 +106,18 @@ static char *weights_text(const mk_asset *a, const float *weights)
     return text;
 }
 
+/* A cell's scalars for mesh k of frame f: the distance to the same vertex of ref (--diff), or
+ * the angle between f's normals and ref's surface normals (--normal-error; ref NULL with
+ * --normals surface, whose angles are 0 by definition). s is zeroed, vertex_count long. */
+static void mesh_scalars(const pb_frame *f, const pb_frame *ref, int distances, uint32_t k, uint32_t vertex_count,
+                         float *s)
+{
+    if (distances)
+        cli_distances(f->positions[k], ref->positions[k], vertex_count, s);
+    else if (ref && f->normals[k] && ref->normals[k])
+        pb_normal_angles(f->normals[k], ref->normals[k], vertex_count, s);
+}
+
 /* B's meshes must be A's: same count, same vertex counts. Returns -1 or the exit status. */
 static int check_same_meshes(const cli_verb *verb, const render_args *args, const mk_asset *a, const mk_asset *b)
 {
@@ -212,11 +224,8 @@ static int run_render(void *p)
             if (!colored) continue;
             float *s = scalars[(size_t)i * meshes + k] = calloc((size_t)v->vertex_count + 1, 4);
             if (!s) { fprintf(stderr, "morphkit render: out of memory\n"); goto done; }
-            if (b)
-                cli_distances(frames[i].positions[k], frames_b[i].positions[k], v->vertex_count, s);
-            else if (reference && frames[i].normals[k] && frames_b[i].normals[k])
-                pb_normal_angles(frames[i].normals[k], frames_b[i].normals[k], v->vertex_count, s);
-            else if (i == 0 && !frames[i].normals[k]) {
+            mesh_scalars(&frames[i], reference ? &frames_b[i] : NULL, b != NULL, k, v->vertex_count, s);
+            if (!b && i == 0 && !frames[i].normals[k]) {
                 mk_mesh_info mi;
                 mk_mesh_get(a, k, &mi);
                 fprintf(stderr, "morphkit render: mesh %u '%s' has no normals; its angles are drawn as 0\n", k, mi.name);
@@ -236,14 +245,14 @@ static int run_render(void *p)
     }
     char title[600];
     const char *views_names[] = { "front", "side", "top", "iso" };
+    const char *against = b ? args->diff : args->normal_error ? "  normal error" : "";
     if (plan.clip >= 0) {
         mk_clip_info ci;
         mk_clip_get(a, (uint32_t)plan.clip, &ci);
-        snprintf(title, sizeof title, "%.200s%s%.200s  clip '%.100s'  %s view", args->input, b ? " vs " : "",
-                 b ? args->diff : args->normal_error ? "  normal error" : "", ci.name, views_names[args->view]);
+        snprintf(title, sizeof title, "%.200s%s%.200s  clip '%.100s'  %s view", args->input, b ? " vs " : "", against,
+                 ci.name, views_names[args->view]);
     } else {
-        snprintf(title, sizeof title, "%.200s%s%.200s  %s  %s view", args->input, b ? " vs " : "",
-                 b ? args->diff : args->normal_error ? "  normal error" : "",
+        snprintf(title, sizeof title, "%.200s%s%.200s  %s  %s view", args->input, b ? " vs " : "", against,
                  plan.frames[0].weights ? "forced weights" : "default weights", views_names[args->view]);
     }
     mkr_sheet_desc desc = { .cells = cells, .cell_count = n, .cell_width = cell_width, .cell_height = cell_height,
