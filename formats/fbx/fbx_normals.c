@@ -7,12 +7,9 @@
 
 mk_result fbx_target_normals(mk_raw_asset *raw, uint32_t first_mesh, const mk_import_options *options, mk_error *err)
 {
+    /* A mesh whose targets all have normals is skipped by the call itself (force 0). */
     for (uint32_t m = first_mesh; m < raw->mesh_count; m++) {
-        int needs = 0;
-        for (uint32_t c = 0; c < raw->channel_count && !needs; c++)
-            if (raw->channels[c].mesh == m)
-                for (uint32_t k = 0; k < raw->channels[c].target_count; k++) needs |= !raw->channels[c].targets[k].normals;
-        mk_result r = needs ? mk_raw_compute_target_normals_replacing(raw, m, 0, options->threads, err) : MK_OK;
+        mk_result r = mk_raw_compute_target_normals_replacing(raw, m, 0, options->threads, err);
         if (r != MK_OK) return r;
     }
     return MK_OK;
