@@ -8,19 +8,12 @@ usage: test_target_normals.py MORPHKIT MAKE_EXAMPLE   (the FBX and glTF checks s
 import json, os, subprocess, sys
 
 mk, make_example = sys.argv[1], sys.argv[2]
-from cli_check import check, corpus, finish, have_corpus, scratch, skip
+from cli_check import check, corpus, finish, have_corpus, read_bytes, runner, scratch, skip
 
 work = scratch("mk_target_normals_")
 
+run = runner(mk, timeout=300)
 
-def run(*args):
-    p = subprocess.run([mk] + [str(a) for a in args], capture_output=True, text=True, timeout=300)
-    return p.returncode, p.stdout, p.stderr
-
-
-def read(p):
-    with open(p, "rb") as f:
-        return f.read()
 
 
 def info(path):
@@ -50,7 +43,7 @@ def check_source(name, source):
     check(name + ": imports with auto, none and without the option", rcs == [0, 0] and rc == 0, err)
     if rc or any(rcs):
         return
-    check(name + ": auto is the default (the same blob)", read(plain) == read(auto))
+    check(name + ": auto is the default (the same blob)", read_bytes(plain) == read_bytes(auto))
     a, n = info(auto), info(none)
     ta, tn = targets(a), targets(n)
     check(name + ": the file has target normals to drop", any(t[5] for t in ta), str(ta))
