@@ -7,8 +7,17 @@
 #include "phase_log.h"
 #include "raw.h"
 
+/* The targets' normal deltas: the file's own where it has them and computed where it has none
+ * (the default), or none at all: for playback that never blends normals (positions only, or
+ * normals recomputed from the evaluated surface), which then reads and stores only positions. */
+typedef enum mk_target_normals {
+    MK_TARGET_NORMALS_AUTO = 0,
+    MK_TARGET_NORMALS_NONE = 1
+} mk_target_normals;
+
 typedef struct mk_import_options {
     mk_stacking stacking;          /* stacking stored for every mesh; 0 = additive (.morph: as stored) */
+    mk_target_normals target_normals; /* 0 = the file's, computed where missing */
     int keep_shape_normals;        /* FBX: 0 = use shape normals only when present and non-zero */
     int keep_plain_meshes;         /* 0 = meshes without morph targets are dropped, each named in a
                                     * warning; 1 = kept (bakers start from them) */

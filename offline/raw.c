@@ -148,6 +148,16 @@ void mk_raw_drop_plain_meshes(mk_raw_asset *raw, const char *what)
     raw->mesh_count = kept;
 }
 
+void mk_raw_drop_target_normals(mk_raw_asset *raw)
+{
+    for (uint32_t c = 0; c < raw->channel_count; c++)
+        for (uint32_t k = 0; k < raw->channels[c].target_count; k++) {
+            mk_raw_target *t = &raw->channels[c].targets[k];
+            mk_arena_release(&raw->arena, t->normals);
+            t->normals = NULL;
+        }
+}
+
 static int finite_array(const float *p, size_t n)
 {
     for (size_t i = 0; i < n; i++)

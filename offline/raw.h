@@ -107,6 +107,9 @@ mk_result mk_raw_group_channels(mk_raw_asset *raw, mk_error *err);
 /* Removes the meshes that have no channel (remapping channel mesh indices), with one warning
  * per mesh: "mesh 'NAME' has no morph targets; <what>" (what NULL: "skipped"). */
 void mk_raw_drop_plain_meshes(mk_raw_asset *raw, const char *what);
+/* Removes every target's normal deltas (mk_import_options.target_normals = none); positions
+ * and tangent deltas stay. */
+void mk_raw_drop_target_normals(mk_raw_asset *raw);
 
 /* Checks everything the writer and runtime rely on: counts, indices in range, strictly
  * increasing sparse indices and key times, finite values, nonzero and strictly increasing

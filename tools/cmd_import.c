@@ -8,7 +8,7 @@
 
 typedef struct import_args {
     const char *input, *output, *channels, *depfile;
-    int stacking, precision, stacking_given, quiet, all_meshes, timings;
+    int stacking, precision, stacking_given, quiet, all_meshes, timings, target_normals;
     double tolerance;
     uint64_t threads;
 } import_args;
@@ -26,6 +26,11 @@ static const cli_option options[] = {
       "How deltas are stored: q16 (int16 with a per-target scale; a target that would exceed --tolerance falls back to "
       "float) or float (lossless float32).",
       "q16", "q16|float", 0, 0, 0, 0 },
+    { "--target-normals", "HOW", CLI_CHOICE, offsetof(import_args, target_normals),
+      "The targets' normal deltas: auto (the file's own; computed from the shape where the file has none) or none "
+      "(not stored: for playback that never blends normals, i.e. positions only or surface normals recomputed from "
+      "the evaluated positions; the blob is smaller and positions evaluate faster). Base normals are always kept.",
+      "auto", "auto|none", 0, 0, 0, 0 },
     { "--tolerance", "D", CLI_NUMBER, offsetof(import_args, tolerance),
       "Largest quantization error of a position, in mesh units. Default: 1e-4 x each mesh's bounding-box diagonal.",
       NULL, NULL, 1e-30, 1e30, 0, 0 },
@@ -91,6 +96,7 @@ static int run_import(void *p)
     mk_phase_log_start(&phases);
     mk_import_options io = { .phases = a->timings ? &phases : NULL, .channels_sidecar = a->channels, .keep_plain_meshes = a->all_meshes,
                              .threads = (uint32_t)a->threads,
+                             .target_normals = a->target_normals ? MK_TARGET_NORMALS_NONE : MK_TARGET_NORMALS_AUTO,
                              .file_read = a->depfile ? cli_depfile_add : NULL, .file_read_user = &deps };
     if (a->stacking_given) io.stacking = a->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
     mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16,

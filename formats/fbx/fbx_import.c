@@ -44,7 +44,7 @@ mk_result mk_import_fbx(const void *data, size_t size, const mk_import_options *
     mk_arena_free_all(&scratch);
     if (options->input_done) options->input_done(options->input_done_user);  /* data is not read again */
     mk_phase_log_mark(options->phases, "release parse data");
-    if (r == MK_OK) {
+    if (r == MK_OK && options->target_normals != MK_TARGET_NORMALS_NONE) {
         r = fbx_target_normals(out, first_mesh, options, err);
         mk_phase_log_mark(options->phases, "target normals");
     }

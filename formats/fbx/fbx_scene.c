@@ -609,7 +609,8 @@ static mk_result add_channel(scene *s, uint32_t mesh, fbx_mesh_map *map, const c
         size_t n_idx, n_pos, n_nrm = 0, n_w = 0;
         mk_result r = fbx_child_array(doc, node, "Indexes", FBX_ELEM_I32, (void **)&indexes, &n_idx);
         if (r == MK_OK) r = fbx_child_array(doc, node, "Vertices", FBX_ELEM_F64, (void **)&positions, &n_pos);
-        if (r == MK_OK) r = fbx_child_array(doc, node, "Normals", FBX_ELEM_F64, (void **)&normals, &n_nrm);
+        if (r == MK_OK && s->options->target_normals != MK_TARGET_NORMALS_NONE)   /* not even decoded */
+            r = fbx_child_array(doc, node, "Normals", FBX_ELEM_F64, (void **)&normals, &n_nrm);
         if (r != MK_OK) {
             fbx_release(doc->arena, indexes);
             fbx_release(doc->arena, positions);

@@ -1,6 +1,7 @@
 """What the command-line test scripts share: where the sources and the corpus are, a scratch
-folder, and check/skip counters that end in the suite's "N passed, N failed, N skipped" line."""
-import os, sys, tempfile
+folder, a way to run the command, and check/skip counters that end in the suite's
+"N passed, N failed, N skipped" line."""
+import os, subprocess, sys, tempfile
 
 root = os.environ.get("MORPHKIT_SOURCE_ROOT", os.path.join(os.path.dirname(__file__), "..", ".."))
 corpus = os.environ.get("MORPHKIT_CORPUS", os.path.join(root, "..", "shared", "corpus"))
@@ -10,6 +11,21 @@ counts = {"passed": 0, "failed": 0, "skipped": 0}
 
 def scratch(prefix):
     return tempfile.mkdtemp(prefix=prefix)
+
+
+def runner(program, timeout=300):
+    """A function run(*args, stdin=None) -> (exit status, stdout, stderr) of `program args...`
+    (text, captured)."""
+    def run(*args, stdin=None):
+        p = subprocess.run([program] + [str(a) for a in args], capture_output=True, text=True, stdin=stdin,
+                           timeout=timeout)
+        return p.returncode, p.stdout, p.stderr
+    return run
+
+
+def read_bytes(path):
+    with open(path, "rb") as f:
+        return f.read()
 
 
 def check(name, cond, detail=""):

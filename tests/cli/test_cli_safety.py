@@ -9,14 +9,11 @@ usage: test_cli_safety.py MORPHKIT MAKE_EXAMPLE   (corpus checks skip without th
 import base64, hashlib, json, os, stat, struct, subprocess, sys, tempfile, threading
 
 mk, make_example = sys.argv[1], sys.argv[2]
-from cli_check import check, corpus, finish, have_corpus, root, scratch, skip
+from cli_check import check, corpus, finish, have_corpus, root, runner, scratch, skip
 
 work = scratch("mk_cli_safety_")
 
-
-def run(*args, stdin=None):
-    p = subprocess.run([mk] + [str(a) for a in args], capture_output=True, text=True, stdin=stdin, timeout=120)
-    return p.returncode, p.stdout, p.stderr
+run = runner(mk, timeout=120)
 
 
 def path(*parts):

@@ -7,21 +7,14 @@ usage: test_import_timings.py MORPHKIT MAKE_EXAMPLE   (the FBX and glTF checks s
 import os, re, subprocess, sys
 
 mk, make_example = sys.argv[1], sys.argv[2]
-from cli_check import check, corpus, finish, have_corpus, scratch, skip
+from cli_check import check, corpus, finish, have_corpus, read_bytes, runner, scratch, skip
 
 work = scratch("mk_import_timings_")
 LINE = re.compile(r"^(\S.*?)\s+(\d+\.\d{3})\s+(\d+\.\d)%\s+(\d+\.\d) MB$")
 TOTAL = re.compile(r"^total\s+(\d+\.\d{3})\s+(\d+\.\d) MB$")
 
+run = runner(mk, timeout=300)
 
-def run(*args):
-    p = subprocess.run([mk] + [str(a) for a in args], capture_output=True, text=True, timeout=300)
-    return p.returncode, p.stdout, p.stderr
-
-
-def read(p):
-    with open(p, "rb") as f:
-        return f.read()
 
 
 def table(err):
@@ -70,7 +63,7 @@ def check_import(name, source, expected):
     # column need not rise line by line; the total's is the largest.
     check(name + ": peak memory known for every phase, the largest is the total's",
           all(p[3] > 0 for p in phases) and total[1] == max(p[3] for p in phases), err)
-    check(name + ": the blob is the same with --timings", read(plain) == read(timed))
+    check(name + ": the blob is the same with --timings", read_bytes(plain) == read_bytes(timed))
 
 
 common = ["validate", "quantize", "lay out blocks", "assemble and checksum", "write file", "release"]

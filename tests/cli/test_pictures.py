@@ -7,14 +7,11 @@ usage: test_pictures.py MORPHKIT MAKE_EXAMPLE"""
 import base64, json, os, re, struct, subprocess, sys, zlib
 
 mk, make_example = sys.argv[1], sys.argv[2]
-from cli_check import check, finish, scratch, skip
+from cli_check import check, finish, runner, scratch, skip
 
 work = scratch("mk_pictures_")
 
-
-def run(*args):
-    p = subprocess.run([mk] + [str(a) for a in args], capture_output=True, text=True, timeout=120)
-    return p.returncode, p.stdout, p.stderr
+run = runner(mk, timeout=120)
 
 
 def path(name):
