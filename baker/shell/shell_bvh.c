@@ -95,6 +95,14 @@ int shell_bvh_build(shell_bvh *bvh, const double *boxes, uint32_t count, mk_aren
     return 1;
 }
 
+void shell_bvh_renumber(shell_bvh *bvh, uint32_t *order, uint32_t count)
+{
+    for (uint32_t i = 0; i < count; i++) {
+        order[i] = bvh->items[i];
+        bvh->items[i] = i;
+    }
+}
+
 static int overlaps(const double *alo, const double *ahi, const double *blo, const double *bhi)
 {
     return !(alo[0] > bhi[0] || ahi[0] < blo[0] || alo[1] > bhi[1] || ahi[1] < blo[1] || alo[2] > bhi[2] || ahi[2] < blo[2]);
