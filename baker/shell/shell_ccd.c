@@ -167,6 +167,23 @@ int shell_ccd_monotone_pieces(const double k[4], double cuts[4])
     return nc;
 }
 
+double shell_ccd_cubic_root(const double k[4], double a, double fa, double b, double fb)
+{
+    double t = a - fa * (b - a) / (fb - fa);
+    if (!(t > a && t < b)) t = 0.5 * (a + b);
+    for (int it = 0; it < 200; it++) {
+        double ft = shell_ccd_cubic(k, t);
+        if (ft == 0) return t;
+        if ((ft > 0) == (fa > 0)) { a = t; fa = ft; } else b = t;
+        double d = (3 * k[3] * t + 2 * k[2]) * t + k[1], n = t - ft / d;
+        if (!(n > a && n < b)) n = 0.5 * (a + b);
+        int done = fabs(n - t) <= 0x1p-52 || b - a <= 0x1p-52;
+        t = n;
+        if (done) break;
+    }
+    return t;
+}
+
 /* Earliest time in [0, 1] at which the pair touches (within tol), or -1. */
 static double time_of_impact(int kind, const double *const s[4], const double *const e[4], const double k[4], double tol)
 {
@@ -180,16 +197,7 @@ static double time_of_impact(int kind, const double *const s[4], const double *c
         double qa[4][3], qb[4][3];
         for (int j = 0; j < 4; j++) { lerp3(qa[j], s[j], e[j], a); lerp3(qb[j], s[j], e[j], b); }
         if (apart_on_an_axis(kind, (const double (*)[3])qa, (const double (*)[3])qb, 1.0000001 * tol)) continue;
-        double t = a;
-        if (fa == 0) t = a;
-        else if (fb == 0) t = b;
-        else {
-            for (int it = 0; it < 50; it++) {
-                double m = 0.5 * (a + b), fm = shell_ccd_cubic(k, m);
-                if ((fm > 0) == (fa > 0)) { a = m; fa = fm; } else b = m;
-            }
-            t = 0.5 * (a + b);
-        }
+        double t = fa == 0 ? a : fb == 0 ? b : shell_ccd_cubic_root(k, a, fa, b, fb);
         if (pair_distance2(kind, s, e, t) <= tol2) return t;
     }
     return -1;

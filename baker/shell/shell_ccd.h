@@ -14,6 +14,12 @@ double shell_ccd_cubic(const double k[4], double t);
  * returns n (2 to 4); the cubic is monotone between consecutive cuts. */
 int shell_ccd_monotone_pieces(const double k[4], double cuts[4]);
 
+/* A root of the cubic k[0] + k[1] t + k[2] t^2 + k[3] t^3 in [a, b], where it is monotone and
+ * fa = f(a), fb = f(b) are nonzero and of opposite signs: Newton steps from the secant's point,
+ * kept inside the shrinking bracket (a bisection when a step would leave it), until a step or
+ * the bracket is below 2^-52 (t is in [0, 1]). */
+double shell_ccd_cubic_root(const double k[4], double a, double fa, double b, double fb);
+
 /* When the pair counts as a hit over the step (points s[i] -> e[i]): the earliest time in
  * [0, 1] at which the four points are coplanar and the pair is within tol, else 1 when it ends
  * closer than thickness having started no closer, else -1. */
