@@ -35,7 +35,9 @@ void shell_bvh_renumber(shell_bvh *bvh, uint32_t *order, uint32_t count);
 void shell_bvh_refit(shell_bvh *bvh);
 
 /* Calls visit(user, a, b) for every unordered pair of items whose boxes overlap (closed boxes),
- * each item with itself too, in a fixed order. */
-void shell_bvh_self_pairs(const shell_bvh *bvh, void (*visit)(void *user, uint32_t a, uint32_t b), void *user);
+ * each item with itself too, in a fixed order. With corners (3 per item, e.g. a triangle's
+ * vertices) pairs of items that share one are left out, and so is each item with itself. */
+void shell_bvh_self_pairs(const shell_bvh *bvh, const uint32_t *corners, void (*visit)(void *user, uint32_t a, uint32_t b),
+                          void *user);
 
 #endif

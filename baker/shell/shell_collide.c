@@ -68,12 +68,6 @@ struct shell_collider {
     size_t near_count[2];
 };
 
-static int share_a_vertex(const uint32_t a[3], const uint32_t b[3])
-{
-    return a[0] == b[0] || a[0] == b[1] || a[0] == b[2] || a[1] == b[0] || a[1] == b[1] || a[1] == b[2] ||
-           a[2] == b[0] || a[2] == b[1] || a[2] == b[2];
-}
-
 static int edges_share_a_vertex(const uint32_t a[2], const uint32_t b[2])
 {
     return a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
@@ -269,15 +263,14 @@ static void owned_vertices_against(collide_ctx *c, uint32_t u, uint32_t s)
         if (boxes_overlap(col->vertex_boxes + 6 * (size_t)i, tb)) add_candidate(c, 0, col->slot_tri[s], col->owned_vertices[i]);
 }
 
-/* Two slots whose boxes overlap (possibly the same one): every vertex-triangle and edge-edge
- * pair whose vertex or edges they own and that shares no vertex. Each candidate is met once: a
- * vertex's box lies in its owner's, an edge's in its owner's. */
+/* Two slots that share no vertex and whose boxes overlap (a slot with itself has no pair that
+ * shares no vertex; neighbours' pairs are listed, near): every vertex-triangle and edge-edge
+ * pair whose vertex or edges they own. Each candidate is met once: a vertex's box lies in its
+ * owner's, an edge's in its owner's. */
 static void visit_triangles(void *user, uint32_t s, uint32_t u)
 {
     collide_ctx *c = user;
     const shell_collider *col = c->col;
-    /* A slot with itself has no pair that shares no vertex; neighbours are listed (near). */
-    if (s == u || share_a_vertex(col->slot_corners + 3 * (size_t)s, col->slot_corners + 3 * (size_t)u)) return;
     owned_vertices_against(c, u, s);
     owned_vertices_against(c, s, u);
     for (uint32_t i = col->edge_start[s]; i < col->edge_start[s + 1]; i++) {
@@ -337,7 +330,7 @@ mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *
         uint32_t before = c.vt + c.ee;
         if (round == 0) {
             near_pairs(&c);
-            shell_bvh_self_pairs(&col->tree, visit_triangles, &c);
+            shell_bvh_self_pairs(&col->tree, col->slot_corners, visit_triangles, &c);
             if (c.oom) { mk_arena_free_all(&local); return mk_error_oom(err, "shell collisions (candidate pairs)"); }
         } else {
             for (int kind = 0; kind < 2; kind++)
