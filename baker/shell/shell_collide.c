@@ -8,7 +8,7 @@
  * finding). The tests of one pair are in shell_ccd.c.
  *
  * Broad phase: the swept boxes of vertices, edges and triangles (inflated by the thickness). A
- * hierarchy over the triangles' boxes, built once on the rest mesh and refitted every step
+ * hierarchy over the triangles' boxes, built once on the rest mesh and refitted before each use
  * (shell_bvh.c), yields the pairs of triangles whose boxes overlap in one traversal of the tree
  * against itself. Every vertex and every edge is owned by one of its triangles, whose box holds
  * its own, so the vertex-triangle and edge-edge pairs whose boxes overlap are among those of
@@ -16,7 +16,12 @@
  * share a vertex always overlap (most of the pairs the traversal meets): their owned pairs are
  * listed once when the collider is made and only their boxes are tested per step, and the
  * traversal passes such triangles by. The triangles are stored in the tree's leaf order, with
- * what they own next to them.
+ * what they own next to them. The traversal itself runs only now and then: it lists the other
+ * pairs of triangles whose boxes, grown from every vertex's range (its step continued a few
+ * steps ahead, plus a margin), overlap; while each step stays inside its vertex's range a
+ * triangle's box lies inside its grown box, so the steps in between test only the listed pairs'
+ * boxes (and when a list serves only a step or two, the next steps traverse directly). Which
+ * pairs are tested, and so every result, is the same as with a traversal per step.
  *
  * Response: the vertices of a hit are moved back to 0.8 of their time of impact; hits that
  * remain after that are moved back to the start of the step (which was free of intersections),
@@ -66,7 +71,33 @@ struct shell_collider {
      * owned_vertices and a slot (kind 0), or two entries of owned_edges (kind 1). */
     uint32_t *near[2];
     size_t near_count[2];
+    /* The other pairs of slots whose boxes can overlap (2 per pair), from one traversal of the
+     * hierarchy with every vertex's box grown to a range ahead of its step (far_range, 6 per
+     * vertex); valid while every step stays inside its vertex's range. */
+    uint32_t *far;
+    size_t far_count, far_capacity;
+    double *far_range;
+    int far_valid, far_oom;
+    uint32_t far_frames;      /* steps the current list has served */
+    uint32_t direct_left;     /* steps still to traverse directly (the ranges held too briefly) */
+    mk_arena *arena;          /* the list of far pairs grows here */
 };
+
+/* Appends (a, b) to a growing list of pairs (2 per pair); 0 when out of memory. */
+static int push_pair(mk_arena *arena, uint32_t **list, size_t *count, size_t *capacity, uint32_t a, uint32_t b)
+{
+    if (*count == *capacity) {
+        size_t nc = *capacity ? 2 * *capacity : 4096;
+        uint32_t *np = mk_arena_realloc(arena, *list, 2 * *capacity * sizeof *np, 2 * nc * sizeof *np);
+        if (!np) return 0;
+        *list = np;
+        *capacity = nc;
+    }
+    (*list)[2 * *count] = a;
+    (*list)[2 * *count + 1] = b;
+    (*count)++;
+    return 1;
+}
 
 static int edges_share_a_vertex(const uint32_t a[2], const uint32_t b[2])
 {
@@ -138,10 +169,12 @@ shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena)
     c->vertex_boxes = mk_arena_array(arena, 6 * (size_t)m->n, sizeof(double));
     c->edge_boxes = mk_arena_array(arena, 6 * nh + 6, sizeof(double));
     c->edge_ends = mk_arena_array(arena, 2 * nh + 2, sizeof(uint32_t));
+    c->far_range = mk_arena_array(arena, 6 * (size_t)m->n + 6, sizeof(double));
+    c->arena = arena;
     uint32_t *slot_of = mk_arena_array(arena, nt + 1, sizeof(uint32_t));
     uint32_t *owner = mk_arena_array(arena, (size_t)(m->n > nh ? m->n : nh) + 1, sizeof(uint32_t));
     if (!c->slot_tri || !c->slot_corners || !c->tri_boxes || !c->vertex_start || !c->edge_start || !c->owned_vertices ||
-        !c->owned_edges || !c->vertex_boxes || !c->edge_boxes || !c->edge_ends || !slot_of || !owner)
+        !c->owned_edges || !c->vertex_boxes || !c->edge_boxes || !c->edge_ends || !c->far_range || !slot_of || !owner)
         return NULL;
     /* The hierarchy's shape from the rest mesh (neighbours on the surface stay neighbours), then
      * the slots in its leaf order. */
@@ -239,16 +272,7 @@ static int boxes_overlap(const double *a, const double *b)
 static void add_candidate(collide_ctx *c, int kind, uint32_t a, uint32_t b)
 {
     if (kind == 1 && b < a) { uint32_t t = a; a = b; b = t; }  /* the smaller edge first: the same rounding either way round */
-    if (c->pair_count[kind] == c->pair_capacity[kind]) {
-        size_t nc = c->pair_capacity[kind] ? 2 * c->pair_capacity[kind] : 4096;
-        uint32_t *np = mk_arena_realloc(c->arena, c->pairs[kind], 2 * c->pair_capacity[kind] * sizeof *np, 2 * nc * sizeof *np);
-        if (!np) { c->oom = 1; return; }
-        c->pairs[kind] = np;
-        c->pair_capacity[kind] = nc;
-    }
-    c->pairs[kind][2 * c->pair_count[kind]] = a;
-    c->pairs[kind][2 * c->pair_count[kind] + 1] = b;
-    c->pair_count[kind]++;
+    if (!push_pair(c->arena, &c->pairs[kind], &c->pair_count[kind], &c->pair_capacity[kind], a, b)) { c->oom = 1; return; }
     uint32_t idx[4];
     pair_vertices(c->m, kind, a, b, idx);
     test_pair(c, kind, idx, 0);
@@ -267,9 +291,8 @@ static void owned_vertices_against(collide_ctx *c, uint32_t u, uint32_t s)
  * shares no vertex; neighbours' pairs are listed, near): every vertex-triangle and edge-edge
  * pair whose vertex or edges they own. Each candidate is met once: a vertex's box lies in its
  * owner's, an edge's in its owner's. */
-static void visit_triangles(void *user, uint32_t s, uint32_t u)
+static void visit_triangles(collide_ctx *c, uint32_t s, uint32_t u)
 {
-    collide_ctx *c = user;
     const shell_collider *col = c->col;
     owned_vertices_against(c, u, s);
     owned_vertices_against(c, s, u);
@@ -296,6 +319,93 @@ static void near_pairs(collide_ctx *c)
     }
 }
 
+/* Each vertex's range: its step x -> p continued FAR_STEPS steps ahead, grown by FAR_SLACK of
+ * the step's largest coordinate and FAR_MARGIN of the mean edge length. */
+#define FAR_STEPS 3
+#define FAR_SLACK 0.5
+#define FAR_MARGIN 0.15
+/* A list that served fewer than FAR_MIN_STEPS steps costs more than it saves: the next
+ * FAR_PAUSE steps traverse the hierarchy directly (this step's boxes), then a list is tried
+ * again. */
+#define FAR_MIN_STEPS 3
+#define FAR_PAUSE 8
+
+static void far_ranges(shell_collider *col, uint32_t n, const double *x, const double *p, double margin)
+{
+    for (uint32_t v = 0; v < n; v++) {
+        const double *a = x + 3 * (size_t)v, *b = p + 3 * (size_t)v;
+        double *r = col->far_range + 6 * (size_t)v, d[3], big = 0;
+        vec3_sub(d, b, a);
+        for (int k = 0; k < 3; k++)
+            if (fabs(d[k]) > big) big = fabs(d[k]);
+        double grow = FAR_SLACK * big + margin;
+        for (int k = 0; k < 3; k++) {
+            double ahead = b[k] + FAR_STEPS * d[k], lo = d[k] < 0 ? ahead : a[k], hi = d[k] < 0 ? a[k] : ahead;
+            r[k] = lo - grow;
+            r[3 + k] = hi + grow;
+        }
+    }
+}
+
+/* Does every vertex's step lie inside its range? */
+static int far_ranges_hold(const shell_collider *col, uint32_t n, const double *x, const double *p)
+{
+    for (uint32_t v = 0; v < n; v++) {
+        const double *r = col->far_range + 6 * (size_t)v, *a = x + 3 * (size_t)v, *b = p + 3 * (size_t)v;
+        for (int k = 0; k < 3; k++)
+            if (!(a[k] >= r[k] && a[k] <= r[3 + k] && b[k] >= r[k] && b[k] <= r[3 + k])) return 0;
+    }
+    return 1;
+}
+
+static void collect_far(void *user, uint32_t s, uint32_t u)
+{
+    shell_collider *col = user;
+    if (!push_pair(col->arena, &col->far, &col->far_count, &col->far_capacity, s, u)) col->far_oom = 1;
+}
+
+/* The far pairs again: the slots' boxes from their corners' ranges (inflated by the thickness),
+ * one traversal. A slot's box this step (from x, p inside the ranges, inflated by the same
+ * thickness) lies inside, the rounding of the inflation being monotonic. 0 when out of memory. */
+static int far_rebuild(shell_collider *col, const shell_mesh *m, const double *x, const double *p, double thickness,
+                       double margin)
+{
+    far_ranges(col, m->n, x, p, margin);
+    for (uint32_t s = 0; s < m->tri_count; s++) {
+        double *box = col->tri_boxes + 6 * (size_t)s;
+        for (int k = 0; k < 3; k++) { box[k] = INFINITY; box[3 + k] = -INFINITY; }
+        for (int j = 0; j < 3; j++) {
+            const double *r = col->far_range + 6 * (size_t)col->slot_corners[3 * (size_t)s + j];
+            for (int k = 0; k < 3; k++) {
+                if (r[k] < box[k]) box[k] = r[k];
+                if (r[3 + k] > box[3 + k]) box[3 + k] = r[3 + k];
+            }
+        }
+        for (int k = 0; k < 3; k++) { box[k] -= thickness; box[3 + k] += thickness; }
+    }
+    shell_bvh_refit(&col->tree);
+    col->far_count = 0;
+    col->far_oom = 0;
+    shell_bvh_self_pairs(&col->tree, col->slot_corners, collect_far, col);
+    col->far_valid = !col->far_oom;
+    return col->far_valid;
+}
+
+static void visit_direct(void *user, uint32_t s, uint32_t u)
+{
+    visit_triangles(user, s, u);
+}
+
+/* The far pairs whose boxes overlap this step. */
+static void far_pairs(collide_ctx *c)
+{
+    const shell_collider *col = c->col;
+    for (size_t k = 0; k < col->far_count; k++) {
+        uint32_t s = col->far[2 * k], u = col->far[2 * k + 1];
+        if (boxes_overlap(col->tri_boxes + 6 * (size_t)s, col->tri_boxes + 6 * (size_t)u)) visit_triangles(c, s, u);
+    }
+}
+
 mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *x, double *p, double thickness,
                         mk_arena *arena, uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err)
 {
@@ -318,19 +428,40 @@ mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *
     c.scale = scale; c.moved = moved; c.arena = &local;
     /* Broad phase, once: later rounds only pull vertices back along their steps, so their swept
      * boxes lie inside round 0's and round 0's candidates are all the pairs that can meet. */
+    int direct = 0;
+    if (col->direct_left > 0) {
+        col->direct_left--;
+        direct = 1;
+    } else if (col->far_valid && far_ranges_hold(col, m->n, x, p)) {
+        col->far_frames++;
+    } else if (col->far_valid && col->far_frames < FAR_MIN_STEPS) {
+        col->far_valid = 0;
+        col->direct_left = FAR_PAUSE - 1;
+        direct = 1;
+    } else {
+        if (!far_rebuild(col, m, x, p, thickness, FAR_MARGIN * mean)) {
+            mk_arena_free_all(&local);
+            return mk_error_oom(err, "shell collisions (candidate pairs)");
+        }
+        col->far_frames = 1;
+    }
     for (uint32_t s = 0; s < m->tri_count; s++)
         swept_box(x, p, col->slot_corners + 3 * (size_t)s, 3, thickness, col->tri_boxes + 6 * (size_t)s, col->tri_boxes + 6 * (size_t)s + 3);
     for (uint32_t i = 0; i < m->n; i++)
         swept_box(x, p, col->owned_vertices + i, 1, thickness, col->vertex_boxes + 6 * (size_t)i, col->vertex_boxes + 6 * (size_t)i + 3);
     for (uint32_t i = 0; i < m->hinge_count; i++)
         swept_box(x, p, col->edge_ends + 2 * (size_t)i, 2, thickness, col->edge_boxes + 6 * (size_t)i, col->edge_boxes + 6 * (size_t)i + 3);
-    shell_bvh_refit(&col->tree);
     for (int round = 0; round < MAX_ROUNDS; round++) {
         for (uint32_t v = 0; v < m->n; v++) scale[v] = 1;
         uint32_t before = c.vt + c.ee;
         if (round == 0) {
             near_pairs(&c);
-            shell_bvh_self_pairs(&col->tree, col->slot_corners, visit_triangles, &c);
+            if (direct) {
+                shell_bvh_refit(&col->tree);
+                shell_bvh_self_pairs(&col->tree, col->slot_corners, visit_direct, &c);
+            } else {
+                far_pairs(&c);
+            }
             if (c.oom) { mk_arena_free_all(&local); return mk_error_oom(err, "shell collisions (candidate pairs)"); }
         } else {
             for (int kind = 0; kind < 2; kind++)
