@@ -20,8 +20,9 @@
  * pairs of triangles whose boxes, grown from every vertex's range (its step continued a few
  * steps ahead, plus a margin), overlap; while each step stays inside its vertex's range a
  * triangle's box lies inside its grown box, so the steps in between test only the listed pairs'
- * boxes (and when a list serves only a step or two, the next steps traverse directly). Which
- * pairs are tested, and so every result, is the same as with a traversal per step.
+ * boxes (and when a list serves only a step or two, the next steps traverse directly); the
+ * neighbours' listed pairs are filtered with the same grown boxes. Which pairs are tested, and
+ * so every result, is the same as with a traversal per step.
  *
  * Response: the vertices of a hit are moved back to 0.8 of their time of impact; hits that
  * remain after that are moved back to the start of the step (which was free of intersections),
@@ -71,12 +72,15 @@ struct shell_collider {
      * owned_vertices and a slot (kind 0), or two entries of owned_edges (kind 1). */
     uint32_t *near[2];
     size_t near_count[2];
+    uint32_t *live[2];        /* those of near whose grown boxes (below) overlap */
+    size_t live_count[2];
     /* The other pairs of slots whose boxes can overlap (2 per pair), from one traversal of the
      * hierarchy with every vertex's box grown to a range ahead of its step (far_range, 6 per
      * vertex); valid while every step stays inside its vertex's range. */
     uint32_t *far;
     size_t far_count, far_capacity;
     double *far_range;
+    double *step_box;         /* 6 per vertex: this step's box (start and end), not inflated */
     int far_valid, far_oom;
     uint32_t far_frames;      /* steps the current list has served */
     uint32_t direct_left;     /* steps still to traverse directly (the ranges held too briefly) */
@@ -170,11 +174,13 @@ shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena)
     c->edge_boxes = mk_arena_array(arena, 6 * nh + 6, sizeof(double));
     c->edge_ends = mk_arena_array(arena, 2 * nh + 2, sizeof(uint32_t));
     c->far_range = mk_arena_array(arena, 6 * (size_t)m->n + 6, sizeof(double));
+    c->step_box = mk_arena_array(arena, 6 * (size_t)m->n + 6, sizeof(double));
     c->arena = arena;
     uint32_t *slot_of = mk_arena_array(arena, nt + 1, sizeof(uint32_t));
     uint32_t *owner = mk_arena_array(arena, (size_t)(m->n > nh ? m->n : nh) + 1, sizeof(uint32_t));
     if (!c->slot_tri || !c->slot_corners || !c->tri_boxes || !c->vertex_start || !c->edge_start || !c->owned_vertices ||
-        !c->owned_edges || !c->vertex_boxes || !c->edge_boxes || !c->edge_ends || !c->far_range || !slot_of || !owner)
+        !c->owned_edges || !c->vertex_boxes || !c->edge_boxes || !c->edge_ends || !c->far_range || !c->step_box || !slot_of ||
+        !owner)
         return NULL;
     /* The hierarchy's shape from the rest mesh (neighbours on the surface stay neighbours), then
      * the slots in its leaf order. */
@@ -208,7 +214,9 @@ shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena)
     list_near_pairs(c, m->tri_count, ring_start, ring, slot_of);
     c->near[0] = mk_arena_array(arena, 2 * c->near_count[0] + 2, sizeof(uint32_t));
     c->near[1] = mk_arena_array(arena, 2 * c->near_count[1] + 2, sizeof(uint32_t));
-    if (!c->near[0] || !c->near[1]) return NULL;
+    c->live[0] = mk_arena_array(arena, 2 * c->near_count[0] + 2, sizeof(uint32_t));
+    c->live[1] = mk_arena_array(arena, 2 * c->near_count[1] + 2, sizeof(uint32_t));
+    if (!c->near[0] || !c->near[1] || !c->live[0] || !c->live[1]) return NULL;
     list_near_pairs(c, m->tri_count, ring_start, ring, slot_of);
     mk_arena_release(arena, ring);
     mk_arena_release(arena, owner);
@@ -262,9 +270,11 @@ static void pair_vertices(const shell_mesh *m, int kind, uint32_t a, uint32_t b,
     }
 }
 
+/* Closed boxes (lo, hi) overlap: all six comparisons without branches, one branch on the result
+ * (which is mostly no, while which comparison fails first is hard to predict). */
 static int boxes_overlap(const double *a, const double *b)
 {
-    return !(a[0] > b[3] || a[3] < b[0] || a[1] > b[4] || a[4] < b[1] || a[2] > b[5] || a[5] < b[2]);
+    return (a[0] <= b[3]) & (b[0] <= a[3]) & (a[1] <= b[4]) & (b[1] <= a[4]) & (a[2] <= b[5]) & (b[2] <= a[5]);
 }
 
 /* Round 0 meets a pair that shares no vertex and whose boxes overlap: it is kept for the later
@@ -303,19 +313,22 @@ static void visit_triangles(collide_ctx *c, uint32_t s, uint32_t u)
     }
 }
 
-/* The listed pairs of neighbouring triangles whose boxes overlap. */
-static void near_pairs(collide_ctx *c)
+/* Listed pairs of neighbouring triangles (near, or live) whose boxes overlap: as candidates
+ * (c), or copied to out (then c is NULL). */
+static void near_pairs(collide_ctx *c, const shell_collider *col, uint32_t *const lists[2], const size_t counts[2],
+                       uint32_t *out[2], size_t out_count[2])
 {
-    const shell_collider *col = c->col;
-    for (size_t k = 0; k < col->near_count[0]; k++) {
-        uint32_t i = col->near[0][2 * k], s = col->near[0][2 * k + 1];
-        if (boxes_overlap(col->vertex_boxes + 6 * (size_t)i, col->tri_boxes + 6 * (size_t)s))
-            add_candidate(c, 0, col->slot_tri[s], col->owned_vertices[i]);
-    }
-    for (size_t k = 0; k < col->near_count[1]; k++) {
-        uint32_t i = col->near[1][2 * k], j = col->near[1][2 * k + 1];
-        if (boxes_overlap(col->edge_boxes + 6 * (size_t)i, col->edge_boxes + 6 * (size_t)j))
-            add_candidate(c, 1, col->owned_edges[i], col->owned_edges[j]);
+    for (int kind = 0; kind < 2; kind++) {
+        const uint32_t *list = lists[kind];
+        for (size_t k = 0; k < counts[kind]; k++) {
+            uint32_t i = list[2 * k], j = list[2 * k + 1];
+            const double *a = kind == 0 ? col->vertex_boxes + 6 * (size_t)i : col->edge_boxes + 6 * (size_t)i;
+            const double *b = kind == 0 ? col->tri_boxes + 6 * (size_t)j : col->edge_boxes + 6 * (size_t)j;
+            if (!boxes_overlap(a, b)) continue;
+            if (!c) put_pair(out[kind], &out_count[kind], i, j);
+            else if (kind == 0) add_candidate(c, 0, col->slot_tri[j], col->owned_vertices[i]);
+            else add_candidate(c, 1, col->owned_edges[i], col->owned_edges[j]);
+        }
     }
 }
 
@@ -358,6 +371,28 @@ static int far_ranges_hold(const shell_collider *col, uint32_t n, const double *
     return 1;
 }
 
+/* The box of the vertices idx[0..k)'s boxes (6 per vertex), inflated by pad. */
+static void union_box(const double *vertex_box, const uint32_t *idx, int k, double pad, double box[6])
+{
+    for (int c = 0; c < 3; c++) { box[c] = INFINITY; box[3 + c] = -INFINITY; }
+    for (int j = 0; j < k; j++) {
+        const double *r = vertex_box + 6 * (size_t)idx[j];
+        for (int c = 0; c < 3; c++) {
+            if (r[c] < box[c]) box[c] = r[c];
+            if (r[3 + c] > box[3 + c]) box[3 + c] = r[3 + c];
+        }
+    }
+    for (int c = 0; c < 3; c++) { box[c] -= pad; box[3 + c] += pad; }
+}
+
+/* Every slot's, owned vertex's and owned edge's box from their vertices' boxes, inflated by pad. */
+static void all_boxes(shell_collider *col, const shell_mesh *m, const double *vertex_box, double pad)
+{
+    for (uint32_t s = 0; s < m->tri_count; s++) union_box(vertex_box, col->slot_corners + 3 * (size_t)s, 3, pad, col->tri_boxes + 6 * (size_t)s);
+    for (uint32_t i = 0; i < m->n; i++) union_box(vertex_box, col->owned_vertices + i, 1, pad, col->vertex_boxes + 6 * (size_t)i);
+    for (uint32_t i = 0; i < m->hinge_count; i++) union_box(vertex_box, col->edge_ends + 2 * (size_t)i, 2, pad, col->edge_boxes + 6 * (size_t)i);
+}
+
 static void collect_far(void *user, uint32_t s, uint32_t u)
 {
     shell_collider *col = user;
@@ -371,18 +406,9 @@ static int far_rebuild(shell_collider *col, const shell_mesh *m, const double *x
                        double margin)
 {
     far_ranges(col, m->n, x, p, margin);
-    for (uint32_t s = 0; s < m->tri_count; s++) {
-        double *box = col->tri_boxes + 6 * (size_t)s;
-        for (int k = 0; k < 3; k++) { box[k] = INFINITY; box[3 + k] = -INFINITY; }
-        for (int j = 0; j < 3; j++) {
-            const double *r = col->far_range + 6 * (size_t)col->slot_corners[3 * (size_t)s + j];
-            for (int k = 0; k < 3; k++) {
-                if (r[k] < box[k]) box[k] = r[k];
-                if (r[3 + k] > box[3 + k]) box[3 + k] = r[3 + k];
-            }
-        }
-        for (int k = 0; k < 3; k++) { box[k] -= thickness; box[3 + k] += thickness; }
-    }
+    all_boxes(col, m, col->far_range, thickness);
+    col->live_count[0] = col->live_count[1] = 0;
+    near_pairs(NULL, col, col->near, col->near_count, col->live, col->live_count);
     shell_bvh_refit(&col->tree);
     col->far_count = 0;
     col->far_oom = 0;
@@ -445,17 +471,14 @@ mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *
         }
         col->far_frames = 1;
     }
-    for (uint32_t s = 0; s < m->tri_count; s++)
-        swept_box(x, p, col->slot_corners + 3 * (size_t)s, 3, thickness, col->tri_boxes + 6 * (size_t)s, col->tri_boxes + 6 * (size_t)s + 3);
-    for (uint32_t i = 0; i < m->n; i++)
-        swept_box(x, p, col->owned_vertices + i, 1, thickness, col->vertex_boxes + 6 * (size_t)i, col->vertex_boxes + 6 * (size_t)i + 3);
-    for (uint32_t i = 0; i < m->hinge_count; i++)
-        swept_box(x, p, col->edge_ends + 2 * (size_t)i, 2, thickness, col->edge_boxes + 6 * (size_t)i, col->edge_boxes + 6 * (size_t)i + 3);
+    for (uint32_t v = 0; v < m->n; v++) swept_box(x, p, &v, 1, 0, col->step_box + 6 * (size_t)v, col->step_box + 6 * (size_t)v + 3);
+    all_boxes(col, m, col->step_box, thickness);
     for (int round = 0; round < MAX_ROUNDS; round++) {
         for (uint32_t v = 0; v < m->n; v++) scale[v] = 1;
         uint32_t before = c.vt + c.ee;
         if (round == 0) {
-            near_pairs(&c);
+            if (direct) near_pairs(&c, col, col->near, col->near_count, NULL, NULL);
+            else near_pairs(&c, col, col->live, col->live_count, NULL, NULL);
             if (direct) {
                 shell_bvh_refit(&col->tree);
                 shell_bvh_self_pairs(&col->tree, col->slot_corners, visit_direct, &c);
