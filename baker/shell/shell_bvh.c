@@ -95,9 +95,19 @@ int shell_bvh_build(shell_bvh *bvh, const double *boxes, uint32_t count, mk_aren
     return 1;
 }
 
+void shell_bvh_renumber(shell_bvh *bvh, uint32_t *order, uint32_t count)
+{
+    for (uint32_t i = 0; i < count; i++) {
+        order[i] = bvh->items[i];
+        bvh->items[i] = i;
+    }
+}
+
+/* Closed boxes overlap (all six comparisons, without branches: about half the tests pass). */
 static int overlaps(const double *alo, const double *ahi, const double *blo, const double *bhi)
 {
-    return !(alo[0] > bhi[0] || ahi[0] < blo[0] || alo[1] > bhi[1] || ahi[1] < blo[1] || alo[2] > bhi[2] || ahi[2] < blo[2]);
+    return (alo[0] <= bhi[0]) & (blo[0] <= ahi[0]) & (alo[1] <= bhi[1]) & (blo[1] <= ahi[1]) & (alo[2] <= bhi[2]) &
+           (blo[2] <= ahi[2]);
 }
 
 void shell_bvh_refit(shell_bvh *bvh)
@@ -126,12 +136,19 @@ void shell_bvh_refit(shell_bvh *bvh)
 
 typedef struct pair_walk {
     const shell_bvh *bvh;
+    const uint32_t *corners;
     void (*visit)(void *user, uint32_t a, uint32_t b);
     void *user;
 } pair_walk;
 
+static int share_a_corner(const uint32_t *a, const uint32_t *b)
+{
+    return (a[0] == b[0]) | (a[0] == b[1]) | (a[0] == b[2]) | (a[1] == b[0]) | (a[1] == b[1]) | (a[1] == b[2]) |
+           (a[2] == b[0]) | (a[2] == b[1]) | (a[2] == b[2]);
+}
+
 /* The overlapping item pairs of two leaves (the same leaf: each unordered pair once, with
- * itself too). */
+ * itself too), but for items that share a corner. */
 static void leaf_pairs(const pair_walk *w, const shell_bvh_node *a, const shell_bvh_node *b)
 {
     const shell_bvh *bvh = w->bvh;
@@ -141,6 +158,7 @@ static void leaf_pairs(const pair_walk *w, const shell_bvh_node *a, const shell_
         for (uint32_t j = a == b ? i : b->start; j < b->start + b->count; j++) {
             uint32_t ib = bvh->items[j];
             const double *bb = bvh->boxes + 6 * (size_t)ib;
+            if (w->corners && share_a_corner(w->corners + 3 * (size_t)ia, w->corners + 3 * (size_t)ib)) continue;
             if (overlaps(ba, ba + 3, bb, bb + 3)) w->visit(w->user, ia, ib);
         }
     }
@@ -170,9 +188,10 @@ static void node_pairs(const pair_walk *w, uint32_t na, uint32_t nb)
     }
 }
 
-void shell_bvh_self_pairs(const shell_bvh *bvh, void (*visit)(void *user, uint32_t a, uint32_t b), void *user)
+void shell_bvh_self_pairs(const shell_bvh *bvh, const uint32_t *corners, void (*visit)(void *user, uint32_t a, uint32_t b),
+                          void *user)
 {
     if (bvh->node_count == 0) return;
-    pair_walk w = { bvh, visit, user };
+    pair_walk w = { bvh, corners, visit, user };
     node_pairs(&w, 0, 0);
 }

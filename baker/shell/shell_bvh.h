@@ -25,12 +25,19 @@ typedef struct shell_bvh {
  * depends only on the boxes (ties broken by item index). Memory from arena; 0 when out of memory. */
 int shell_bvh_build(shell_bvh *bvh, const double *boxes, uint32_t count, mk_arena *arena);
 
+/* Renumbers the items in the order of the leaves: order[i] (count entries) receives the item
+ * now numbered i, and from then on the boxes array must hold item order[i]'s box at i. Items
+ * of a leaf, and of nearby leaves, then lie next to each other in memory. */
+void shell_bvh_renumber(shell_bvh *bvh, uint32_t *order, uint32_t count);
+
 /* Recomputes every node's box after the items' boxes (the same array) changed; the tree's
  * shape stays (it is only as tight as the items stay near their neighbours at build time). */
 void shell_bvh_refit(shell_bvh *bvh);
 
 /* Calls visit(user, a, b) for every unordered pair of items whose boxes overlap (closed boxes),
- * each item with itself too, in a fixed order. */
-void shell_bvh_self_pairs(const shell_bvh *bvh, void (*visit)(void *user, uint32_t a, uint32_t b), void *user);
+ * each item with itself too, in a fixed order. With corners (3 per item, e.g. a triangle's
+ * vertices) pairs of items that share one are left out, and so is each item with itself. */
+void shell_bvh_self_pairs(const shell_bvh *bvh, const uint32_t *corners, void (*visit)(void *user, uint32_t a, uint32_t b),
+                          void *user);
 
 #endif

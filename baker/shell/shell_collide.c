@@ -5,14 +5,24 @@
  * when its four points are coplanar, which is a cubic in t; at each root in [0, 1] the pair is
  * checked for actual contact (distance within the tolerance). A pair that also ends closer than
  * the thickness while it started farther counts as a hit (a proximity test backing up the root
- * finding).
+ * finding). The tests of one pair are in shell_ccd.c.
  *
  * Broad phase: the swept boxes of vertices, edges and triangles (inflated by the thickness). A
- * hierarchy over the triangles' boxes, built once on the rest mesh and refitted every step
+ * hierarchy over the triangles' boxes, built once on the rest mesh and refitted before each use
  * (shell_bvh.c), yields the pairs of triangles whose boxes overlap in one traversal of the tree
  * against itself. Every vertex and every edge is owned by one of its triangles, whose box holds
  * its own, so the vertex-triangle and edge-edge pairs whose boxes overlap are among those of
- * owners that overlap, each met once. Pairs that share a vertex are skipped.
+ * owners that overlap, each met once. Pairs that share a vertex are skipped. Triangles that
+ * share a vertex always overlap (most of the pairs the traversal meets): their owned pairs are
+ * listed once when the collider is made and only their boxes are tested per step, and the
+ * traversal passes such triangles by. The triangles are stored in the tree's leaf order, with
+ * what they own next to them. The traversal itself runs only now and then: it lists the other
+ * pairs of triangles whose boxes, grown from every vertex's range (its step continued a few
+ * steps ahead, plus a margin), overlap; while each step stays inside its vertex's range a
+ * triangle's box lies inside its grown box, so the steps in between test only the listed pairs'
+ * boxes (and when a list serves only a step or two, the next steps traverse directly); the
+ * neighbours' listed pairs are filtered with the same grown boxes. Which pairs are tested, and
+ * so every result, is the same as with a traversal per step.
  *
  * Response: the vertices of a hit are moved back to 0.8 of their time of impact; hits that
  * remain after that are moved back to the start of the step (which was free of intersections),
@@ -25,6 +35,7 @@
 #include "shell.h"
 #include "bake_util.h"
 #include "shell_bvh.h"
+#include "shell_ccd.h"
 
 #define MAX_ROUNDS 64
 
@@ -42,169 +53,99 @@ static void swept_box(const double *x, const double *p, const uint32_t *idx, int
     for (int c = 0; c < 3; c++) { lo[c] -= pad; hi[c] += pad; }
 }
 
-/* ---- narrow phase ---- */
-
-static void lerp3(double out[3], const double *a, const double *b, double t)
-{
-    for (int c = 0; c < 3; c++) out[c] = a[c] + t * (b[c] - a[c]);
-}
-
-/* Squared distance from q to triangle abc (closest point by region, Ericson's method). */
-static double point_triangle_distance2(const double q[3], const double a[3], const double b[3], const double c[3])
-{
-    double ab[3], ac[3], ap[3], bp[3], cp[3], r[3];
-    vec3_sub(ab, b, a); vec3_sub(ac, c, a); vec3_sub(ap, q, a);
-    double d1 = vec3_dot(ab, ap), d2 = vec3_dot(ac, ap);
-    if (d1 <= 0 && d2 <= 0) { vec3_sub(r, q, a); return vec3_dot(r, r); }
-    vec3_sub(bp, q, b);
-    double d3 = vec3_dot(ab, bp), d4 = vec3_dot(ac, bp);
-    if (d3 >= 0 && d4 <= d3) { vec3_sub(r, q, b); return vec3_dot(r, r); }
-    double vc = d1 * d4 - d3 * d2, w[3];
-    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-        double v = d1 / (d1 - d3);
-        for (int k = 0; k < 3; k++) w[k] = a[k] + v * ab[k];
-        vec3_sub(r, q, w); return vec3_dot(r, r);
-    }
-    vec3_sub(cp, q, c);
-    double d5 = vec3_dot(ab, cp), d6 = vec3_dot(ac, cp);
-    if (d6 >= 0 && d5 <= d6) { vec3_sub(r, q, c); return vec3_dot(r, r); }
-    double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-        double v = d2 / (d2 - d6);
-        for (int k = 0; k < 3; k++) w[k] = a[k] + v * ac[k];
-        vec3_sub(r, q, w); return vec3_dot(r, r);
-    }
-    double va = d3 * d6 - d5 * d4;
-    if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
-        double v = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        for (int k = 0; k < 3; k++) w[k] = b[k] + v * (c[k] - b[k]);
-        vec3_sub(r, q, w); return vec3_dot(r, r);
-    }
-    double den = 1 / (va + vb + vc), v = vb * den, u = vc * den;
-    for (int k = 0; k < 3; k++) w[k] = a[k] + v * ab[k] + u * ac[k];
-    vec3_sub(r, q, w);
-    return vec3_dot(r, r);
-}
-
-static double clamp01(double v) { return v < 0 ? 0 : v > 1 ? 1 : v; }
-
-/* Squared distance between segments p0p1 and q0q1 (Ericson's closest points). */
-static double segment_distance2(const double p0[3], const double p1[3], const double q0[3], const double q1[3])
-{
-    double d1[3], d2[3], r[3];
-    vec3_sub(d1, p1, p0); vec3_sub(d2, q1, q0); vec3_sub(r, p0, q0);
-    double a = vec3_dot(d1, d1), e = vec3_dot(d2, d2), f = vec3_dot(d2, r), s, t;
-    if (a <= 1e-300 && e <= 1e-300) s = t = 0;
-    else if (a <= 1e-300) { s = 0; t = clamp01(f / e); }
-    else {
-        double c = vec3_dot(d1, r);
-        if (e <= 1e-300) { t = 0; s = clamp01(-c / a); }
-        else {
-            double b = vec3_dot(d1, d2), den = a * e - b * b;
-            s = den > 1e-300 ? clamp01((b * f - c * e) / den) : 0;
-            t = (b * s + f) / e;
-            if (t < 0) { t = 0; s = clamp01(-c / a); }
-            else if (t > 1) { t = 1; s = clamp01((b - c) / a); }
-        }
-    }
-    double w[3];
-    for (int k = 0; k < 3; k++) w[k] = (p0[k] + s * d1[k]) - (q0[k] + t * d2[k]);
-    return vec3_dot(w, w);
-}
-
-/* Distance of the pair at time t: kind 0 = point 3 against triangle 0 1 2, 1 = edge 0 1 against
- * edge 2 3. */
-static double pair_distance2(int kind, const double *const s[4], const double *const e[4], double t)
-{
-    double q[4][3];
-    for (int i = 0; i < 4; i++) lerp3(q[i], s[i], e[i], t);
-    return kind == 0 ? point_triangle_distance2(q[3], q[0], q[1], q[2]) : segment_distance2(q[0], q[1], q[2], q[3]);
-}
-
-/* Are the pair's two parts (points 0-2 and 3, or 0-1 and 2-3) at least d apart on some axis
- * over the positions p0 and p1 (and so over every position between, points moving on lines)?
- * Then their distance is at least d meanwhile. */
-static int apart_on_an_axis(int kind, const double (*p0)[3], const double (*p1)[3], double d)
-{
-    int split = kind == 0 ? 3 : 2;
-    for (int c = 0; c < 3; c++) {
-        double alo = INFINITY, ahi = -INFINITY, blo = INFINITY, bhi = -INFINITY;
-        for (int i = 0; i < 4; i++) {
-            double u = p0[i][c], w = p1[i][c], lo = u < w ? u : w, hi = u < w ? w : u;
-            double *plo = i < split ? &alo : &blo, *phi = i < split ? &ahi : &bhi;
-            if (lo < *plo) *plo = lo;
-            if (hi > *phi) *phi = hi;
-        }
-        if (blo - ahi >= d || alo - bhi >= d) return 1;
-    }
-    return 0;
-}
-
-static double cubic(const double k[4], double t) { return ((k[3] * t + k[2]) * t + k[1]) * t + k[0]; }
-
-/* Earliest time in [0, 1] at which the pair touches (within tol), or -1. */
-static double time_of_impact(int kind, const double *const s[4], const double *const e[4], double tol)
-{
-    double x21[3], x31[3], x41[3], v21[3], v31[3], v41[3], v[4][3];
-    for (int i = 0; i < 4; i++) vec3_sub(v[i], e[i], s[i]);
-    vec3_sub(x21, s[1], s[0]); vec3_sub(x31, s[2], s[0]); vec3_sub(x41, s[3], s[0]);
-    vec3_sub(v21, v[1], v[0]); vec3_sub(v31, v[2], v[0]); vec3_sub(v41, v[3], v[0]);
-    double c[3], k[4];
-    vec3_cross(c, x21, x31); k[0] = vec3_dot(c, x41);
-    k[1] = vec3_dot(c, v41);
-    vec3_cross(c, v21, x31); k[1] += vec3_dot(c, x41); k[2] = vec3_dot(c, v41);
-    vec3_cross(c, x21, v31); k[1] += vec3_dot(c, x41); k[2] += vec3_dot(c, v41);
-    vec3_cross(c, v21, v31); k[2] += vec3_dot(c, x41); k[3] = vec3_dot(c, v41);
-    /* Monotone pieces of f on [0, 1]: split at the roots of f' = 3 k3 t^2 + 2 k2 t + k1. */
-    double cuts[4] = { 0, 1, 1, 1 };
-    int nc = 1;
-    double A = 3 * k[3], B = 2 * k[2], C = k[1];
-    if (fabs(A) > 1e-300) {
-        double disc = B * B - 4 * A * C;
-        if (disc >= 0) {
-            double sq = sqrt(disc), r1 = (-B - sq) / (2 * A), r2 = (-B + sq) / (2 * A);
-            if (r1 > r2) { double tmp = r1; r1 = r2; r2 = tmp; }
-            if (r1 > 0 && r1 < 1) cuts[nc++] = r1;
-            if (r2 > 0 && r2 < 1) cuts[nc++] = r2;
-        }
-    } else if (fabs(B) > 1e-300) {
-        double r1 = -C / B;
-        if (r1 > 0 && r1 < 1) cuts[nc++] = r1;
-    }
-    cuts[nc++] = 1;
-    double tol2 = tol * tol;
-    for (int i = 0; i + 1 < nc; i++) {
-        double a = cuts[i], b = cuts[i + 1], fa = cubic(k, a), fb = cubic(k, b);
-        if (fa != 0 && fb != 0 && (fa > 0) == (fb > 0)) continue;
-        /* No contact possible in [a, b] when the parts stay apart by more than tol. */
-        double qa[4][3], qb[4][3];
-        for (int j = 0; j < 4; j++) { lerp3(qa[j], s[j], e[j], a); lerp3(qb[j], s[j], e[j], b); }
-        if (apart_on_an_axis(kind, (const double (*)[3])qa, (const double (*)[3])qb, 1.0000001 * tol)) continue;
-        double t = a;
-        if (fa == 0) t = a;
-        else if (fb == 0) t = b;
-        else {
-            for (int it = 0; it < 50; it++) {
-                double m = 0.5 * (a + b), fm = cubic(k, m);
-                if ((fm > 0) == (fa > 0)) { a = m; fa = fm; } else b = m;
-            }
-            t = 0.5 * (a + b);
-        }
-        if (pair_distance2(kind, s, e, t) <= tol2) return t;
-    }
-    return -1;
-}
-
+/* The triangles are numbered in the hierarchy's leaf order ("slots", shell_bvh_renumber), and
+ * what a traversal reads of a slot lies together: its box, its corners, the vertices and edges
+ * it owns with their boxes. */
 struct shell_collider {
-    shell_bvh tree;           /* over the triangles' boxes */
-    double *tri_boxes;        /* 6 per triangle: this step's swept boxes, inflated */
-    double *vertex_boxes;     /* 6 per vertex */
-    double *edge_boxes;       /* 6 per edge */
-    /* Every vertex and edge belongs to one of its triangles, whose box holds its own: the
-     * vertices of triangle t are owned_vertices[vertex_start[t] .. vertex_start[t + 1]), its
-     * edges likewise. */
+    shell_bvh tree;           /* over the slots' boxes */
+    uint32_t *slot_tri;       /* per slot: its triangle */
+    uint32_t *slot_corners;   /* 3 per slot: the triangle's vertices */
+    double *tri_boxes;        /* 6 per slot: this step's swept boxes, inflated */
+    /* Every vertex and edge belongs to one of its triangles, whose box holds its own: slot s owns
+     * owned_vertices[vertex_start[s] .. vertex_start[s + 1]), its edges likewise. */
     uint32_t *vertex_start, *owned_vertices, *edge_start, *owned_edges;
+    double *vertex_boxes;     /* 6 per entry of owned_vertices */
+    double *edge_boxes;       /* 6 per entry of owned_edges */
+    uint32_t *edge_ends;      /* 2 per entry of owned_edges: its vertices */
+    /* Triangles that share a vertex always have overlapping boxes: their pairs that share no
+     * vertex are listed once here and the traversal skips such triangles. 2 per pair: an entry of
+     * owned_vertices and a slot (kind 0), or two entries of owned_edges (kind 1). */
+    uint32_t *near[2];
+    size_t near_count[2];
+    uint32_t *live[2];        /* those of near whose grown boxes (below) overlap */
+    size_t live_count[2];
+    /* The other pairs of slots whose boxes can overlap (2 per pair), from one traversal of the
+     * hierarchy with every vertex's box grown to a range ahead of its step (far_range, 6 per
+     * vertex); valid while every step stays inside its vertex's range. */
+    uint32_t *far;
+    size_t far_count, far_capacity;
+    double *far_range;
+    double *step_box;         /* 6 per vertex: this step's box (start and end), not inflated */
+    int far_valid, far_oom;
+    uint32_t far_frames;      /* steps the current list has served */
+    uint32_t direct_left;     /* steps still to traverse directly (the ranges held too briefly) */
+    mk_arena *arena;          /* the list of far pairs grows here */
 };
+
+/* Appends (a, b) to a growing list of pairs (2 per pair); 0 when out of memory. */
+static int push_pair(mk_arena *arena, uint32_t **list, size_t *count, size_t *capacity, uint32_t a, uint32_t b)
+{
+    if (*count == *capacity) {
+        size_t nc = *capacity ? 2 * *capacity : 4096;
+        uint32_t *np = mk_arena_realloc(arena, *list, 2 * *capacity * sizeof *np, 2 * nc * sizeof *np);
+        if (!np) return 0;
+        *list = np;
+        *capacity = nc;
+    }
+    (*list)[2 * *count] = a;
+    (*list)[2 * *count + 1] = b;
+    (*count)++;
+    return 1;
+}
+
+static int edges_share_a_vertex(const uint32_t a[2], const uint32_t b[2])
+{
+    return a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
+}
+
+/* Appends (a, b) to list (2 per pair) at *count, or only counts when list is NULL. */
+static void put_pair(uint32_t *list, size_t *count, uint32_t a, uint32_t b)
+{
+    if (list) { list[2 * *count] = a; list[2 * *count + 1] = b; }
+    (*count)++;
+}
+
+/* The pairs of slots s < u sharing a vertex (through the slots around each vertex, ring), each
+ * once: the vertices one owns that are not the other's corners against the other, and their
+ * owned edges that share no vertex. With near[k] NULL only counts. mark: one per slot. */
+static void list_near_pairs(shell_collider *c, uint32_t slots, const uint32_t *ring_start, const uint32_t *ring,
+                            uint32_t *mark)
+{
+    for (uint32_t s = 0; s < slots; s++) mark[s] = UINT32_MAX;
+    c->near_count[0] = c->near_count[1] = 0;
+    for (uint32_t s = 0; s < slots; s++) {
+        const uint32_t *ks = c->slot_corners + 3 * (size_t)s;
+        for (int k = 0; k < 3; k++)
+            for (uint32_t r = ring_start[ks[k]]; r < ring_start[ks[k] + 1]; r++) {
+                uint32_t u = ring[r];
+                if (u <= s || mark[u] == s) continue;
+                mark[u] = s;
+                const uint32_t *ku = c->slot_corners + 3 * (size_t)u;
+                for (int side = 0; side < 2; side++) {
+                    uint32_t owner = side ? s : u, tri = side ? u : s;
+                    const uint32_t *kt = side ? ku : ks;
+                    for (uint32_t i = c->vertex_start[owner]; i < c->vertex_start[owner + 1]; i++) {
+                        uint32_t v = c->owned_vertices[i];
+                        if (v != kt[0] && v != kt[1] && v != kt[2]) put_pair(c->near[0], &c->near_count[0], i, tri);
+                    }
+                }
+                for (uint32_t i = c->edge_start[s]; i < c->edge_start[s + 1]; i++)
+                    for (uint32_t j = c->edge_start[u]; j < c->edge_start[u + 1]; j++)
+                        if (!edges_share_a_vertex(c->edge_ends + 2 * (size_t)i, c->edge_ends + 2 * (size_t)j))
+                            put_pair(c->near[1], &c->near_count[1], i, j);
+            }
+    }
+}
 
 /* Lists items[0..n) by owner (counting sort): start[owner .. owner + 1) in list. */
 static void group_by_owner(const uint32_t *owner, uint32_t n, uint32_t owners, uint32_t *start, uint32_t *list)
@@ -221,28 +162,65 @@ shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena)
 {
     shell_collider *c = mk_arena_array(arena, 1, sizeof *c);
     if (!c) return NULL;
-    c->tri_boxes = mk_arena_array(arena, 6 * (size_t)m->tri_count, sizeof(double));
-    c->vertex_boxes = mk_arena_array(arena, 6 * (size_t)m->n, sizeof(double));
-    c->edge_boxes = mk_arena_array(arena, 6 * (size_t)m->hinge_count + 6, sizeof(double));
-    c->vertex_start = mk_arena_array(arena, (size_t)m->tri_count + 1, sizeof(uint32_t));
-    c->edge_start = mk_arena_array(arena, (size_t)m->tri_count + 1, sizeof(uint32_t));
+    size_t nt = m->tri_count, nh = m->hinge_count;
+    c->slot_tri = mk_arena_array(arena, nt + 1, sizeof(uint32_t));
+    c->slot_corners = mk_arena_array(arena, 3 * nt + 3, sizeof(uint32_t));
+    c->tri_boxes = mk_arena_array(arena, 6 * nt, sizeof(double));
+    c->vertex_start = mk_arena_array(arena, nt + 1, sizeof(uint32_t));
+    c->edge_start = mk_arena_array(arena, nt + 1, sizeof(uint32_t));
     c->owned_vertices = mk_arena_array(arena, m->n, sizeof(uint32_t));
-    c->owned_edges = mk_arena_array(arena, (size_t)m->hinge_count + 1, sizeof(uint32_t));
-    uint32_t *owner = mk_arena_array(arena, (size_t)m->n + 1, sizeof(uint32_t));
-    if (!c->tri_boxes || !c->vertex_boxes || !c->edge_boxes || !c->vertex_start || !c->edge_start || !c->owned_vertices ||
-        !c->owned_edges || !owner)
+    c->owned_edges = mk_arena_array(arena, nh + 1, sizeof(uint32_t));
+    c->vertex_boxes = mk_arena_array(arena, 6 * (size_t)m->n, sizeof(double));
+    c->edge_boxes = mk_arena_array(arena, 6 * nh + 6, sizeof(double));
+    c->edge_ends = mk_arena_array(arena, 2 * nh + 2, sizeof(uint32_t));
+    c->far_range = mk_arena_array(arena, 6 * (size_t)m->n + 6, sizeof(double));
+    c->step_box = mk_arena_array(arena, 6 * (size_t)m->n + 6, sizeof(double));
+    c->arena = arena;
+    uint32_t *slot_of = mk_arena_array(arena, nt + 1, sizeof(uint32_t));
+    uint32_t *owner = mk_arena_array(arena, (size_t)(m->n > nh ? m->n : nh) + 1, sizeof(uint32_t));
+    if (!c->slot_tri || !c->slot_corners || !c->tri_boxes || !c->vertex_start || !c->edge_start || !c->owned_vertices ||
+        !c->owned_edges || !c->vertex_boxes || !c->edge_boxes || !c->edge_ends || !c->far_range || !c->step_box || !slot_of ||
+        !owner)
         return NULL;
-    /* A vertex's owner: its first triangle. */
-    for (uint32_t v = 0; v < m->n; v++) owner[v] = UINT32_MAX;
-    for (uint32_t t = m->tri_count; t-- > 0;)
-        for (int k = 0; k < 3; k++) owner[m->tris[3 * (size_t)t + k]] = t;
-    group_by_owner(owner, m->n, m->tri_count, c->vertex_start, c->owned_vertices);
-    group_by_owner(m->hinge_tri, m->hinge_count, m->tri_count, c->edge_start, c->owned_edges);
-    mk_arena_release(arena, owner);
-    /* The hierarchy's shape from the rest mesh (neighbours on the surface stay neighbours). */
+    /* The hierarchy's shape from the rest mesh (neighbours on the surface stay neighbours), then
+     * the slots in its leaf order. */
     for (uint32_t t = 0; t < m->tri_count; t++)
         swept_box(m->rest, m->rest, m->tris + 3 * (size_t)t, 3, 0, c->tri_boxes + 6 * (size_t)t, c->tri_boxes + 6 * (size_t)t + 3);
     if (!shell_bvh_build(&c->tree, c->tri_boxes, m->tri_count, arena)) return NULL;
+    shell_bvh_renumber(&c->tree, c->slot_tri, m->tri_count);
+    for (uint32_t s = 0; s < m->tri_count; s++) {
+        slot_of[c->slot_tri[s]] = s;
+        memcpy(c->slot_corners + 3 * (size_t)s, m->tris + 3 * (size_t)c->slot_tri[s], 3 * sizeof(uint32_t));
+    }
+    /* A vertex's owner: its first triangle; an edge's: the hinge's triangle. */
+    for (uint32_t v = 0; v < m->n; v++) owner[v] = UINT32_MAX;
+    for (uint32_t t = m->tri_count; t-- > 0;)
+        for (int k = 0; k < 3; k++) owner[m->tris[3 * (size_t)t + k]] = slot_of[t];
+    group_by_owner(owner, m->n, m->tri_count, c->vertex_start, c->owned_vertices);
+    for (uint32_t h = 0; h < m->hinge_count; h++) owner[h] = slot_of[m->hinge_tri[h]];
+    group_by_owner(owner, m->hinge_count, m->tri_count, c->edge_start, c->owned_edges);
+    for (uint32_t i = 0; i < m->hinge_count; i++)
+        memcpy(c->edge_ends + 2 * (size_t)i, m->hinges + 4 * (size_t)c->owned_edges[i], 2 * sizeof(uint32_t));
+    /* The slots around each vertex, then the pairs of slots that share a vertex. */
+    uint32_t *ring_start = owner, *ring = mk_arena_array(arena, 3 * nt + 1, sizeof(uint32_t));
+    if (!ring) return NULL;
+    memset(ring_start, 0, ((size_t)m->n + 1) * sizeof(uint32_t));
+    for (size_t i = 0; i < 3 * nt; i++) ring_start[c->slot_corners[i] + 1]++;
+    for (uint32_t v = 0; v < m->n; v++) ring_start[v + 1] += ring_start[v];
+    for (uint32_t s = 0; s < m->tri_count; s++)
+        for (int k = 0; k < 3; k++) ring[ring_start[c->slot_corners[3 * (size_t)s + k]]++] = s;
+    for (uint32_t v = m->n; v > 0; v--) ring_start[v] = ring_start[v - 1];
+    ring_start[0] = 0;
+    list_near_pairs(c, m->tri_count, ring_start, ring, slot_of);
+    c->near[0] = mk_arena_array(arena, 2 * c->near_count[0] + 2, sizeof(uint32_t));
+    c->near[1] = mk_arena_array(arena, 2 * c->near_count[1] + 2, sizeof(uint32_t));
+    c->live[0] = mk_arena_array(arena, 2 * c->near_count[0] + 2, sizeof(uint32_t));
+    c->live[1] = mk_arena_array(arena, 2 * c->near_count[1] + 2, sizeof(uint32_t));
+    if (!c->near[0] || !c->near[1] || !c->live[0] || !c->live[1]) return NULL;
+    list_near_pairs(c, m->tri_count, ring_start, ring, slot_of);
+    mk_arena_release(arena, ring);
+    mk_arena_release(arena, owner);
+    mk_arena_release(arena, slot_of);
     return c;
 }
 
@@ -272,15 +250,7 @@ static void test_pair(collide_ctx *c, int kind, const uint32_t idx[4], int round
     if (round > 0 && !c->moved[idx[0]] && !c->moved[idx[1]] && !c->moved[idx[2]] && !c->moved[idx[3]]) return;
     const double *s[4], *e[4];
     for (int i = 0; i < 4; i++) { s[i] = c->x + 3 * (size_t)idx[i]; e[i] = c->p + 3 * (size_t)idx[i]; }
-    double t = time_of_impact(kind, s, e, c->tol);
-    if (t < 0 && c->thickness > 0) {
-        double th2 = c->thickness * c->thickness;
-        double end[4][3];
-        for (int i = 0; i < 4; i++) memcpy(end[i], e[i], sizeof end[i]);
-        if (!apart_on_an_axis(kind, (const double (*)[3])end, (const double (*)[3])end, c->thickness) &&
-            pair_distance2(kind, s, e, 1) < th2 && pair_distance2(kind, s, e, 0) >= th2)
-            t = 1;
-    }
+    double t = shell_ccd_hit(kind, s, e, c->tol, c->thickness);
     if (t < 0) return;
     if (kind == 0) c->vt++; else c->ee++;
     double keep = round == 0 ? 0.8 * t : 0;
@@ -300,61 +270,165 @@ static void pair_vertices(const shell_mesh *m, int kind, uint32_t a, uint32_t b,
     }
 }
 
+/* Closed boxes (lo, hi) overlap: all six comparisons without branches, one branch on the result
+ * (which is mostly no, while which comparison fails first is hard to predict). */
 static int boxes_overlap(const double *a, const double *b)
 {
-    return !(a[0] > b[3] || a[3] < b[0] || a[1] > b[4] || a[4] < b[1] || a[2] > b[5] || a[5] < b[2]);
+    return (a[0] <= b[3]) & (b[0] <= a[3]) & (a[1] <= b[4]) & (b[1] <= a[4]) & (a[2] <= b[5]) & (b[2] <= a[5]);
 }
 
-/* Round 0 meets a pair whose boxes overlap: unless the two share a vertex, it is kept for the
- * later rounds and tested. */
+/* Round 0 meets a pair that shares no vertex and whose boxes overlap: it is kept for the later
+ * rounds and tested. */
 static void add_candidate(collide_ctx *c, int kind, uint32_t a, uint32_t b)
 {
     if (kind == 1 && b < a) { uint32_t t = a; a = b; b = t; }  /* the smaller edge first: the same rounding either way round */
+    if (!push_pair(c->arena, &c->pairs[kind], &c->pair_count[kind], &c->pair_capacity[kind], a, b)) { c->oom = 1; return; }
     uint32_t idx[4];
     pair_vertices(c->m, kind, a, b, idx);
-    if (kind == 0 ? (idx[3] == idx[0] || idx[3] == idx[1] || idx[3] == idx[2])
-                  : (idx[0] == idx[2] || idx[0] == idx[3] || idx[1] == idx[2] || idx[1] == idx[3]))
-        return;
-    if (c->pair_count[kind] == c->pair_capacity[kind]) {
-        size_t nc = c->pair_capacity[kind] ? 2 * c->pair_capacity[kind] : 4096;
-        uint32_t *np = mk_arena_realloc(c->arena, c->pairs[kind], 2 * c->pair_capacity[kind] * sizeof *np, 2 * nc * sizeof *np);
-        if (!np) { c->oom = 1; return; }
-        c->pairs[kind] = np;
-        c->pair_capacity[kind] = nc;
-    }
-    c->pairs[kind][2 * c->pair_count[kind]] = a;
-    c->pairs[kind][2 * c->pair_count[kind] + 1] = b;
-    c->pair_count[kind]++;
     test_pair(c, kind, idx, 0);
 }
 
-/* The vertices owned by triangle u against triangle t. */
-static void owned_vertices_against(collide_ctx *c, uint32_t u, uint32_t t)
+/* The vertices owned by slot u against slot s's triangle (the two share no vertex). */
+static void owned_vertices_against(collide_ctx *c, uint32_t u, uint32_t s)
 {
     const shell_collider *col = c->col;
-    const double *tb = col->tri_boxes + 6 * (size_t)t;
-    for (uint32_t i = col->vertex_start[u]; i < col->vertex_start[u + 1]; i++) {
-        uint32_t v = col->owned_vertices[i];
-        if (boxes_overlap(col->vertex_boxes + 6 * (size_t)v, tb)) add_candidate(c, 0, t, v);
+    const double *tb = col->tri_boxes + 6 * (size_t)s;
+    for (uint32_t i = col->vertex_start[u]; i < col->vertex_start[u + 1]; i++)
+        if (boxes_overlap(col->vertex_boxes + 6 * (size_t)i, tb)) add_candidate(c, 0, col->slot_tri[s], col->owned_vertices[i]);
+}
+
+/* Two slots that share no vertex and whose boxes overlap (a slot with itself has no pair that
+ * shares no vertex; neighbours' pairs are listed, near): every vertex-triangle and edge-edge
+ * pair whose vertex or edges they own. Each candidate is met once: a vertex's box lies in its
+ * owner's, an edge's in its owner's. */
+static void visit_triangles(collide_ctx *c, uint32_t s, uint32_t u)
+{
+    const shell_collider *col = c->col;
+    owned_vertices_against(c, u, s);
+    owned_vertices_against(c, s, u);
+    for (uint32_t i = col->edge_start[s]; i < col->edge_start[s + 1]; i++) {
+        const double *eb = col->edge_boxes + 6 * (size_t)i;
+        for (uint32_t j = col->edge_start[u]; j < col->edge_start[u + 1]; j++)
+            if (boxes_overlap(eb, col->edge_boxes + 6 * (size_t)j)) add_candidate(c, 1, col->owned_edges[i], col->owned_edges[j]);
     }
 }
 
-/* Two triangles whose boxes overlap (possibly the same one): every vertex-triangle and edge-edge
- * pair whose vertex or edges they own. Each candidate is met once: a vertex's box lies in its
- * owner's, an edge's in its owner's. */
-static void visit_triangles(void *user, uint32_t t, uint32_t u)
+/* Listed pairs of neighbouring triangles (near, or live) whose boxes overlap: as candidates
+ * (c), or copied to out (then c is NULL). */
+static void near_pairs(collide_ctx *c, const shell_collider *col, uint32_t *const lists[2], const size_t counts[2],
+                       uint32_t *out[2], size_t out_count[2])
 {
-    collide_ctx *c = user;
-    const shell_collider *col = c->col;
-    owned_vertices_against(c, u, t);
-    if (t != u) owned_vertices_against(c, t, u);
-    for (uint32_t i = col->edge_start[t]; i < col->edge_start[t + 1]; i++) {
-        uint32_t e = col->owned_edges[i];
-        const double *eb = col->edge_boxes + 6 * (size_t)e;
-        for (uint32_t j = t == u ? i + 1 : col->edge_start[u]; j < col->edge_start[u + 1]; j++) {
-            uint32_t f = col->owned_edges[j];
-            if (boxes_overlap(eb, col->edge_boxes + 6 * (size_t)f)) add_candidate(c, 1, e, f);
+    for (int kind = 0; kind < 2; kind++) {
+        const uint32_t *list = lists[kind];
+        for (size_t k = 0; k < counts[kind]; k++) {
+            uint32_t i = list[2 * k], j = list[2 * k + 1];
+            const double *a = kind == 0 ? col->vertex_boxes + 6 * (size_t)i : col->edge_boxes + 6 * (size_t)i;
+            const double *b = kind == 0 ? col->tri_boxes + 6 * (size_t)j : col->edge_boxes + 6 * (size_t)j;
+            if (!boxes_overlap(a, b)) continue;
+            if (!c) put_pair(out[kind], &out_count[kind], i, j);
+            else if (kind == 0) add_candidate(c, 0, col->slot_tri[j], col->owned_vertices[i]);
+            else add_candidate(c, 1, col->owned_edges[i], col->owned_edges[j]);
         }
+    }
+}
+
+/* Each vertex's range: its step x -> p continued FAR_STEPS steps ahead, grown by FAR_SLACK of
+ * the step's largest coordinate and FAR_MARGIN of the mean edge length. */
+#define FAR_STEPS 3
+#define FAR_SLACK 0.5
+#define FAR_MARGIN 0.15
+/* A list that served fewer than FAR_MIN_STEPS steps costs more than it saves: the next
+ * FAR_PAUSE steps traverse the hierarchy directly (this step's boxes), then a list is tried
+ * again. */
+#define FAR_MIN_STEPS 3
+#define FAR_PAUSE 8
+
+static void far_ranges(shell_collider *col, uint32_t n, const double *x, const double *p, double margin)
+{
+    for (uint32_t v = 0; v < n; v++) {
+        const double *a = x + 3 * (size_t)v, *b = p + 3 * (size_t)v;
+        double *r = col->far_range + 6 * (size_t)v, d[3], big = 0;
+        vec3_sub(d, b, a);
+        for (int k = 0; k < 3; k++)
+            if (fabs(d[k]) > big) big = fabs(d[k]);
+        double grow = FAR_SLACK * big + margin;
+        for (int k = 0; k < 3; k++) {
+            double ahead = b[k] + FAR_STEPS * d[k], lo = d[k] < 0 ? ahead : a[k], hi = d[k] < 0 ? a[k] : ahead;
+            r[k] = lo - grow;
+            r[3 + k] = hi + grow;
+        }
+    }
+}
+
+/* Does every vertex's step lie inside its range? */
+static int far_ranges_hold(const shell_collider *col, uint32_t n, const double *x, const double *p)
+{
+    for (uint32_t v = 0; v < n; v++) {
+        const double *r = col->far_range + 6 * (size_t)v, *a = x + 3 * (size_t)v, *b = p + 3 * (size_t)v;
+        for (int k = 0; k < 3; k++)
+            if (!(a[k] >= r[k] && a[k] <= r[3 + k] && b[k] >= r[k] && b[k] <= r[3 + k])) return 0;
+    }
+    return 1;
+}
+
+/* The box of the vertices idx[0..k)'s boxes (6 per vertex), inflated by pad. */
+static void union_box(const double *vertex_box, const uint32_t *idx, int k, double pad, double box[6])
+{
+    for (int c = 0; c < 3; c++) { box[c] = INFINITY; box[3 + c] = -INFINITY; }
+    for (int j = 0; j < k; j++) {
+        const double *r = vertex_box + 6 * (size_t)idx[j];
+        for (int c = 0; c < 3; c++) {
+            if (r[c] < box[c]) box[c] = r[c];
+            if (r[3 + c] > box[3 + c]) box[3 + c] = r[3 + c];
+        }
+    }
+    for (int c = 0; c < 3; c++) { box[c] -= pad; box[3 + c] += pad; }
+}
+
+/* Every slot's, owned vertex's and owned edge's box from their vertices' boxes, inflated by pad. */
+static void all_boxes(shell_collider *col, const shell_mesh *m, const double *vertex_box, double pad)
+{
+    for (uint32_t s = 0; s < m->tri_count; s++) union_box(vertex_box, col->slot_corners + 3 * (size_t)s, 3, pad, col->tri_boxes + 6 * (size_t)s);
+    for (uint32_t i = 0; i < m->n; i++) union_box(vertex_box, col->owned_vertices + i, 1, pad, col->vertex_boxes + 6 * (size_t)i);
+    for (uint32_t i = 0; i < m->hinge_count; i++) union_box(vertex_box, col->edge_ends + 2 * (size_t)i, 2, pad, col->edge_boxes + 6 * (size_t)i);
+}
+
+static void collect_far(void *user, uint32_t s, uint32_t u)
+{
+    shell_collider *col = user;
+    if (!push_pair(col->arena, &col->far, &col->far_count, &col->far_capacity, s, u)) col->far_oom = 1;
+}
+
+/* The far pairs again: the slots' boxes from their corners' ranges (inflated by the thickness),
+ * one traversal. A slot's box this step (from x, p inside the ranges, inflated by the same
+ * thickness) lies inside, the rounding of the inflation being monotonic. 0 when out of memory. */
+static int far_rebuild(shell_collider *col, const shell_mesh *m, const double *x, const double *p, double thickness,
+                       double margin)
+{
+    far_ranges(col, m->n, x, p, margin);
+    all_boxes(col, m, col->far_range, thickness);
+    col->live_count[0] = col->live_count[1] = 0;
+    near_pairs(NULL, col, col->near, col->near_count, col->live, col->live_count);
+    shell_bvh_refit(&col->tree);
+    col->far_count = 0;
+    col->far_oom = 0;
+    shell_bvh_self_pairs(&col->tree, col->slot_corners, collect_far, col);
+    col->far_valid = !col->far_oom;
+    return col->far_valid;
+}
+
+static void visit_direct(void *user, uint32_t s, uint32_t u)
+{
+    visit_triangles(user, s, u);
+}
+
+/* The far pairs whose boxes overlap this step. */
+static void far_pairs(collide_ctx *c)
+{
+    const shell_collider *col = c->col;
+    for (size_t k = 0; k < col->far_count; k++) {
+        uint32_t s = col->far[2 * k], u = col->far[2 * k + 1];
+        if (boxes_overlap(col->tri_boxes + 6 * (size_t)s, col->tri_boxes + 6 * (size_t)u)) visit_triangles(c, s, u);
     }
 }
 
@@ -380,18 +454,37 @@ mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *
     c.scale = scale; c.moved = moved; c.arena = &local;
     /* Broad phase, once: later rounds only pull vertices back along their steps, so their swept
      * boxes lie inside round 0's and round 0's candidates are all the pairs that can meet. */
-    for (uint32_t t = 0; t < m->tri_count; t++)
-        swept_box(x, p, m->tris + 3 * (size_t)t, 3, thickness, col->tri_boxes + 6 * (size_t)t, col->tri_boxes + 6 * (size_t)t + 3);
-    for (uint32_t v = 0; v < m->n; v++)
-        swept_box(x, p, &v, 1, thickness, col->vertex_boxes + 6 * (size_t)v, col->vertex_boxes + 6 * (size_t)v + 3);
-    for (uint32_t h = 0; h < m->hinge_count; h++)
-        swept_box(x, p, m->hinges + 4 * (size_t)h, 2, thickness, col->edge_boxes + 6 * (size_t)h, col->edge_boxes + 6 * (size_t)h + 3);
-    shell_bvh_refit(&col->tree);
+    int direct = 0;
+    if (col->direct_left > 0) {
+        col->direct_left--;
+        direct = 1;
+    } else if (col->far_valid && far_ranges_hold(col, m->n, x, p)) {
+        col->far_frames++;
+    } else if (col->far_valid && col->far_frames < FAR_MIN_STEPS) {
+        col->far_valid = 0;
+        col->direct_left = FAR_PAUSE - 1;
+        direct = 1;
+    } else {
+        if (!far_rebuild(col, m, x, p, thickness, FAR_MARGIN * mean)) {
+            mk_arena_free_all(&local);
+            return mk_error_oom(err, "shell collisions (candidate pairs)");
+        }
+        col->far_frames = 1;
+    }
+    for (uint32_t v = 0; v < m->n; v++) swept_box(x, p, &v, 1, 0, col->step_box + 6 * (size_t)v, col->step_box + 6 * (size_t)v + 3);
+    all_boxes(col, m, col->step_box, thickness);
     for (int round = 0; round < MAX_ROUNDS; round++) {
         for (uint32_t v = 0; v < m->n; v++) scale[v] = 1;
         uint32_t before = c.vt + c.ee;
         if (round == 0) {
-            shell_bvh_self_pairs(&col->tree, visit_triangles, &c);
+            if (direct) near_pairs(&c, col, col->near, col->near_count, NULL, NULL);
+            else near_pairs(&c, col, col->live, col->live_count, NULL, NULL);
+            if (direct) {
+                shell_bvh_refit(&col->tree);
+                shell_bvh_self_pairs(&col->tree, col->slot_corners, visit_direct, &c);
+            } else {
+                far_pairs(&c);
+            }
             if (c.oom) { mk_arena_free_all(&local); return mk_error_oom(err, "shell collisions (candidate pairs)"); }
         } else {
             for (int kind = 0; kind < 2; kind++)
