@@ -387,6 +387,12 @@ mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void
     return MK_OK;
 }
 
+size_t fbx_node_array_length(const fbx_node *node)
+{
+    if (node->value_count == 1 && node->values[0].kind == FBX_ARRAY) return node->values[0].count;
+    return node->value_count;
+}
+
 mk_result fbx_child_array(fbx_doc *doc, const fbx_node *node, const char *name, fbx_elem elem,
                           void **out, size_t *count)
 {

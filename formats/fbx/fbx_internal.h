@@ -119,6 +119,8 @@ mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void
 /* Same for the child named `name`; *out NULL and count 0 when the child is absent (MK_OK). */
 mk_result fbx_child_array(fbx_doc *doc, const fbx_node *node, const char *name, fbx_elem elem,
                           void **out, size_t *count);
+/* The element count fbx_node_array gives for `node` when it succeeds, without decoding. */
+size_t fbx_node_array_length(const fbx_node *node);
 /* Gives back an array of fbx_node_array (`size` bytes: its count times the element size) for
  * the next arrays to reuse: a blend shape's arrays are decoded, expanded and dropped, and a
  * fresh buffer for every shape costs a zeroed page for every page. Small arrays, and arrays

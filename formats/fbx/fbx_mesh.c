@@ -408,7 +408,7 @@ static int cmp_pair(const void *a, const void *b)
     return x->entry < y->entry ? -1 : x->entry > y->entry;
 }
 
-mk_result fbx_expand_shape(fbx_doc *doc, mk_raw_asset *raw, fbx_mesh_map *map, const fbx_shape_data *shape,
+mk_result fbx_expand_shape(fbx_doc *doc, mk_arena *out, fbx_mesh_map *map, const fbx_shape_data *shape,
                            mk_raw_target *target, size_t *skipped)
 {
     mk_arena *arena = doc->arena;
@@ -479,7 +479,6 @@ mk_result fbx_expand_shape(fbx_doc *doc, mk_raw_asset *raw, fbx_mesh_map *map, c
         total += map->first[cp + 1] - map->first[cp];
     }
     if (total > UINT32_MAX) { r = mk_error_set(doc->err, MK_ERROR_LIMIT, UINT64_MAX, "FBX shape too large"); goto done; }
-    mk_arena *out = &raw->arena;
     target->count = (uint32_t)total;
     target->indices = mk_arena_array(out, total ? total : 1, sizeof(uint32_t));
     target->positions = mk_arena_array(out, total ? total : 1, 3 * sizeof(float));
