@@ -251,6 +251,8 @@ mk_result fbx_add_channels(fbx_doc *doc, mk_raw_asset *raw, const mk_import_opti
     for (uint32_t w = 0; w < workers; w++) {
         shape_worker *sw = &l.workers[w];
         sw->doc = *doc;
+        sw->doc.prefetched = NULL;  /* the mesh's arrays were handed over or dropped */
+        sw->doc.prefetched_count = 0;
         sw->map = *map;
         sw->out = &raw->arena;
         if (w == 0) continue;  /* the calling thread: the document's and the raw asset's own */

@@ -1,9 +1,10 @@
 /* SPDX-License-Identifier: MIT */
-/* The shapes of an FBX mesh are decoded and expanded on worker threads (fbx_shapes.c): the
- * imported model, its warnings (which and in what order), the blob and, for a broken file, the
- * error are the same on 1, 2, 3 and 8 threads, including channels whose in-betweens the skip
- * rules drop (zero and repeated full weights), Blender per-vertex FullWeights, entries outside
- * the control points and authored shape normals. */
+/* An FBX import on worker threads: a mesh's large arrays are decoded together
+ * (fbx_prefetch.c), its shapes decoded and expanded (fbx_shapes.c). The imported model, its
+ * warnings (which and in what order), the blob and, for a broken file, the error are the same
+ * on 1, 2, 3 and 8 threads, including channels whose in-betweens the skip rules drop (zero and
+ * repeated full weights), Blender per-vertex FullWeights, entries outside the control points,
+ * authored shape normals and a corrupt zlib stream in a mesh array. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -161,16 +162,41 @@ static void import_with(const unsigned char *data, size_t size, uint32_t threads
     mk_raw_free(&raw);
 }
 
-static void compare_threads(int blender, int nan, const char *what)
+/* Flips a byte in the middle of the zlib stream of the first array named `name` after `after`
+ * (binary 7400: name length byte, name, then the 'd'/'f'/'i' array header of 13 bytes). */
+static int corrupt_array(unsigned char *data, size_t size, const char *after, const char *name)
+{
+    size_t n = strlen(name), from = 0, a = strlen(after);
+    for (; from + a <= size && memcmp(data + from, after, a) != 0; from++) {}
+    for (size_t i = from; i + n + 14 < size; i++) {
+        if (data[i - 1] != n || memcmp(data + i, name, n) != 0) continue;
+        const unsigned char *h = data + i + n;
+        uint32_t encoding = (uint32_t)h[5] | (uint32_t)h[6] << 8, stored = (uint32_t)h[9] | (uint32_t)h[10] << 8 |
+                                                                        (uint32_t)h[11] << 16 | (uint32_t)h[12] << 24;
+        if (encoding != 1 || stored < 64 || i + n + 13 + stored > size) return 0;
+        for (uint32_t k = stored / 2; k < stored / 2 + 16; k++) data[i + n + 13 + k] ^= 0x5a;
+        return 1;
+    }
+    return 0;
+}
+
+/* corrupt: 0 none, 1 the mesh's Vertices, 2 its layer Normals (both decoded ahead). */
+static void compare_threads(int blender, int nan, int corrupt, const char *what)
 {
     grid_scene g;
     build(&g, blender, nan);
     unsigned char *data = NULL;
     size_t size = 0;
     CHECK(fbxw_write(&g.scene, &data, &size) == 0);
+    if (corrupt)
+        CHECK(corrupt_array(data, size, corrupt == 1 ? "Geometry" : "LayerElementNormal", corrupt == 1 ? "Vertices" : "Normals"));
     outcome first;
     import_with(data, size, 1, &first);
-    if (nan) {
+    if (corrupt) {
+        CHECK_MSG(first.result == MK_ERROR_PARSE && strstr(first.err.message, corrupt == 1 ? "Vertices" : "Normals") &&
+                      (strstr(first.err.message, "zlib") || strstr(first.err.message, "compressed array")),
+                  "%s: %s", what, first.err.message);
+    } else if (nan) {
         CHECK_MSG(first.result == MK_ERROR_NOT_FINITE, "%s: %s", what, first.err.message);
         CHECK_MSG(strstr(first.err.message, "'s3'") != NULL, "%s: the first broken shape in file order: %s", what,
                   first.err.message);
@@ -204,12 +230,18 @@ static void compare_threads(int blender, int nan, const char *what)
     release(&g);
 }
 
-static void test_plain_shapes(void) { compare_threads(0, 0, "plain"); }
-static void test_blender_vertex_weights(void) { compare_threads(1, 0, "Blender"); }
+static void test_plain_shapes(void) { compare_threads(0, 0, 0, "plain"); }
+static void test_blender_vertex_weights(void) { compare_threads(1, 0, 0, "Blender"); }
 static void test_first_error_in_file_order(void)
 {
-    compare_threads(0, 1, "NaN deltas");
-    compare_threads(1, 1, "NaN deltas, Blender");
+    compare_threads(0, 1, 0, "NaN deltas");
+    compare_threads(1, 1, 0, "NaN deltas, Blender");
+}
+static void test_corrupt_mesh_arrays(void)
+{
+    compare_threads(0, 0, 1, "corrupt Vertices");
+    compare_threads(0, 0, 2, "corrupt Normals");
 }
 
-CHECK_MAIN(CASE(test_plain_shapes), CASE(test_blender_vertex_weights), CASE(test_first_error_in_file_order))
+CHECK_MAIN(CASE(test_plain_shapes), CASE(test_blender_vertex_weights), CASE(test_first_error_in_file_order),
+           CASE(test_corrupt_mesh_arrays))
