@@ -89,6 +89,31 @@ void *mk_arena_realloc(mk_arena *arena, void *ptr, size_t old_size, size_t new_s
     return p;
 }
 
+void *mk_arena_grow(mk_arena *arena, void *ptr, size_t new_size)
+{
+    mk_arena_block *b = (mk_arena_block *)ptr - 1;
+    size_t old_size = b->size;
+    if (new_size <= old_size) return ptr;
+    if (arena->allocator.alloc || arena->allocator.free) return mk_arena_realloc(arena, ptr, old_size, new_size);
+    if (new_size > SIZE_MAX - sizeof(mk_arena_block) - 16 ||
+        (arena->allocator.memory_limit && new_size - old_size > arena->allocator.memory_limit - arena->bytes_live)) {
+        arena->failed = 1;
+        return NULL;
+    }
+    arena->calls++;
+    if (arena->allocator.fail_after && arena->calls >= arena->allocator.fail_after) { arena->failed = 1; return NULL; }
+    mk_arena_block *prev = b->prev, *next = b->next;
+    mk_arena_block *g = realloc(b, sizeof(mk_arena_block) + new_size);
+    if (!g) { arena->failed = 1; return NULL; }
+    if (prev) prev->next = g; else arena->blocks = g;
+    if (next) next->prev = g;
+    g->size = new_size;
+    arena->bytes_live += new_size - old_size;
+    if (arena->bytes_live > arena->bytes_peak) arena->bytes_peak = arena->bytes_live;
+    memset((char *)(g + 1) + old_size, 0, new_size - old_size);
+    return g + 1;
+}
+
 char *mk_arena_strndup(mk_arena *arena, const char *s, size_t n)
 {
     char *p = mk_arena_alloc(arena, n + 1);

@@ -41,6 +41,11 @@ void *mk_arena_alloc(mk_arena *arena, size_t size);
 void *mk_arena_array(mk_arena *arena, size_t count, size_t size);
 /* Grows an array allocated from this arena: returns new zeroed-tail copy (old is released). */
 void *mk_arena_realloc(mk_arena *arena, void *ptr, size_t old_size, size_t new_size);
+/* Grows a block of this arena to new_size bytes (never shrinks it: a smaller size returns ptr);
+ * the bytes past its old size are zeroed. With the default allocator the block is moved by
+ * realloc, which keeps a large block's pages (mremap) instead of copying them into fresh ones;
+ * otherwise as mk_arena_realloc. NULL (and ptr left as it was) when refused. */
+void *mk_arena_grow(mk_arena *arena, void *ptr, size_t new_size);
 void mk_arena_release(mk_arena *arena, void *ptr);
 char *mk_arena_strdup(mk_arena *arena, const char *s);
 char *mk_arena_strndup(mk_arena *arena, const char *s, size_t n);

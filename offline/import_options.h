@@ -35,8 +35,8 @@ typedef struct mk_import_options {
     /* Where the import's time and memory go, phase by phase (read, parse, meshes, shapes,
      * target normals, animation, validate); may be NULL. The caller starts the log. */
     mk_phase_log *phases;
-    /* Threads for the parts of an import that run in parallel (target normals); 0 = one per
-     * core. The result is the same for any count. With more than one, the raw asset's
+    /* Threads for the parts of an import that run in parallel (FBX shapes, target normals); 0 =
+     * one per core. The result is the same for any count. With more than one, the raw asset's
      * allocator is called from several threads (the default one, malloc, may be). */
     uint32_t threads;
     /* Called at most once, when the importer will not read the input bytes again (FBX: before

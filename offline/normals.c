@@ -98,9 +98,12 @@ static int compare_u32(const void *a, const void *b)
 
 /* One target, in time proportional to what it touches: the triangles around moved vertices
  * get deformed face normals, the groups around those triangles new normals, and the
- * target's index set grows by the vertices of those groups. */
-static mk_result compute_target(mk_arena *arena, const mk_raw_mesh *m, const topology *topo, mk_raw_target *t,
-                                work *w, mk_error *err)
+ * target's index set grows by the vertices of those groups. New arrays come from `arena`;
+ * with an `owner` (the arena of the target's arrays, shared by the workers through
+ * owner_lock), the indices and positions grow in place instead (mk_arena_grow keeps their
+ * pages) and the merge runs from the end, so it never overwrites an entry it has yet to read. */
+static mk_result compute_target(mk_arena *arena, mk_arena *owner, mtx_t *owner_lock, const mk_raw_mesh *m,
+                                const topology *topo, mk_raw_target *t, work *w, mk_error *err)
 {
     for (uint32_t j = 0; j < t->count; j++) w->moved[t->indices[j]] = (int32_t)j;
     uint32_t tri_count = 0, group_count = 0, extra = 0;
@@ -142,23 +145,41 @@ static mk_result compute_target(mk_arena *arena, const mk_raw_mesh *m, const top
     }
     qsort(w->extra, extra, sizeof *w->extra, compare_u32);
     uint32_t total = t->count + extra;
-    uint32_t *indices = mk_arena_array(arena, (size_t)total + 1, sizeof(uint32_t));
-    float *positions = mk_arena_array(arena, (size_t)total * 3 + 3, sizeof(float));
+    uint32_t *indices = NULL;
+    float *positions = NULL;
+    const uint32_t *old_indices = t->indices;
+    const float *old_positions = t->positions;
+    if (owner && t->count) {
+        mtx_lock(owner_lock);
+        indices = mk_arena_grow(owner, t->indices, ((size_t)total + 1) * sizeof(uint32_t));
+        if (indices) t->indices = indices;  /* the old pointer is gone once grown */
+        positions = indices ? mk_arena_grow(owner, t->positions, ((size_t)total * 3 + 3) * sizeof(float)) : NULL;
+        if (positions) t->positions = positions;
+        mtx_unlock(owner_lock);
+        old_indices = indices;
+        old_positions = positions;
+    } else {
+        indices = mk_arena_array(arena, (size_t)total + 1, sizeof(uint32_t));
+        positions = mk_arena_array(arena, (size_t)total * 3 + 3, sizeof(float));
+    }
     float *normals = mk_arena_array(arena, (size_t)total * 3 + 3, sizeof(float));
     /* Authored tangent deltas are kept (re-spread to the grown index set); otherwise the
      * base tangent is re-orthogonalized against the new normal. */
     const float *authored_tangents = t->tangents;
     float *tangents = m->tangents ? mk_arena_array(arena, (size_t)total * 3 + 3, sizeof(float)) : NULL;
     if (!indices || !positions || !normals || (m->tangents && !tangents)) return mk_error_oom(err, "computing target normals");
-    /* Merge the sorted moved indices with the sorted added vertices. */
-    uint32_t a = 0, b = 0;
-    for (uint32_t out = 0; out < total; out++) {
-        int from_moved = b >= extra || (a < t->count && t->indices[a] < w->extra[b]);
-        uint32_t v = from_moved ? t->indices[a] : w->extra[b];
+    /* The moved marks are cleared now: the merge may overwrite the moved indices. */
+    for (uint32_t j = 0; j < t->count; j++) w->moved[old_indices[j]] = -1;
+    /* Merge the sorted moved indices with the sorted added vertices, from the end. */
+    uint32_t a = t->count, b = extra;
+    for (uint32_t out = total; out-- > 0;) {
+        int from_moved = b == 0 || (a > 0 && old_indices[a - 1] > w->extra[b - 1]);
+        uint32_t v = from_moved ? old_indices[a - 1] : w->extra[b - 1];
+        uint32_t src = from_moved ? --a : 0;
+        if (!from_moved) b--;
         indices[out] = v;
-        uint32_t src = a;
-        if (from_moved) memcpy(&positions[3u * out], &t->positions[3u * a++], 3 * sizeof(float));
-        else b++;
+        if (from_moved) memmove(&positions[3u * out], &old_positions[3u * src], 3 * sizeof(float));
+        else memset(&positions[3u * out], 0, 3 * sizeof(float));
         uint32_t g = topo->g.group_of[v];
         const float *nb = &topo->base_normal[3u * g];
         const float *nt = w->group_slot[g] >= 0 ? &group_new[3u * (uint32_t)w->group_slot[g]] : nb;
@@ -173,12 +194,12 @@ static mk_result compute_target(mk_arena *arena, const mk_raw_mesh *m, const top
             for (int d = 0; d < 3; d++) tangents[3u * out + (uint32_t)d] = tt[d] - tb[d];
         }
     }
-    /* Reset the work arrays for the next target. */
-    for (uint32_t j = 0; j < t->count; j++) w->moved[t->indices[j]] = -1;
+    /* Reset the other work arrays for the next target. */
     for (uint32_t k = 0; k < tri_count; k++) w->tri_slot[w->tris[k]] = -1;
     for (uint32_t k = 0; k < group_count; k++) w->group_slot[w->groups[k]] = -1;
     for (uint32_t k = 0; k < extra; k++) w->vert_mark[w->extra[k]] = 0;
-    /* The old arrays are replaced (they may belong to the importer: left to the arena). */
+    /* The old arrays are replaced or grown (without an owner they may belong to the importer:
+     * left to the arena). */
     t->indices = indices;
     t->positions = positions;
     t->normals = normals;
@@ -235,8 +256,10 @@ static void normals_item(void *user, uint32_t item, uint32_t worker)
 {
     normals_loop *l = user;
     mk_raw_target *t = l->targets[item];
-    void *old[] = { t->indices, t->positions, t->normals, t->tangents };
-    l->results[item] = compute_target(&l->arenas[worker], l->m, l->topo, t, &l->works[worker], &l->errors[item]);
+    int grows = l->owner && t->count;  /* indices and positions grow in place (compute_target) */
+    void *old[] = { grows ? NULL : t->indices, grows ? NULL : t->positions, t->normals, t->tangents };
+    l->results[item] = compute_target(&l->arenas[worker], l->owner, l->owner_lock, l->m, l->topo, t, &l->works[worker],
+                                      &l->errors[item]);
     if (!l->owner || l->results[item] != MK_OK) return;
     mtx_lock(l->owner_lock);
     for (size_t i = 0; i < sizeof old / sizeof old[0]; i++) mk_arena_release(l->owner, old[i]);

@@ -124,8 +124,9 @@ mk_result mk_raw_validate(const mk_raw_asset *raw, mk_error *err);
  * threads (0: one per core; the result is the same for any count). */
 mk_result mk_raw_compute_target_normals(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads, mk_error *err);
 /* The same for a model whose target arrays are each a block of the raw arena, pointed at by
- * nothing else (an importer's): a target's replaced arrays go back to the arena as soon as its
- * new ones exist, so the old and new arrays of all targets are never alive at once. */
+ * nothing else (an importer's): a target's indices and positions grow in place (their pages
+ * are kept, mk_arena_grow) and its replaced arrays go back to the arena as soon as its new
+ * ones exist, so the old and new arrays of all targets are never alive at once. */
 mk_result mk_raw_compute_target_normals_replacing(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads,
                                                   mk_error *err);
 

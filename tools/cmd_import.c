@@ -47,8 +47,8 @@ static const cli_option options[] = {
       "normals, quantize, lay out blocks, write file, ...), then the total.",
       NULL, NULL, 0, 0, 0, 0 },
     { "--threads", "N", CLI_UINT, offsetof(import_args, threads),
-      "Threads for the parts of an import that run in parallel (target normals, quantization, block layout); 0 = "
-      "one per core. The blob is the same for any count.",
+      "Threads for the parts of an import that run in parallel (FBX shapes, target normals, quantization, block "
+      "layout); 0 = one per core. The blob is the same for any count.",
       "0", NULL, 0, 64, 0, 0 },
     { "--depfile", "PATH", CLI_STRING, offsetof(import_args, depfile),
       "Also write a depfile for build systems (make syntax, as ninja and meson read it): the blob and every file the "

@@ -28,6 +28,7 @@ void fbx_release(mk_arena *arena, void *ptr)
 
 void fbx_doc_free(fbx_doc *doc)
 {
+    fbx_prefetch_drop(doc);
     if (doc->inflater) libdeflate_free_decompressor(doc->inflater);
     doc->inflater = NULL;
     for (size_t i = 0; i < sizeof doc->spare / sizeof doc->spare[0]; i++) fbx_release(doc->arena, doc->spare[i].ptr);
@@ -355,6 +356,8 @@ mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void
 {
     *out = NULL;
     *count = 0;
+    mk_result taken;
+    if (fbx_prefetch_take(doc, node, elem, out, count, &taken)) return taken;
     size_t esize = elem_size(elem);
     if (node->value_count == 1 && node->values[0].kind == FBX_ARRAY) {
         const fbx_value *v = &node->values[0];
@@ -385,6 +388,12 @@ mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void
     *out = data;
     *count = node->value_count;
     return MK_OK;
+}
+
+size_t fbx_node_array_length(const fbx_node *node)
+{
+    if (node->value_count == 1 && node->values[0].kind == FBX_ARRAY) return node->values[0].count;
+    return node->value_count;
 }
 
 mk_result fbx_child_array(fbx_doc *doc, const fbx_node *node, const char *name, fbx_elem elem,

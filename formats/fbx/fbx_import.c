@@ -30,6 +30,7 @@ mk_result mk_import_fbx(const void *data, size_t size, const mk_import_options *
     doc.data = data;
     doc.size = size;
     doc.err = err;
+    doc.threads = options->threads;
     doc.binary = fbx_is_binary(data, size);
     const uint32_t first_mesh = out->mesh_count;
     r = doc.binary ? fbx_parse_binary(&doc) : fbx_parse_ascii(&doc);

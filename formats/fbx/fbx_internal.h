@@ -68,6 +68,9 @@ typedef struct fbx_doc {
     mk_error *err;
     void *inflater;         /* libdeflate decompressor, made on first use, freed by fbx_doc_free */
     struct { void *ptr; size_t size; } spare[4]; /* recycled array buffers (fbx_recycle) */
+    uint32_t threads;       /* mk_import_options.threads: worker threads for fbx_prefetch and the shapes */
+    struct fbx_prefetched *prefetched; /* arrays decoded ahead (fbx_prefetch), handed over by fbx_node_array */
+    uint32_t prefetched_count;
 } fbx_doc;
 
 void fbx_doc_free(fbx_doc *doc);
@@ -119,6 +122,27 @@ mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void
 /* Same for the child named `name`; *out NULL and count 0 when the child is absent (MK_OK). */
 mk_result fbx_child_array(fbx_doc *doc, const fbx_node *node, const char *name, fbx_elem elem,
                           void **out, size_t *count);
+/* fbx_prefetch.c: decodes the arrays of nodes[i] as elems[i] (a node may be NULL) on
+ * doc->threads worker threads, so that the next fbx_node_array of each (node, elem) returns at
+ * once what decoding it then would return: the array, or the error (with the same message).
+ * Small arrays, and a single large one, are left to be decoded when asked; so is everything
+ * when the bookkeeping cannot be allocated. fbx_prefetch_drop releases what was not asked
+ * for (call it before the next fbx_prefetch and before the document is freed). */
+typedef struct fbx_prefetched {
+    const fbx_node *node;   /* NULL once handed over */
+    fbx_elem elem;
+    void *data;             /* doc->arena */
+    size_t count;
+    mk_result result;
+    mk_error error;
+} fbx_prefetched;
+void fbx_prefetch(fbx_doc *doc, const fbx_node *const *nodes, const fbx_elem *elems, uint32_t count);
+void fbx_prefetch_drop(fbx_doc *doc);
+/* The prefetched (node, elem) of fbx_prefetch: 1 and the result in *r when there is one. */
+int fbx_prefetch_take(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void **out, size_t *count, mk_result *r);
+
+/* The element count fbx_node_array gives for `node` when it succeeds, without decoding. */
+size_t fbx_node_array_length(const fbx_node *node);
 /* Gives back an array of fbx_node_array (`size` bytes: its count times the element size) for
  * the next arrays to reuse: a blend shape's arrays are decoded, expanded and dropped, and a
  * fresh buffer for every shape costs a zeroed page for every page. Small arrays, and arrays

@@ -152,6 +152,18 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
     int normals_present = 0;
 
     fbx_node_path(geometry, path, sizeof path);
+    /* The large arrays read below, decoded together on worker threads (fbx_prefetch.c). */
+    const fbx_node *normal_element = first_element(geometry, "LayerElementNormal");
+    const fbx_node *uv_element = first_element(geometry, "LayerElementUV");
+    const fbx_node *uv_info = uv_element ? NULL : fbx_child(geometry, "GeometryUVInfo");
+    const fbx_node *ahead[] = { fbx_child(geometry, "Vertices"), fbx_child(geometry, "PolygonVertexIndex"),
+                                fbx_child(normal_element, "Normals"), fbx_child(normal_element, "NormalsIndex"),
+                                normal_element ? NULL : fbx_child(geometry, "Normals"), fbx_child(uv_element, "UV"),
+                                fbx_child(uv_element, "UVIndex"), fbx_child(uv_info, "TextureUV"),
+                                fbx_child(uv_info, "TextureUVVerticeIndex") };
+    const fbx_elem as[] = { FBX_ELEM_F64, FBX_ELEM_I32, FBX_ELEM_F32, FBX_ELEM_I32, FBX_ELEM_F32,
+                            FBX_ELEM_F32, FBX_ELEM_I32, FBX_ELEM_F32, FBX_ELEM_I32 };
+    fbx_prefetch(doc, ahead, as, (uint32_t)(sizeof ahead / sizeof ahead[0]));
     r = fbx_child_array(doc, geometry, "Vertices", FBX_ELEM_F64, (void **)&vertices, &vertex_doubles);
     if (r != MK_OK) goto done;
     if (vertex_doubles % 3 != 0) {
@@ -179,7 +191,6 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
     }
 
     /* Normals: LayerElementNormal (6.x/7.x), or a plain Normals array on the geometry (FBX 5). */
-    const fbx_node *normal_element = first_element(geometry, "LayerElementNormal");
     if (normal_element) {
         r = read_layer(doc, raw, normal_element, "Normals", "NormalsIndex", 3, pv_count, &normals);
     } else if (fbx_child(geometry, "Normals") && !fbx_child(geometry, "Indexes")) {
@@ -191,11 +202,10 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
         normals.mapping = normals.data_count == cp_count ? MAP_CP : normals.data_count == pv_count ? MAP_PV : MAP_NONE;
     }
     if (r != MK_OK) goto done;
-    const fbx_node *uv_element = first_element(geometry, "LayerElementUV");
     if (uv_element) {
         r = read_layer(doc, raw, uv_element, "UV", "UVIndex", 2, pv_count, &uvs);
-    } else if ((uv_element = fbx_child(geometry, "GeometryUVInfo")) != NULL) {
-        r = read_layer(doc, raw, uv_element, "TextureUV", "TextureUVVerticeIndex", 2, pv_count, &uvs);
+    } else if (uv_info) {
+        r = read_layer(doc, raw, uv_info, "TextureUV", "TextureUVVerticeIndex", 2, pv_count, &uvs);
     }
     if (r != MK_OK) goto done;
     normals_present = normals.mapping != MAP_NONE && normals.data;
@@ -369,6 +379,7 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
     r = MK_OK;
 
 done:
+    fbx_prefetch_drop(doc);  /* what was not asked for */
     fbx_release(arena, vertices);
     fbx_release(arena, polygon_index);
     free_layer(doc, &normals);
@@ -408,7 +419,7 @@ static int cmp_pair(const void *a, const void *b)
     return x->entry < y->entry ? -1 : x->entry > y->entry;
 }
 
-mk_result fbx_expand_shape(fbx_doc *doc, mk_raw_asset *raw, fbx_mesh_map *map, const fbx_shape_data *shape,
+mk_result fbx_expand_shape(fbx_doc *doc, mk_arena *out, fbx_mesh_map *map, const fbx_shape_data *shape,
                            mk_raw_target *target, size_t *skipped)
 {
     mk_arena *arena = doc->arena;
@@ -479,7 +490,6 @@ mk_result fbx_expand_shape(fbx_doc *doc, mk_raw_asset *raw, fbx_mesh_map *map, c
         total += map->first[cp + 1] - map->first[cp];
     }
     if (total > UINT32_MAX) { r = mk_error_set(doc->err, MK_ERROR_LIMIT, UINT64_MAX, "FBX shape too large"); goto done; }
-    mk_arena *out = &raw->arena;
     target->count = (uint32_t)total;
     target->indices = mk_arena_array(out, total ? total : 1, sizeof(uint32_t));
     target->positions = mk_arena_array(out, total ? total : 1, 3 * sizeof(float));

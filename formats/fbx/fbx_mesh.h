@@ -41,8 +41,9 @@ typedef struct fbx_shape_data {
 } fbx_shape_data;
 
 /* Fills target->count/indices/positions/normals with the deltas on render vertices (strictly
- * increasing indices). Entries with out-of-range indices are skipped and counted. */
-mk_result fbx_expand_shape(fbx_doc *doc, mk_raw_asset *raw, fbx_mesh_map *map, const fbx_shape_data *shape,
+ * increasing indices), the arrays allocated from `out`; scratch comes from doc->arena and the
+ * map. Entries with out-of-range indices are skipped and counted. */
+mk_result fbx_expand_shape(fbx_doc *doc, mk_arena *out, fbx_mesh_map *map, const fbx_shape_data *shape,
                            mk_raw_target *target, size_t *skipped);
 
 #endif

@@ -30,6 +30,7 @@
 #include "mat4.h"
 #include "fbx_anim.h"
 #include "fbx_mesh.h"
+#include "fbx_shapes.h"
 #include "fbx_transform.h"
 
 enum {
@@ -544,152 +545,68 @@ static mk_result transform_not_finite(scene *s, uint32_t o, const char *mesh_nam
 
 /* ---- blend shapes ---- */
 
-typedef struct shape_ref {
-    const fbx_node *node;     /* Geometry Shape or legacy Shape: node */
-    const char *name;
-    uint32_t name_length;
-    double full_weight;       /* percent */
-} shape_ref;
-
 static char *dup_name(scene *s, const char *name, uint32_t length)
 {
     return mk_arena_strndup(&s->raw->arena, name ? name : "", name ? length : 0);
 }
 
-static int any_nonzero(const double *v, size_t n)
-{
-    for (size_t i = 0; i < n; i++) if (v[i] != 0.0) return 1;
-    return 0;
-}
+/* A mesh's channels in file order (fbx_add_channels adds them), each with the (object,
+ * property) its animation is bound to. */
+typedef struct channel_key {
+    uint32_t object;
+    const char *prop;
+    uint32_t prop_length;
+} channel_key;
 
-/* Adds one channel with its shapes; returns the raw channel index through *channel_index
- * (UINT32_MAX when every shape was unusable and no channel was added). */
-static mk_result add_channel(scene *s, uint32_t mesh, fbx_mesh_map *map, const char *name, uint32_t name_length,
-                             double default_percent, shape_ref *shapes, uint32_t shape_count,
-                             const double *full_weights, size_t full_weight_count, uint32_t *channel_index)
+typedef struct found_channels {
+    fbx_channel_plan *plans;
+    channel_key *keys;
+    uint32_t count, cap;
+} found_channels;
+
+/* Appends a channel; takes `shapes` and `full_weights` (doc arena), also when it fails. */
+static mk_result found_add(scene *s, found_channels *f, const char *name, uint32_t name_length, double default_percent,
+                           fbx_shape_ref *shapes, uint32_t shape_count, double *full_weights, size_t full_weight_count,
+                           const fbx_node *vertex_weights, channel_key key)
 {
     fbx_doc *doc = s->doc;
-    mk_raw_asset *raw = s->raw;
-    *channel_index = UINT32_MAX;
-    char path[160];
-    /* Blender writes vertex-group weights (one per Indexes entry, 0..100) into FullWeights
-     * (ufbx PR #212; Blender export_fbx_bin.py): they scale the deltas, full weight is 100. */
-    int vertex_weights = 0;
-    if (s->blender && shape_count == 1 && full_weight_count > 0) vertex_weights = 1;
-    for (uint32_t i = 0; i < shape_count; i++)
-        shapes[i].full_weight = (!vertex_weights && i < full_weight_count) ? full_weights[i] : 100.0;
-    /* Stable insertion sort by full weight (in-betweens come in connection order). */
-    for (uint32_t i = 1; i < shape_count; i++) {
-        shape_ref t = shapes[i];
-        uint32_t j = i;
-        while (j > 0 && shapes[j - 1].full_weight > t.full_weight) { shapes[j] = shapes[j - 1]; j--; }
-        shapes[j] = t;
+    if (f->count == f->cap) {
+        uint32_t cap = f->cap ? f->cap * 2 : 16;
+        fbx_channel_plan *plans = fbx_grow(doc->arena, f->plans, f->cap * sizeof *plans, cap * sizeof *plans);
+        if (plans) f->plans = plans;
+        channel_key *keys = plans ? fbx_grow(doc->arena, f->keys, f->cap * sizeof *keys, cap * sizeof *keys) : NULL;
+        if (!keys) {
+            fbx_release(doc->arena, shapes);
+            fbx_release(doc->arena, full_weights);
+            return mk_error_oom(doc->err, "FBX channels");
+        }
+        f->keys = keys;
+        f->cap = cap;
     }
-    mk_raw_channel *channel = NULL;
-    uint32_t index = raw->channel_count;
-    float last_weight = 0;
-    for (uint32_t i = 0; i < shape_count; i++) {
-        const fbx_node *node = shapes[i].node;
-        fbx_node_path(node, path, sizeof path);
-        float fw = (float)(shapes[i].full_weight / 100.0);
-        /* The same gaps mk_raw_validate and the runtime require (format.h): a full weight the
-         * runtime cannot place is skipped here with a warning, never passed on to fail later. */
-        if (!isfinite(fw) || fabsf(fw) < MK_MIN_FULL_WEIGHT_GAP) {
-            mk_raw_warn(raw, "FBX %s '%.*s': full weight %g is zero (closer than 1e-6) or not finite; shape skipped", path,
-                        (int)shapes[i].name_length, shapes[i].name, shapes[i].full_weight);
-            continue;
-        }
-        if (channel && channel->target_count > 0 && !(fw - last_weight >= MK_MIN_FULL_WEIGHT_GAP)) {
-            mk_raw_warn(raw, "FBX %s '%.*s': full weight %g repeats the previous in-between (closer than 1e-6); duplicate dropped",
-                        path, (int)shapes[i].name_length, shapes[i].name, shapes[i].full_weight);
-            continue;
-        }
-        int32_t *indexes = NULL;
-        double *positions = NULL, *normals = NULL, *weights = NULL;
-        size_t n_idx, n_pos, n_nrm = 0, n_w = 0;
-        mk_result r = fbx_child_array(doc, node, "Indexes", FBX_ELEM_I32, (void **)&indexes, &n_idx);
-        if (r == MK_OK) r = fbx_child_array(doc, node, "Vertices", FBX_ELEM_F64, (void **)&positions, &n_pos);
-        if (r == MK_OK && s->options->target_normals != MK_TARGET_NORMALS_NONE)   /* not even decoded */
-            r = fbx_child_array(doc, node, "Normals", FBX_ELEM_F64, (void **)&normals, &n_nrm);
-        if (r != MK_OK) {
-            fbx_release(doc->arena, indexes);
-            fbx_release(doc->arena, positions);
-            fbx_release(doc->arena, normals);
-            return r;
-        }
-        int usable = indexes && positions && n_pos == 3 * n_idx;
-        if (!usable) {
-            mk_raw_warn(raw, "FBX %s: shape needs Indexes and 3 Vertices values per index (%zu, %zu); skipped", path,
-                        n_idx, n_pos);
-        } else {
-            fbx_shape_data data;
-            memset(&data, 0, sizeof data);
-            data.count = n_idx;
-            data.indexes = indexes;
-            data.positions = positions;
-            data.path = path;
-            data.node = node;
-            data.name = shapes[i].name;
-            data.name_length = shapes[i].name_length;
-            if (normals && n_nrm != n_pos) {
-                mk_raw_warn(raw, "FBX %s: Normals has %zu values for %zu vertices; ignored", path, n_nrm, n_pos);
-            } else if (normals && (s->options->keep_shape_normals || any_nonzero(normals, n_nrm))) {
-                data.normals = normals;
-            }
-            if (vertex_weights) {
-                if (full_weight_count == n_idx) {
-                    weights = mk_arena_array(doc->arena, n_idx ? n_idx : 1, sizeof(double));
-                    if (!weights) r = mk_error_oom(doc->err, "FBX shape");
-                    for (size_t k = 0; weights && k < n_idx; k++) weights[k] = full_weights[k] / 100.0;
-                    data.vertex_weights = weights;
-                    n_w = n_idx;
-                } else {
-                    mk_raw_warn(raw, "FBX %s: Blender FullWeights count %zu differs from %zu indexes; ignored", path,
-                                full_weight_count, n_idx);
-                }
-            }
-            (void)n_w;
-            if (r == MK_OK && !channel) {
-                channel = mk_raw_add_channels(raw, 1);
-                if (!channel) r = mk_error_oom(doc->err, "FBX channel");
-                else {
-                    channel->mesh = mesh;
-                    channel->name = dup_name(s, name, name_length);
-                    channel->origin = NULL;
-                    channel->default_weight = (float)(default_percent / 100.0);
-                    if (!channel->name) r = mk_error_oom(doc->err, "FBX channel");
-                }
-            }
-            mk_raw_target *target = NULL;
-            if (r == MK_OK) {
-                target = mk_raw_add_targets(raw, channel, 1);
-                if (!target) r = mk_error_oom(doc->err, "FBX target");
-            }
-            size_t skipped = 0;
-            if (r == MK_OK) {
-                target->full_weight = fw;
-                target->name = dup_name(s, shapes[i].name, shapes[i].name_length);
-                if (!target->name) r = mk_error_oom(doc->err, "FBX target");
-            }
-            if (r == MK_OK) r = fbx_expand_shape(doc, raw, map, &data, target, &skipped);
-            if (skipped)
-                mk_raw_warn(raw, "FBX %s: %zu Indexes entries outside the %u control points skipped", path, skipped,
-                            map->control_point_count);
-            last_weight = fw;
-        }
-        fbx_recycle(doc, indexes, n_idx * sizeof *indexes);  /* the next shape's arrays reuse them */
-        fbx_recycle(doc, positions, n_pos * sizeof *positions);
-        fbx_recycle(doc, normals, n_nrm * sizeof *normals);
-        fbx_release(doc->arena, weights);
-        if (r != MK_OK) return r;
-    }
-    if (!channel) {
-        mk_raw_warn(raw, "FBX channel '%.*s': no usable shape; channel dropped", (int)name_length, name ? name : "");
-        return MK_OK;
-    }
-    if (!isfinite(channel->default_weight)) channel->default_weight = 0;
-    *channel_index = index;
+    fbx_channel_plan *p = &f->plans[f->count];
+    memset(p, 0, sizeof *p);
+    p->name = name;
+    p->name_length = name_length;
+    p->default_percent = default_percent;
+    p->shapes = shapes;
+    p->shape_count = shape_count;
+    p->full_weights = full_weights;
+    p->full_weight_count = full_weight_count;
+    p->vertex_weights = vertex_weights;
+    p->channel = UINT32_MAX;
+    f->keys[f->count++] = key;
     return MK_OK;
+}
+
+static void found_free(scene *s, found_channels *f)
+{
+    for (uint32_t i = 0; i < f->count; i++) {
+        fbx_release(s->doc->arena, f->plans[i].shapes);
+        fbx_release(s->doc->arena, (void *)f->plans[i].full_weights);
+    }
+    fbx_release(s->doc->arena, f->plans);
+    fbx_release(s->doc->arena, f->keys);
+    memset(f, 0, sizeof *f);
 }
 
 /* DeformPercent from the Properties70 property, else the plain field (Blender, ZBrush). */
@@ -701,7 +618,7 @@ static double deform_percent(const fbx_node *node)
     return 0.0;
 }
 
-static mk_result blend_channels_7x(scene *s, uint32_t geometry, uint32_t mesh, fbx_mesh_map *map)
+static mk_result find_channels_7x(scene *s, uint32_t geometry, found_channels *found)
 {
     fbx_doc *doc = s->doc;
     uint32_t deformer_cursor = 0;
@@ -713,7 +630,7 @@ static mk_result blend_channels_7x(scene *s, uint32_t geometry, uint32_t mesh, f
             const object *ch = &s->objects[cc->src];
             uint32_t count = 0, cursor = 0;
             while (child_of_kind(s, cc->src, OBJ_SHAPE, &cursor)) count++;
-            shape_ref *shapes = mk_arena_array(doc->arena, count ? count : 1, sizeof(shape_ref));
+            fbx_shape_ref *shapes = mk_arena_array(doc->arena, count ? count : 1, sizeof(fbx_shape_ref));
             if (!shapes) return mk_error_oom(doc->err, "FBX shapes");
             cursor = 0;
             for (uint32_t i = 0; i < count; i++) {
@@ -722,17 +639,22 @@ static mk_result blend_channels_7x(scene *s, uint32_t geometry, uint32_t mesh, f
                 shapes[i].name = s->objects[sc->src].name;
                 shapes[i].name_length = s->objects[sc->src].name_length;
             }
+            /* Blender: a one-shape channel's FullWeights are per-vertex weights (fbx_shapes.h). */
+            const fbx_node *fw_node = fbx_child(ch->node, "FullWeights");
+            const fbx_node *vertex_weights =
+                s->blender && count == 1 && fw_node && fbx_node_array_length(fw_node) > 0 ? fw_node : NULL;
             double *full_weights = NULL;
             size_t fw_count = 0;
-            mk_result r = fbx_child_array(doc, ch->node, "FullWeights", FBX_ELEM_F64, (void **)&full_weights, &fw_count);
-            uint32_t index = UINT32_MAX;
-            if (r == MK_OK)
-                r = add_channel(s, mesh, map, ch->name, ch->name_length, deform_percent(ch->node), shapes, count,
-                                full_weights, fw_count, &index);
-            fbx_release(doc->arena, full_weights);
-            fbx_release(doc->arena, shapes);
+            mk_result r = vertex_weights ? MK_OK
+                          : fbx_child_array(doc, ch->node, "FullWeights", FBX_ELEM_F64, (void **)&full_weights, &fw_count);
+            if (r != MK_OK) {
+                fbx_release(doc->arena, shapes);
+                return r;
+            }
+            channel_key key = { cc->src, "DeformPercent", 13 };
+            r = found_add(s, found, ch->name, ch->name_length, deform_percent(ch->node), shapes, count, full_weights,
+                          fw_count, vertex_weights, key);
             if (r != MK_OK) return r;
-            if (index != UINT32_MAX && (r = bind(s, cc->src, "DeformPercent", 13, index)) != MK_OK) return r;
         }
     }
     return MK_OK;
@@ -740,29 +662,29 @@ static mk_result blend_channels_7x(scene *s, uint32_t geometry, uint32_t mesh, f
 
 /* FBX <= 7100: `Shape: "Name"` children of the geometry node, weight = same-named property of
  * `weight_holder` (Geometry in 7100, Model in 6.x), animation bound to (bind_object, name). */
-static mk_result legacy_shapes(scene *s, const fbx_node *geometry, const fbx_node *weight_holder, uint32_t bind_object,
-                               uint32_t mesh, fbx_mesh_map *map)
+static mk_result find_legacy_shapes(scene *s, const fbx_node *geometry, const fbx_node *weight_holder,
+                                    uint32_t bind_object, found_channels *found)
 {
     const fbx_node *shape = NULL;
     fbx_props props = fbx_props_of(weight_holder);
     while ((shape = fbx_next_child(geometry, shape, "Shape")) != NULL) {
-        shape_ref ref;
-        memset(&ref, 0, sizeof ref);
-        ref.node = shape;
-        if (shape->value_count < 1 || !fbx_value_string(&shape->values[0], &ref.name, &ref.name_length)) {
-            ref.name = "";
-            ref.name_length = 0;
+        fbx_shape_ref *ref = mk_arena_alloc(s->doc->arena, sizeof *ref);
+        if (!ref) return mk_error_oom(s->doc->err, "FBX shapes");
+        ref->node = shape;
+        if (shape->value_count < 1 || !fbx_value_string(&shape->values[0], &ref->name, &ref->name_length)) {
+            ref->name = "";
+            ref->name_length = 0;
         }
-        split_name(ref.name, ref.name_length, &ref.name, &ref.name_length);
+        split_name(ref->name, ref->name_length, &ref->name, &ref->name_length);
         /* Weight: property named after the shape; FBX 5 keeps it as Channel: "<name> (Shape)" Default. */
         double percent = 0.0;
         char prop_name[300];
-        if (ref.name_length < 256) {
-            memcpy(prop_name, ref.name, ref.name_length);
-            prop_name[ref.name_length] = 0;
+        if (ref->name_length < 256) {
+            memcpy(prop_name, ref->name, ref->name_length);
+            prop_name[ref->name_length] = 0;
             if (!fbx_prop_number_opt(props, prop_name, &percent)) {
                 const fbx_node *ch = NULL;
-                memcpy(prop_name + ref.name_length, " (Shape)", 9);
+                memcpy(prop_name + ref->name_length, " (Shape)", 9);
                 while ((ch = fbx_next_child(weight_holder, ch, "Channel")) != NULL) {
                     const char *n;
                     uint32_t nl;
@@ -771,12 +693,36 @@ static mk_result legacy_shapes(scene *s, const fbx_node *geometry, const fbx_nod
                 }
             }
         }
-        uint32_t index;
-        mk_result r = add_channel(s, mesh, map, ref.name, ref.name_length, percent, &ref, 1, NULL, 0, &index);
+        channel_key key = { bind_object, ref->name, ref->name_length };
+        mk_result r = found_add(s, found, ref->name, ref->name_length, percent, ref, 1, NULL, 0, NULL, key);
         if (r != MK_OK) return r;
-        if (index != UINT32_MAX && (r = bind(s, bind_object, ref.name, ref.name_length, index)) != MK_OK) return r;
     }
     return MK_OK;
+}
+
+/* The blend shape channels of a mesh: found in file order, added by fbx_add_channels (shapes
+ * decoded and expanded on worker threads), then bound to their animation. An error while
+ * finding them is reported after the channels found before it, as those come first in the file. */
+static mk_result mesh_channels(scene *s, const fbx_node *geometry, int32_t geometry_object, uint32_t model,
+                               uint32_t mesh, fbx_mesh_map *map)
+{
+    found_channels found;
+    memset(&found, 0, sizeof found);
+    mk_result r;
+    if (geometry_object >= 0) {
+        r = find_channels_7x(s, (uint32_t)geometry_object, &found);
+        if (r == MK_OK && fbx_child(geometry, "Shape"))
+            r = find_legacy_shapes(s, geometry, geometry, (uint32_t)geometry_object, &found);
+    } else {
+        r = find_legacy_shapes(s, geometry, geometry, model, &found);
+    }
+    mk_result added = fbx_add_channels(s->doc, s->raw, s->options, mesh, map, found.plans, found.count);
+    if (added != MK_OK) r = added;
+    for (uint32_t i = 0; i < found.count && r == MK_OK; i++)
+        if (found.plans[i].channel != UINT32_MAX)
+            r = bind(s, found.keys[i].object, found.keys[i].prop, found.keys[i].prop_length, found.plans[i].channel);
+    found_free(s, &found);
+    return r;
 }
 
 /* ---- meshes ---- */
@@ -905,13 +851,7 @@ static mk_result convert_meshes(scene *s)
             return transform_not_finite(s, o, mesh->name);
         }
         s->objects[o].raw_mesh = (int32_t)mesh_index;
-        if (geometry_object >= 0) {
-            r = blend_channels_7x(s, (uint32_t)geometry_object, mesh_index, &map);
-            if (r == MK_OK && fbx_child(geometry, "Shape"))
-                r = legacy_shapes(s, geometry, geometry, (uint32_t)geometry_object, mesh_index, &map);
-        } else {
-            r = legacy_shapes(s, geometry, geometry, o, mesh_index, &map);
-        }
+        r = mesh_channels(s, geometry, geometry_object, o, mesh_index, &map);
         fbx_mesh_map_free(doc, &map);
         mk_phase_log_mark(s->options->phases, "shapes");
         if (r != MK_OK) return r;

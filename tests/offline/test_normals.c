@@ -93,7 +93,7 @@ static void test_matches_recomputed_normals(void)
 
 /* Authored tangent deltas are kept when normals are computed: each moved vertex keeps its
  * own delta in the grown index set, and the neighbours that joined it get none. */
-static void test_authored_tangents_follow_their_vertex(void)
+static void authored_tangents_case(int replacing)
 {
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
@@ -103,7 +103,8 @@ static void test_authored_tangents_follow_their_vertex(void)
     t->tangents = mk_arena_array(&raw.arena, 9, sizeof(float));
     memcpy(t->tangents, authored, sizeof authored);
     mk_error err;
-    CHECK(mk_raw_compute_target_normals(&raw, 0, 0, 0, &err) == MK_OK);
+    CHECK(replacing ? mk_raw_compute_target_normals_replacing(&raw, 0, 0, 0, &err) == MK_OK
+                    : mk_raw_compute_target_normals(&raw, 0, 0, 0, &err) == MK_OK);
     t = &raw.channels[0].targets[0];
     CHECK(t->count > 3 && t->tangents != NULL);
     uint32_t found = 0;
@@ -119,6 +120,14 @@ static void test_authored_tangents_follow_their_vertex(void)
     }
     CHECK_EQ_INT(found, 3);
     mk_raw_free(&raw);
+}
+
+/* Both variants: the plain one, and the replacing one whose indices and positions grow in
+ * place (merged from the end). */
+static void test_authored_tangents_follow_their_vertex(void)
+{
+    authored_tangents_case(0);
+    authored_tangents_case(1);
 }
 
 /* Two targets moving the same vertices on one worker thread: the second gets the same grown
