@@ -42,11 +42,23 @@ static void raw_free(mk_arena *arena, void *ptr)
     else free(ptr);
 }
 
+/* Whether `more` bytes would take the arena past its limit. An arena that adopted another's
+ * blocks (mk_arena_adopt) may already be past it: then every further byte is refused. */
+static int over_limit(const mk_arena *arena, size_t more)
+{
+    const size_t limit = arena->allocator.memory_limit;
+    return limit && (arena->bytes_live > limit || more > limit - arena->bytes_live);
+}
+
+uint32_t mk_arena_threads(const mk_arena *arena, uint32_t threads)
+{
+    return arena->allocator.memory_limit || arena->allocator.fail_after ? 1u : threads;
+}
+
 void *mk_arena_alloc(mk_arena *arena, size_t size)
 {
     if (size > SIZE_MAX - sizeof(mk_arena_block) - 16) { arena->failed = 1; return NULL; }
-    /* bytes_live never exceeds the limit, so the subtraction cannot wrap. */
-    if (arena->allocator.memory_limit && size > arena->allocator.memory_limit - arena->bytes_live) {
+    if (over_limit(arena, size)) {
         arena->failed = 1;
         return NULL;
     }
@@ -95,8 +107,7 @@ void *mk_arena_grow(mk_arena *arena, void *ptr, size_t new_size)
     size_t old_size = b->size;
     if (new_size <= old_size) return ptr;
     if (arena->allocator.alloc || arena->allocator.free) return mk_arena_realloc(arena, ptr, old_size, new_size);
-    if (new_size > SIZE_MAX - sizeof(mk_arena_block) - 16 ||
-        (arena->allocator.memory_limit && new_size - old_size > arena->allocator.memory_limit - arena->bytes_live)) {
+    if (new_size > SIZE_MAX - sizeof(mk_arena_block) - 16 || over_limit(arena, new_size - old_size)) {
         arena->failed = 1;
         return NULL;
     }

@@ -36,6 +36,11 @@ typedef struct mk_arena {
 void mk_arena_init(mk_arena *arena, const mk_allocator *allocator);
 /* Zeroed memory, 16-byte aligned; NULL (and arena->failed set) when refused or size overflows.
  * size 0 returns a valid unique pointer. */
+/* Threads a parallel step whose workers allocate through arenas made from this arena's
+ * allocator may use: `threads`, or 1 where the allocator has a memory limit or a fault-injection
+ * count. Those are counted per arena, so per worker they would let the workers together go past
+ * the limit and make where an import fails depend on the thread count. */
+uint32_t mk_arena_threads(const mk_arena *arena, uint32_t threads);
 void *mk_arena_alloc(mk_arena *arena, size_t size);
 /* count * size with overflow check. */
 void *mk_arena_array(mk_arena *arena, size_t count, size_t size);

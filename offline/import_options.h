@@ -7,9 +7,10 @@
 #include "phase_log.h"
 #include "raw.h"
 
-/* The targets' normal deltas: the file's own where it has them and computed where it has none
- * (the default), or none at all: for playback that never blends normals (positions only, or
- * normals recomputed from the evaluated surface), which then reads and stores only positions. */
+/* The targets' normal deltas: the file's own (the default; FBX also computes them where the
+ * file has none), or none at all: for playback that never blends normals (positions only, or
+ * normals recomputed from the evaluated surface). With none, FBX shape normals are neither
+ * decoded nor computed, other inputs' are dropped after reading; tangent deltas stay. */
 typedef enum mk_target_normals {
     MK_TARGET_NORMALS_AUTO = 0,
     MK_TARGET_NORMALS_NONE = 1

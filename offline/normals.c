@@ -297,7 +297,7 @@ static mk_result compute_normals(mk_raw_asset *raw, uint32_t mesh, int force, ui
     topology topo;
     mk_result r = build_topology(arena, m, &topo, err);
     if (r != MK_OK) return r;
-    uint32_t workers = mk_parallel_threads(threads, count);
+    uint32_t workers = mk_parallel_threads(mk_arena_threads(arena, threads), count);
     normals_loop l = { m, &topo, NULL, NULL, NULL, NULL, NULL, NULL, NULL };
     l.targets = mk_arena_array(arena, count, sizeof *l.targets);
     l.results = mk_arena_array(arena, count, sizeof *l.results);

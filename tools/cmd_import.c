@@ -27,9 +27,10 @@ static const cli_option options[] = {
       "float) or float (lossless float32).",
       "q16", "q16|float", 0, 0, 0, 0 },
     { "--target-normals", "HOW", CLI_CHOICE, offsetof(import_args, target_normals),
-      "The targets' normal deltas: auto (the file's own; computed from the shape where the file has none) or none "
+      "The targets' normal deltas: auto (the file's own; FBX also computes them where the file has none) or none "
       "(not stored: for playback that never blends normals, i.e. positions only or surface normals recomputed from "
-      "the evaluated positions; the blob is smaller and positions evaluate faster). Base normals are always kept.",
+      "the evaluated positions; the blob is smaller and positions evaluate faster). Base normals and tangent deltas "
+      "are kept.",
       "auto", "auto|none", 0, 0, 0, 0 },
     { "--tolerance", "D", CLI_NUMBER, offsetof(import_args, tolerance),
       "Largest quantization error of a position, in mesh units. Default: 1e-4 x each mesh's bounding-box diagonal.",
@@ -47,8 +48,8 @@ static const cli_option options[] = {
       "normals, quantize, lay out blocks, write file, ...), then the total.",
       NULL, NULL, 0, 0, 0, 0 },
     { "--threads", "N", CLI_UINT, offsetof(import_args, threads),
-      "Threads for the parts of an import that run in parallel (FBX shapes, target normals, quantization, block "
-      "layout); 0 = one per core. The blob is the same for any count.",
+      "Threads for the parts of an import that run in parallel (FBX mesh arrays and shapes, target normals, "
+      "quantization, block layout); 0 = one per core. The blob is the same for any count.",
       "0", NULL, 0, 64, 0, 0 },
     { "--depfile", "PATH", CLI_STRING, offsetof(import_args, depfile),
       "Also write a depfile for build systems (make syntax, as ninja and meson read it): the blob and every file the "

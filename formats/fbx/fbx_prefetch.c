@@ -44,7 +44,7 @@ void fbx_prefetch(fbx_doc *doc, const fbx_node *const *nodes, const fbx_elem *el
     fbx_prefetch_drop(doc);
     uint32_t n = 0;
     for (uint32_t i = 0; i < count; i++) n += decoded_bytes(nodes[i], elems[i]) >= PREFETCH_MIN_BYTES;
-    uint32_t workers = mk_parallel_threads(doc->threads, n);
+    uint32_t workers = mk_parallel_threads(mk_arena_threads(doc->arena, doc->threads), n);
     if (n < 2 || workers < 2) return;
     fbx_prefetched *items = mk_arena_array(doc->arena, n, sizeof *items);
     prefetch_worker *w = mk_arena_array(doc->arena, workers, sizeof *w);

@@ -9,8 +9,10 @@
  *    every job keeps its own result, error and what its warnings need.
  * 3. In channel and in-between order, on the calling thread: the skip rules, warnings,
  *    channels and targets, exactly as going through the shapes one by one, and the first error
- *    in that order. A job whose shape a rule drops (a repeated full weight, which depends on
- *    the shapes before it) was done for nothing and its arrays are given back.
+ *    in that order. A shape whose full weight repeats the previous job's in its channel is not
+ *    run in step 2 (the duplicate rule usually drops it, and a file can repeat one cheap-to-store
+ *    shape many times); it runs here, on the calling thread, only if the rule keeps it (when the
+ *    shapes before it were unusable).
  */
 #include <math.h>
 #include <string.h>
@@ -19,6 +21,7 @@
 
 typedef struct shape_job {
     const fbx_shape_ref *ref;      /* NULL: no job (the full weight already drops the shape) */
+    int deferred;                  /* its full weight repeats the previous job's: run in step 3 if kept */
     const fbx_node *vertex_weights;/* Blender per-vertex FullWeights (percent), or NULL */
     size_t full_weight_count;      /* their count once decoded */
     mk_result result;
@@ -112,7 +115,7 @@ static void shape_item(void *user, uint32_t item, uint32_t worker)
 {
     shape_loop *l = user;
     shape_job *j = &l->jobs[item];
-    if (!j->ref) return;
+    if (!j->ref || j->deferred) return;
     shape_worker *w = &l->workers[worker];
     w->doc.err = &j->error;
     j->result = decode_and_expand(l, w, j);
@@ -132,9 +135,10 @@ static mk_result job_error(fbx_doc *doc, const shape_job *j)
     return j->result;
 }
 
-/* Step 3 for one channel: its shapes' jobs are jobs[0 .. plan->shape_count). */
+/* Step 3 for one channel: its shapes' jobs are jobs[0 .. plan->shape_count); a deferred job
+ * runs on the loop's first worker (the calling thread's). */
 static mk_result add_channel(fbx_doc *doc, mk_raw_asset *raw, uint32_t mesh, uint32_t control_points,
-                             fbx_channel_plan *plan, shape_job *jobs)
+                             fbx_channel_plan *plan, shape_job *jobs, shape_loop *l)
 {
     plan->channel = UINT32_MAX;
     char path[160];
@@ -158,6 +162,10 @@ static mk_result add_channel(fbx_doc *doc, mk_raw_asset *raw, uint32_t mesh, uin
                         path, (int)shape->name_length, shape->name, shape->full_weight);
             drop_job_arrays(raw, j);
             continue;
+        }
+        if (j->deferred) {
+            j->deferred = 0;
+            shape_item(l, (uint32_t)(j - l->jobs), 0);
         }
         if (!j->decoded) return job_error(doc, j);
         if (!j->usable) {
@@ -232,7 +240,7 @@ mk_result fbx_add_channels(fbx_doc *doc, mk_raw_asset *raw, const mk_import_opti
     shape_loop l;
     l.options = options;
     l.jobs = mk_arena_array(doc->arena, total ? total : 1, sizeof *l.jobs);
-    uint32_t workers = mk_parallel_threads(options->threads, (uint32_t)total);
+    uint32_t workers = mk_parallel_threads(mk_arena_threads(&raw->arena, options->threads), (uint32_t)total);
     l.workers = mk_arena_array(doc->arena, workers, sizeof *l.workers);
     if (!l.jobs || !l.workers) {
         fbx_release(doc->arena, l.jobs);
@@ -241,11 +249,19 @@ mk_result fbx_add_channels(fbx_doc *doc, mk_raw_asset *raw, const mk_import_opti
     size_t n = 0;
     for (uint32_t p = 0; p < plan_count; p++) {
         const fbx_channel_plan *plan = &plans[p];
+        float previous = 0;
+        int have_previous = 0;
         for (uint32_t i = 0; i < plan->shape_count; i++, n++) {
             float fw = (float)(plan->shapes[i].full_weight / 100.0);
             if (!isfinite(fw) || fabsf(fw) < MK_MIN_FULL_WEIGHT_GAP) continue;  /* dropped in step 3 */
             l.jobs[n].ref = &plan->shapes[i];
             l.jobs[n].vertex_weights = plan->vertex_weights;
+            if (have_previous && !(fw - previous >= MK_MIN_FULL_WEIGHT_GAP)) {
+                l.jobs[n].deferred = 1;
+            } else {
+                previous = fw;
+                have_previous = 1;
+            }
         }
     }
     for (uint32_t w = 0; w < workers; w++) {
@@ -267,10 +283,6 @@ mk_result fbx_add_channels(fbx_doc *doc, mk_raw_asset *raw, const mk_import_opti
         sw->map.pairs = NULL;
     }
     mk_parallel_for((uint32_t)total, workers, shape_item, &l);
-    /* The first worker's decoder, spare arrays and scratch go back to the document and map. */
-    doc->inflater = l.workers[0].doc.inflater;
-    memcpy(doc->spare, l.workers[0].doc.spare, sizeof doc->spare);
-    *map = l.workers[0].map;
     for (uint32_t w = 1; w < workers; w++) {
         fbx_doc_free(&l.workers[w].doc);
         mk_arena_free_all(&l.workers[w].scratch);
@@ -279,9 +291,13 @@ mk_result fbx_add_channels(fbx_doc *doc, mk_raw_asset *raw, const mk_import_opti
     mk_result r = MK_OK;
     n = 0;
     for (uint32_t p = 0; p < plan_count && r == MK_OK; p++) {
-        r = add_channel(doc, raw, mesh, map->control_point_count, &plans[p], &l.jobs[n]);
+        r = add_channel(doc, raw, mesh, map->control_point_count, &plans[p], &l.jobs[n], &l);
         n += plans[p].shape_count;
     }
+    /* The first worker's decoder, spare arrays and scratch go back to the document and map. */
+    doc->inflater = l.workers[0].doc.inflater;
+    memcpy(doc->spare, l.workers[0].doc.spare, sizeof doc->spare);
+    *map = l.workers[0].map;
     for (size_t i = 0; i < total; i++) drop_job_arrays(raw, &l.jobs[i]);  /* after an error: what was not used */
     fbx_release(doc->arena, l.workers);
     fbx_release(doc->arena, l.jobs);

@@ -95,4 +95,33 @@ static void test_refused_growth_keeps_the_block(void)
     }
 }
 
-CHECK_MAIN(CASE(test_grow_default_allocator), CASE(test_grow_user_allocator), CASE(test_refused_growth_keeps_the_block))
+/* An arena that adopted a worker arena's blocks can be past its limit (each arena counts its
+ * own): then it refuses everything, instead of the limit check wrapping around. A limited
+ * arena also keeps parallel steps on one thread, so where an import runs out does not depend
+ * on the thread count. */
+static void test_adopted_past_the_limit_refuses(void)
+{
+    mk_allocator a;
+    memset(&a, 0, sizeof a);
+    a.memory_limit = 100;
+    mk_arena into, from;
+    mk_arena_init(&into, &a);
+    mk_arena_init(&from, &a);
+    unsigned char *p = mk_arena_alloc(&into, 80), *q = mk_arena_alloc(&from, 80);
+    CHECK(p != NULL && q != NULL);
+    mk_arena_adopt(&into, &from);
+    CHECK_EQ_INT(into.bytes_live, 160);
+    CHECK(mk_arena_alloc(&into, 1) == NULL);
+    CHECK(mk_arena_alloc(&into, (size_t)1 << 20) == NULL);
+    if (p) CHECK(mk_arena_grow(&into, p, (size_t)2 << 20) == NULL);
+    CHECK(into.failed);
+    CHECK_EQ_INT(mk_arena_threads(&into, 8), 1);
+    a.memory_limit = 0;
+    mk_arena free_arena;
+    mk_arena_init(&free_arena, &a);
+    CHECK_EQ_INT(mk_arena_threads(&free_arena, 8), 8);
+    mk_arena_free_all(&into);
+}
+
+CHECK_MAIN(CASE(test_grow_default_allocator), CASE(test_grow_user_allocator), CASE(test_refused_growth_keeps_the_block),
+           CASE(test_adopted_past_the_limit_refuses))
