@@ -115,8 +115,8 @@ static int generate(const char *path, uint32_t grid, uint32_t channels, uint32_t
     for (uint32_t c = 0; c < channels; c++) {
         for (int k = 0; k < KEYS; k++) values[(size_t)c * KEYS + (size_t)k] = (float)(50 + 50 * ((k + (int)c) % 24 < 12 ? 1 : -1));
         curves[c] = (fbxw_curve){ KEYS, times, values + (size_t)c * KEYS, flags, data };
-        shapes[2 * c] = (fbxw_shape){ "half", moved, indexes, deltas_half, shape_normals ? shape_normal : NULL };
-        shapes[2 * c + 1] = (fbxw_shape){ "full", moved, indexes, deltas_full, shape_normals ? shape_normal : NULL };
+        shapes[2 * c] = (fbxw_shape){ "half", moved, indexes, deltas_half, shape_normals ? shape_normal : NULL, 0 };
+        shapes[2 * c + 1] = (fbxw_shape){ "full", moved, indexes, deltas_full, shape_normals ? shape_normal : NULL, 0 };
         chans[c].name = "channel";
         chans[c].shape_count = 2;
         chans[c].shapes = &shapes[2 * c];

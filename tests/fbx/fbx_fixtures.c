@@ -66,9 +66,9 @@ void fixture_cube(fbxw_scene *scene, uint32_t version, int binary, int compress)
     squash_curve = (fbxw_curve){ 3, squash_times, squash_values, squash_flags, squash_data };
     grow_curve = (fbxw_curve){ 2, grow_times, grow_values, grow_flags, grow_data };
 
-    squash_shape = (fbxw_shape){ "Squash", 4, squash_indexes, squash_deltas, NULL };
-    grow_shapes[0] = (fbxw_shape){ "Grow100", 1, grow100_indexes, grow100_deltas, NULL };
-    grow_shapes[1] = (fbxw_shape){ "Grow50", 3, grow50_indexes, grow50_deltas, NULL };
+    squash_shape = (fbxw_shape){ "Squash", 4, squash_indexes, squash_deltas, NULL, 0 };
+    grow_shapes[0] = (fbxw_shape){ "Grow100", 1, grow100_indexes, grow100_deltas, NULL, 0 };
+    grow_shapes[1] = (fbxw_shape){ "Grow50", 3, grow50_indexes, grow50_deltas, NULL, 0 };
     memset(cube_channels, 0, sizeof cube_channels);
     cube_channels[0].name = "Squash";
     cube_channels[0].deform_percent = 25;

@@ -671,7 +671,7 @@ static void write_scene(out *o, const fbxw_scene *sc)
                 } else {
                     leaf_array(o, "Indexes", 'i', sh->indexes, sh->count, 0);
                 }
-                leaf_array(o, "Vertices", 'd', sh->deltas, 3 * (size_t)sh->count, 0);
+                leaf_array(o, "Vertices", 'd', sh->deltas, 3 * (size_t)(sh->count - sh->short_deltas), 0);
                 if (sh->normals) leaf_array(o, "Normals", 'd', sh->normals, 3 * (size_t)sh->count, 0);
                 end(o, 1);
             }

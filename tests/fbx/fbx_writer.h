@@ -19,6 +19,7 @@ typedef struct fbxw_shape {
     const int32_t *indexes;       /* control points (may be unsorted / out of range on purpose) */
     const double *deltas;         /* 3 per entry */
     const double *normals;        /* 3 per entry or NULL (no Normals array) */
+    uint32_t short_deltas;        /* write this many fewer delta triples than entries (a broken shape) */
 } fbxw_shape;
 
 typedef struct fbxw_curve {

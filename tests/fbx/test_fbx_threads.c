@@ -36,8 +36,9 @@ static uint32_t next_random(uint32_t *state)
 }
 
 /* A GRID x GRID plane of quads; channel c has one shape, except channel 10 (in-betweens at 50,
- * 50 and 100 %: the second is a repeat and dropped) and channel 11 (0 and 100 %: the first is
- * skipped). Channel 4 lists a control point past the mesh; channel 6 has normals; channel 9's
+ * 50 and 100 %: the second is a repeat and dropped), channel 11 (0 and 100 %: the first is
+ * skipped) and channel 12 (50 and 50 %: the first has too few Vertices values and is skipped,
+ * so the repeat is kept: the importer runs it only then). Channel 4 lists a control point past the mesh; channel 6 has normals; channel 9's
  * FullWeights (per-vertex weights for Blender) has one entry too few. Channels 3 and 8 get a
  * NaN delta when `nan`. */
 static void build(grid_scene *g, int blender, int nan)
@@ -64,7 +65,7 @@ static void build(grid_scene *g, int blender, int nan)
         }
     uint32_t seed = 12345;
     for (uint32_t c = 0; c < CHANNELS; c++) {
-        uint32_t shape_count = c == 10 ? 3 : c == 11 ? 2 : 1;
+        uint32_t shape_count = c == 10 ? 3 : c == 11 || c == 12 ? 2 : 1;
         uint32_t entries = ENTRIES + 300 * c;
         for (uint32_t s = 0; s < shape_count; s++) {
             int32_t *idx = calloc(entries, sizeof(int32_t));
@@ -80,7 +81,7 @@ static void build(grid_scene *g, int blender, int nan)
             g->indexes[c][s] = idx;
             g->deltas[c][s] = d;
             g->shape_normals[c][s] = n;
-            g->shapes[c][s] = (fbxw_shape){ NULL, entries, idx, d, n };
+            g->shapes[c][s] = (fbxw_shape){ NULL, entries, idx, d, n, c == 12 && s == 0 ? 1u : 0u };
         }
         uint32_t fw_count = shape_count;
         double *fw;
@@ -90,8 +91,8 @@ static void build(grid_scene *g, int blender, int nan)
             for (uint32_t e = 0; e < fw_count; e++) fw[e] = (double)(next_random(&seed) % 101);
         } else {
             fw = calloc(3, sizeof(double));
-            fw[0] = c == 10 ? 50 : c == 11 ? 0 : 100;
-            fw[1] = c == 10 ? 50 : 100;
+            fw[0] = c == 10 || c == 12 ? 50 : c == 11 ? 0 : 100;
+            fw[1] = c == 10 || c == 12 ? 50 : 100;
             fw[2] = 100;
         }
         g->full_weights[c] = fw;
@@ -102,7 +103,7 @@ static void build(grid_scene *g, int blender, int nan)
                                                          "c7", "c8", "c9", "c10", "c11", "c12", "c13" };
     static const char *const shape_names[CHANNELS][3] = {
         { "s0" }, { "s1" }, { "s2" }, { "s3" }, { "s4" }, { "s5" }, { "s6" }, { "s7" }, { "s8" }, { "s9" },
-        { "s10a", "s10b", "s10c" }, { "s11a", "s11b" }, { "s12" }, { "s13" } };
+        { "s10a", "s10b", "s10c" }, { "s11a", "s11b" }, { "s12a", "s12b" }, { "s13" } };
     for (uint32_t c = 0; c < CHANNELS; c++) {
         g->channels[c].name = channel_names[c];
         for (uint32_t s = 0; s < g->channels[c].shape_count; s++) g->shapes[c][s].name = shape_names[c][s];
@@ -202,9 +203,23 @@ static void compare_threads(int blender, int nan, int corrupt, const char *what)
                   first.err.message);
     } else {
         CHECK_MSG(first.result == MK_OK && first.blob != NULL, "%s: %s", what, first.err.message);
-        /* repeat (c10), zero full weight (c11), index past the mesh (c4), and for Blender the
-         * FullWeights count of c9 */
-        CHECK_MSG(first.warning_count == (blender ? 4u : 3u), "%s: %u warnings", what, first.warning_count);
+        /* repeat (c10), zero full weight (c11), index past the mesh (c4), the broken first shape of
+         * c12 (its repeat is used, not dropped), and for Blender the FullWeights count of c9 */
+        CHECK_MSG(first.warning_count == (blender ? 5u : 4u), "%s: %u warnings", what, first.warning_count);
+        int broken_seen = 0, c12_dropped = 0;
+        for (uint32_t w = 0; w < first.warning_count && w < MK_RAW_MAX_WARNINGS; w++) {
+            broken_seen |= strstr(first.warnings[w].message, "shape needs Indexes and 3 Vertices values") != NULL;
+            c12_dropped |= strstr(first.warnings[w].message, "'s12") != NULL && strstr(first.warnings[w].message, "duplicate") != NULL;
+        }
+        CHECK_MSG(broken_seen && !c12_dropped, "%s: c12's broken shape skipped and its repeat kept", what);
+        mk_asset asset;
+        uint32_t c12 = UINT32_MAX;
+        mk_channel_info info;
+        memset(&info, 0, sizeof info);
+        if (first.blob && mk_asset_open(first.blob, first.blob_size, &asset, NULL) == MK_OK &&
+            mk_find_channels(&asset, "c12", &c12, 1) == 1)
+            mk_channel_get(&asset, c12, &info);
+        CHECK_MSG(c12 != UINT32_MAX && info.target_count == 1, "%s: channel c12 holds its kept repeat", what);
     }
     for (size_t t = 1; t < sizeof thread_counts / sizeof thread_counts[0]; t++)
         for (int round = 0; round < 3; round++) {

@@ -262,7 +262,7 @@ static int import_curve(const int64_t *times, const float *values, const int32_t
     static const int32_t idx[1] = { 0 };
     static const double delta[3] = { 1, 0, 0 };
     static const double fw[1] = { 100 };
-    fbxw_shape shape = { "S", 1, idx, delta, NULL };
+    fbxw_shape shape = { "S", 1, idx, delta, NULL, 0 };
     fbxw_curve curve = { count, times, values, flags, attr };
     fbxw_channel channel = { .name = "C", .shape_count = 1, .shapes = &shape, .full_weight_count = 1, .full_weights = fw,
                              .curve = &curve };
@@ -416,7 +416,7 @@ static void test_blender_full_weights(void)
     static const double delta[6] = { 0, 0, 2, 0, 0, 2 };
     static const double fw[2] = { 25, 100 };  /* per Indexes entry: Blender vertex-group weights */
     for (int blender = 0; blender < 2; blender++) {
-        fbxw_shape shape = { "Key", 2, idx, delta, NULL };
+        fbxw_shape shape = { "Key", 2, idx, delta, NULL, 0 };
         fbxw_channel channel = { .name = "Key", .deform_percent = 100, .deform_as_field_only = 1, .shape_count = 1,
                                  .shapes = &shape, .full_weight_count = 2, .full_weights = fw };
         fbxw_mesh mesh = triangle_mesh("Tri", tri_points, &channel, 1);
@@ -454,7 +454,7 @@ static void test_blender_inbetweens_keep_full_weights(void)
     static const double fw[2] = { 50, 100 };
     static const double points[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
     static const int32_t tri[3] = { 0, 1, ~2 };
-    fbxw_shape shapes[2] = { { "Half", 2, idx, half, NULL }, { "Full", 2, idx, full, NULL } };
+    fbxw_shape shapes[2] = { { "Half", 2, idx, half, NULL, 0 }, { "Full", 2, idx, full, NULL, 0 } };
     fbxw_channel channel;
     memset(&channel, 0, sizeof channel);
     channel.name = "Key";
@@ -510,7 +510,7 @@ static void test_duplicate_full_weights(void)
     static const int32_t idx[1] = { 0 };
     static const double d1[3] = { 1, 0, 0 }, d2[3] = { 2, 0, 0 }, d3[3] = { 3, 0, 0 };
     static const double fw[3] = { 50, 50, 0 };  /* duplicate, then a zero full weight */
-    fbxw_shape shapes[3] = { { "A", 1, idx, d1, NULL }, { "B", 1, idx, d2, NULL }, { "C", 1, idx, d3, NULL } };
+    fbxw_shape shapes[3] = { { "A", 1, idx, d1, NULL, 0 }, { "B", 1, idx, d2, NULL, 0 }, { "C", 1, idx, d3, NULL, 0 } };
     fbxw_channel channel = { .name = "Dup", .shape_count = 3, .shapes = shapes, .full_weight_count = 3, .full_weights = fw };
     fbxw_mesh mesh = triangle_mesh("Tri", tri_points, &channel, 1);
     fbxw_scene scene = { .version = 7500, .binary = 0, .mesh_count = 1, .meshes = &mesh };
@@ -535,8 +535,8 @@ static void test_tiny_full_weights(void)
     static const double d1[3] = { 1, 0, 0 }, d2[3] = { 2, 0, 0 }, d3[3] = { 3, 0, 0 }, d4[3] = { 4, 0, 0 };
     /* percent: 1e-5 % = 1e-7 (too close to 0), 50, 50 + 1e-5 % (too close to 50), 100 */
     static const double fw[4] = { 1e-5, 50, 50.00001, 100 };
-    fbxw_shape shapes[4] = { { "A", 1, idx, d1, NULL }, { "B", 1, idx, d2, NULL }, { "C", 1, idx, d3, NULL },
-                             { "D", 1, idx, d4, NULL } };
+    fbxw_shape shapes[4] = { { "A", 1, idx, d1, NULL, 0 }, { "B", 1, idx, d2, NULL, 0 }, { "C", 1, idx, d3, NULL, 0 },
+                             { "D", 1, idx, d4, NULL, 0 } };
     fbxw_channel channel = { .name = "Tiny", .shape_count = 4, .shapes = shapes, .full_weight_count = 4, .full_weights = fw };
     fbxw_mesh mesh = triangle_mesh("Tri", tri_points, &channel, 1);
     fbxw_scene scene = { .version = 7500, .binary = 1, .mesh_count = 1, .meshes = &mesh };
@@ -683,7 +683,7 @@ static void test_empty_mesh_skipped(void)
     static const int32_t idx[1] = { 2 };
     static const double delta[3] = { 0, 0, 1 };
     static const double fw[1] = { 100 };
-    fbxw_shape shape = { "Up", 1, idx, delta, NULL };
+    fbxw_shape shape = { "Up", 1, idx, delta, NULL, 0 };
     fbxw_channel channels[2] = { { .name = "Up", .deform_percent = 50, .shape_count = 1, .shapes = &shape,
                                    .full_weight_count = 1, .full_weights = fw } };
     channels[1] = channels[0];
