@@ -90,6 +90,13 @@ void mk_arena_release(mk_arena *arena, void *ptr)
     raw_free(arena, b);
 }
 
+void mk_arena_release_locked(mk_arena *arena, mtx_t *lock, void *const *ptrs, size_t n)
+{
+    mtx_lock(lock);
+    for (size_t i = 0; i < n; i++) mk_arena_release(arena, ptrs[i]);
+    mtx_unlock(lock);
+}
+
 void *mk_arena_realloc(mk_arena *arena, void *ptr, size_t old_size, size_t new_size)
 {
     void *p = mk_arena_alloc(arena, new_size);

@@ -11,6 +11,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <threads.h>
 #include "morphkit.h"
 
 typedef struct mk_allocator {
@@ -52,6 +53,9 @@ void *mk_arena_realloc(mk_arena *arena, void *ptr, size_t old_size, size_t new_s
  * otherwise as mk_arena_realloc. NULL (and ptr left as it was) when refused. */
 void *mk_arena_grow(mk_arena *arena, void *ptr, size_t new_size);
 void mk_arena_release(mk_arena *arena, void *ptr);
+/* Releases ptrs[0 .. n) (NULLs skipped) while holding `lock`: for workers giving arrays back to
+ * an arena they share. */
+void mk_arena_release_locked(mk_arena *arena, mtx_t *lock, void *const *ptrs, size_t n);
 char *mk_arena_strdup(mk_arena *arena, const char *s);
 char *mk_arena_strndup(mk_arena *arena, const char *s, size_t n);
 void mk_arena_free_all(mk_arena *arena);

@@ -149,7 +149,8 @@ static mk_result compute_target(mk_arena *arena, mk_arena *owner, mtx_t *owner_l
     float *positions = NULL;
     const uint32_t *old_indices = t->indices;
     const float *old_positions = t->positions;
-    if (owner && t->count) {
+    const int grows = owner && t->count;
+    if (grows) {
         mtx_lock(owner_lock);
         indices = mk_arena_grow(owner, t->indices, ((size_t)total + 1) * sizeof(uint32_t));
         if (indices) t->indices = indices;  /* the old pointer is gone once grown */
@@ -198,8 +199,12 @@ static mk_result compute_target(mk_arena *arena, mk_arena *owner, mtx_t *owner_l
     for (uint32_t k = 0; k < tri_count; k++) w->tri_slot[w->tris[k]] = -1;
     for (uint32_t k = 0; k < group_count; k++) w->group_slot[w->groups[k]] = -1;
     for (uint32_t k = 0; k < extra; k++) w->vert_mark[w->extra[k]] = 0;
-    /* The old arrays are replaced or grown (without an owner they may belong to the importer:
-     * left to the arena). */
+    /* The old arrays are grown or replaced; the replaced ones go back to the owner (without one
+     * they may belong to the importer: left to the arena). */
+    if (owner) {
+        void *replaced[] = { grows ? NULL : t->indices, grows ? NULL : t->positions, t->normals, t->tangents };
+        mk_arena_release_locked(owner, owner_lock, replaced, sizeof replaced / sizeof replaced[0]);
+    }
     t->indices = indices;
     t->positions = positions;
     t->normals = normals;
@@ -255,15 +260,8 @@ typedef struct normals_loop {
 static void normals_item(void *user, uint32_t item, uint32_t worker)
 {
     normals_loop *l = user;
-    mk_raw_target *t = l->targets[item];
-    int grows = l->owner && t->count;  /* indices and positions grow in place (compute_target) */
-    void *old[] = { grows ? NULL : t->indices, grows ? NULL : t->positions, t->normals, t->tangents };
-    l->results[item] = compute_target(&l->arenas[worker], l->owner, l->owner_lock, l->m, l->topo, t, &l->works[worker],
-                                      &l->errors[item]);
-    if (!l->owner || l->results[item] != MK_OK) return;
-    mtx_lock(l->owner_lock);
-    for (size_t i = 0; i < sizeof old / sizeof old[0]; i++) mk_arena_release(l->owner, old[i]);
-    mtx_unlock(l->owner_lock);
+    l->results[item] = compute_target(&l->arenas[worker], l->owner, l->owner_lock, l->m, l->topo, l->targets[item],
+                                      &l->works[worker], &l->errors[item]);
 }
 
 static mk_result compute_normals(mk_raw_asset *raw, uint32_t mesh, int force, uint32_t threads, int release,

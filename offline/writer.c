@@ -283,9 +283,7 @@ static void layout_write(void *user, uint32_t item, uint32_t worker)
     mk_raw_target *own = it.tl->own;
     if (!own) return;
     void *arrays[] = { own->indices, own->positions, own->normals, own->tangents };
-    mtx_lock(l->owner_lock);
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++) mk_arena_release(l->owner, arrays[i]);
-    mtx_unlock(l->owner_lock);
+    mk_arena_release_locked(l->owner, l->owner_lock, arrays, sizeof arrays / sizeof arrays[0]);
     own->indices = NULL;
     own->positions = own->normals = own->tangents = NULL;
     own->count = 0;

@@ -244,6 +244,7 @@ mk_result fbx_add_channels(fbx_doc *doc, mk_raw_asset *raw, const mk_import_opti
     l.workers = mk_arena_array(doc->arena, workers, sizeof *l.workers);
     if (!l.jobs || !l.workers) {
         fbx_release(doc->arena, l.jobs);
+        fbx_release(doc->arena, l.workers);
         return mk_error_oom(doc->err, "FBX shapes");
     }
     size_t n = 0;
