@@ -103,12 +103,6 @@ void shell_bvh_renumber(shell_bvh *bvh, uint32_t *order, uint32_t count)
     }
 }
 
-/* Closed boxes overlap (all six comparisons, without branches: about half the tests pass). */
-static int overlaps(const double *alo, const double *ahi, const double *blo, const double *bhi)
-{
-    return (alo[0] <= bhi[0]) & (blo[0] <= ahi[0]) & (alo[1] <= bhi[1]) & (blo[1] <= ahi[1]) & (alo[2] <= bhi[2]) &
-           (blo[2] <= ahi[2]);
-}
 
 void shell_bvh_refit(shell_bvh *bvh)
 {
@@ -159,7 +153,7 @@ static void leaf_pairs(const pair_walk *w, const shell_bvh_node *a, const shell_
             uint32_t ib = bvh->items[j];
             const double *bb = bvh->boxes + 6 * (size_t)ib;
             if (w->corners && share_a_corner(w->corners + 3 * (size_t)ia, w->corners + 3 * (size_t)ib)) continue;
-            if (overlaps(ba, ba + 3, bb, bb + 3)) w->visit(w->user, ia, ib);
+            if (shell_boxes_overlap(ba, ba + 3, bb, bb + 3)) w->visit(w->user, ia, ib);
         }
     }
 }
@@ -174,7 +168,7 @@ static void node_pairs(const pair_walk *w, uint32_t na, uint32_t nb)
         node_pairs(w, a->start, a->start + 1);
         return;
     }
-    if (!overlaps(a->lo, a->hi, b->lo, b->hi)) return;
+    if (!shell_boxes_overlap(a->lo, a->hi, b->lo, b->hi)) return;
     if (a->count && b->count) { leaf_pairs(w, a, b); return; }
     /* Descend into the inner node with the larger box (or the only inner one). */
     double va = 0, vb = 0;

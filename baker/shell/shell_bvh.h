@@ -7,6 +7,14 @@
 #include <stdint.h>
 #include "alloc.h"
 
+/* Closed boxes [alo, ahi] and [blo, bhi] overlap: all six comparisons without branches, one
+ * branch on the result (mostly no, while which comparison fails first is hard to predict). */
+static inline int shell_boxes_overlap(const double *alo, const double *ahi, const double *blo, const double *bhi)
+{
+    return (alo[0] <= bhi[0]) & (blo[0] <= ahi[0]) & (alo[1] <= bhi[1]) & (blo[1] <= ahi[1]) & (alo[2] <= bhi[2]) &
+           (blo[2] <= ahi[2]);
+}
+
 typedef struct shell_bvh_node {
     double lo[3], hi[3];
     uint32_t start;           /* leaf: first entry of items; inner node: index of the left child (right = start + 1) */

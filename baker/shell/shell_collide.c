@@ -270,12 +270,8 @@ static void pair_vertices(const shell_mesh *m, int kind, uint32_t a, uint32_t b,
     }
 }
 
-/* Closed boxes (lo, hi) overlap: all six comparisons without branches, one branch on the result
- * (which is mostly no, while which comparison fails first is hard to predict). */
-static int boxes_overlap(const double *a, const double *b)
-{
-    return (a[0] <= b[3]) & (b[0] <= a[3]) & (a[1] <= b[4]) & (b[1] <= a[4]) & (a[2] <= b[5]) & (b[2] <= a[5]);
-}
+/* Boxes stored as six values (lo, hi) overlap. */
+static int boxes_overlap(const double *a, const double *b) { return shell_boxes_overlap(a, a + 3, b, b + 3); }
 
 /* Round 0 meets a pair that shares no vertex and whose boxes overlap: it is kept for the later
  * rounds and tested. */
