@@ -4,19 +4,20 @@
 #include "frame.h"
 #include "timing.h"
 
-void bench_surface_frames(const pb_asset *l, const float *weight_sets, uint32_t frames, double *ns_nlerp,
-                          double *ns_surface)
+void bench_surface_frames(const pb_asset *nlerp_asset, const pb_asset *surface_asset, const float *weight_sets,
+                          uint32_t frames, double *ns_nlerp, double *ns_surface)
 {
-    const mk_asset *a = &l->asset;
     double best[2] = { 0, 0 };
     *ns_nlerp = *ns_surface = 0;
-    for (uint32_t mi = 0; mi < a->mesh_count; mi++) {
+    const mk_asset *an = &nlerp_asset->asset, *as = &surface_asset->asset;
+    for (uint32_t mi = 0; mi < an->mesh_count && mi < as->mesh_count; mi++) {
         mk_mesh_info m;
-        mk_mesh_get(a, mi, &m);
+        mk_mesh_get(an, mi, &m);
         pb_surface surf;
         mk_error err;
-        if (!mk_surface_topology_size(a, mi) || pb_surface_prepare(&surf, a, mi, &err) != MK_OK) continue;
-        size_t scratch_size = mk_eval_scratch_size(a, mi);
+        if (!mk_surface_topology_size(as, mi) || pb_surface_prepare(&surf, as, mi, &err) != MK_OK) continue;
+        size_t scratch_size = mk_eval_scratch_size(an, mi), ss = mk_eval_scratch_size(as, mi);
+        scratch_size = ss > scratch_size ? ss : scratch_size;
         void *scratch = aligned_alloc(16, (scratch_size + 31) & ~(size_t)15);
         float *positions = malloc(12 * (size_t)m.vertex_count + 16), *normals = malloc(12 * (size_t)m.vertex_count + 16);
         int ok = scratch && positions && normals;
@@ -25,8 +26,8 @@ void bench_surface_frames(const pb_asset *l, const float *weight_sets, uint32_t 
             int surface = pass & 1;
             double t0 = bench_now_ns();
             for (uint32_t f = 0; ok && f < frames; f++) {
-                mk_eval_job job = { .asset = a, .mesh = mi, .vertex_count = MK_VERTICES_TO_END,
-                                    .weights = weight_sets + (size_t)f * a->channel_count + m.first_channel,
+                mk_eval_job job = { .asset = surface ? as : an, .mesh = mi, .vertex_count = MK_VERTICES_TO_END,
+                                    .weights = weight_sets + (size_t)f * an->channel_count + m.first_channel,
                                     .weight_count = m.channel_count, .scratch = scratch, .scratch_size = scratch_size,
                                     .positions = positions, .positions_size = 12 * (size_t)m.vertex_count,
                                     .normals = surface ? NULL : normals, .normals_size = 12 * (size_t)m.vertex_count };

@@ -29,6 +29,7 @@
 #include "morphkit.h"
 #include "error.h"
 #include "span.h"
+#include "clones.h"
 #include "determinism.h"
 
 /* ---- channel spans ---- */
@@ -203,24 +204,6 @@ static void compute_coefficients(frame *f, const mk_eval_job *job, mk_stacking s
 }
 
 /* ---- block accumulation ---- */
-
-/* The block loop is compiled twice where the compiler and platform allow it: for the
- * baseline ISA and for x86-64-v3 (AVX2, FMA, BMI, POPCNT), picked once at load time by feature
- * level, not CPU model ("arch=haswell" would check the model and never match an AMD CPU),
- * (GCC/Clang target_clones through a glibc ifunc). The helpers it calls are force-inlined so each
- * clone gets its own vector code. Define MK_NO_TARGET_CLONES to build one baseline copy.
- * GCC only: clang 14 emits the resolver as a global symbol. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__GLIBC__) && \
-    !defined(MK_NO_TARGET_CLONES) && !defined(__SANITIZE_ADDRESS__)
-#define MK_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
-#else
-#define MK_CLONES
-#endif
-#if defined(__GNUC__) || defined(__clang__)
-#define MK_INLINE static inline __attribute__((always_inline))
-#else
-#define MK_INLINE static inline
-#endif
 
 /* Software prefetch. Delta data is target-major, so each active target is its own sequential
  * stream, and a frame reads tens of them besides the base arrays: more streams than hardware
@@ -411,7 +394,8 @@ static int job_streams(const mk_eval_job *job)
     return (size_t)job->asset->meshes[job->mesh].vertex_count * per_vertex >= MK_STREAM_MIN_BYTES;
 }
 
-/* The per-block work of one job (see the top of this file). */
+/* The per-block work of one job (see the top of this file), compiled per ISA level
+ * (clones.h). */
 static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
 {
     const frame f = *frame_in;

@@ -8,11 +8,11 @@
  * group's rest normal. The rules and the order of every sum are those of the offline importer's
  * target normals (which sums in double precision; here single precision keeps the per-frame
  * pass small), so a single target at its full weight reproduces the normal deltas the importer
- * computed for it up to float rounding. A job computes the face normal of each triangle it
- * needs once, then per vertex sums its group's face normals in the group's triangle order (a
- * gather: no sum is shared between vertices, so no read-modify-write chains through memory)
- * and finishes eight vertices at a time in lanes without branches. A vertex's normal depends
- * only on the positions and the topology, never on the job's range. */
+ * computed for it up to float rounding. A job walks the triangles it needs in order, adds each
+ * one's face normal to the sums of its distinct corner groups (so every group's sum is formed in
+ * its triangle order, the order the importer sums in), then finishes sixteen vertices at a time
+ * in lanes without branches, compiled per ISA level (clones.h). A vertex's normal depends only
+ * on the positions and the topology, never on the job's range. */
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -20,6 +20,7 @@
 #include "morphkit.h"
 #include "error.h"
 #include "span.h"
+#include "clones.h"
 #include "determinism.h"
 
 #define TOPOLOGY_MAGIC 0x32534b4du /* "MKS2" */
@@ -112,21 +113,6 @@ static void face_normal(const uint32_t *tri, const uint8_t *p, size_t stride, fl
     out[2] = e1[0] * e2[1] - e1[1] * e2[0];
 }
 
-/* The sum of the face normals of the triangles list[0, count) in that order (a group's: in
- * triangle order), read from faces (a job's face pass) or, with faces NULL, computed from the
- * positions p (the build): the same values either way, so N(P0) and N(P) are one sum. */
-static void sum_faces(const uint32_t *list, uint32_t count, const float (*faces)[3], const uint32_t *triangles,
-                      const uint8_t *p, size_t stride, float sum[3])
-{
-    sum[0] = sum[1] = sum[2] = 0;
-    for (uint32_t k = 0; k < count; k++) {
-        float computed[3];
-        if (!faces) face_normal(&triangles[3u * list[k]], p, stride, computed);
-        const float *f = faces ? faces[list[k]] : computed;
-        for (int c = 0; c < 3; c++) sum[c] += f[c];
-    }
-}
-
 /* The distinct corner groups of triangle t, NO_GROUP for a repeated one. */
 static void corner_groups(const uint32_t *triangles, const uint32_t *group_of, uint32_t t, uint32_t g[3])
 {
@@ -135,6 +121,37 @@ static void corner_groups(const uint32_t *triangles, const uint32_t *group_of, u
     g[2] = group_of[triangles[3u * t + 2]];
     if (g[1] == g[0]) g[1] = NO_GROUP;
     if (g[2] == g[0] || g[2] == g[1]) g[2] = NO_GROUP;
+}
+
+/* Each group's sum of the face normals of its triangles, in triangle order, into sums[group]:
+ * the triangles [t_lo, t_hi) (only those marked, when mark is not NULL) add their face normal at
+ * positions p to the sums of their distinct corner groups, in order. The sums the triangles
+ * touch start at zero (all group_count of them without marks), so sums needs no
+ * initialization; a group gets its whole sum when all its triangles are in the walk (a range
+ * job marks every triangle of its vertices' groups). The build's rest normals and a job's
+ * normals are the same sums, at P0 and at P. */
+static void group_sums(const uint32_t *triangles, const uint32_t *group_of, uint32_t group_count, uint32_t t_lo,
+                       uint32_t t_hi, const uint8_t *mark, const uint8_t *p, size_t stride, float (*sums)[3])
+{
+    if (!mark) memset(sums, 0, 12 * (size_t)group_count);
+    else
+        for (uint32_t t = t_lo; t < t_hi; t++)
+            if (mark[t]) {
+                uint32_t g[3];
+                corner_groups(triangles, group_of, t, g);
+                for (int c = 0; c < 3; c++)
+                    if (g[c] != NO_GROUP) sums[g[c]][0] = sums[g[c]][1] = sums[g[c]][2] = 0;
+            }
+    for (uint32_t t = t_lo; t < t_hi; t++)
+        if (!mark || mark[t]) {
+            float f[3];
+            uint32_t g[3];
+            face_normal(&triangles[3u * t], p, stride, f);
+            corner_groups(triangles, group_of, t, g);
+            for (int c = 0; c < 3; c++)
+                if (g[c] != NO_GROUP)
+                    for (int d = 0; d < 3; d++) sums[g[c]][d] += f[d];
+        }
 }
 
 mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *topology, size_t size, mk_error *err)
@@ -187,12 +204,11 @@ mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *
     /* Rest normals N(P0) by the jobs' own sum (the scratch is no longer needed); (0,0,0) for a
      * group without area, whose vertices then take their own base normal as the rest normal. */
     float (*rest)[3] = (float (*)[3])(void *)(base + l.rest);
+    group_sums(triangles, group_of, groups, 0, tri_count, NULL, asset->data + m->positions, 12, rest);
     for (uint32_t g = 0; g < groups; g++) {
-        float sum[3];
-        sum_faces(&group_tris[tri_first[g]], tri_first[g + 1] - tri_first[g], NULL, triangles, asset->data + m->positions,
-                  12, sum);
+        float *sum = rest[g];
         float len = sqrtf(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
-        for (int c = 0; c < 3; c++) rest[g][c] = len > 0 && len <= FLT_MAX ? sum[c] * (1.0f / len) : 0;
+        for (int c = 0; c < 3; c++) sum[c] = len > 0 && len <= FLT_MAX ? sum[c] * (1.0f / len) : 0;
     }
     topology_header h = { .magic = TOPOLOGY_MAGIC, .mesh = mesh, .vertex_count = n, .triangle_count = tri_count,
                           .group_count = groups, .size = l.size, .checksum = asset->header->checksum,
@@ -243,9 +259,9 @@ mk_result mk_surface_validate(const mk_surface_job *job, mk_error *err)
     return MK_OK;
 }
 
-/* A job's scratch: one mark byte per triangle (whether a range job needs it), then the face
- * normals of the triangles it needs. A job fills what it reads, so the
- * scratch needs no initialization and any job may use any scratch. */
+/* A job's scratch: one mark byte per triangle (whether a range job needs it), then the sums of
+ * the groups (at most one per vertex). A job fills what it reads, so the scratch needs no
+ * initialization and any job may use any scratch. */
 
 static size_t marks_size(const mk_blob_mesh *m) { return align16(m->triangle_count); }
 
@@ -253,7 +269,7 @@ size_t mk_surface_scratch_size(const mk_asset *asset, uint32_t mesh)
 {
     if (!mk_surface_topology_size(asset, mesh)) return 0;
     const mk_blob_mesh *m = &asset->meshes[mesh];
-    return marks_size(m) + 12 * (size_t)m->triangle_count;
+    return marks_size(m) + 12 * (size_t)m->vertex_count;
 }
 
 /* Vertices are finished FINISH_BLOCK at a time in lanes (component-major): every operation is
@@ -261,7 +277,7 @@ size_t mk_surface_scratch_size(const mk_asset *asset, uint32_t mesh)
  * compiler can use vector instructions (with -fno-math-errno, which the build adds: otherwise a
  * square root may set errno, a branch that keeps the loop scalar); the same IEEE operations per
  * lane, so the same bytes as one vertex at a time. */
-#define FINISH_BLOCK 8
+#define FINISH_BLOCK 16
 typedef struct finish_block {
     float sum[3][FINISH_BLOCK], base[3][FINISH_BLOCK], rest[3][FINISH_BLOCK], out[3][FINISH_BLOCK];
     float changed[FINISH_BLOCK];
@@ -282,7 +298,7 @@ typedef struct finish_block {
 #pragma GCC push_options
 #pragma GCC optimize("no-trapping-math")
 #endif
-static void finish_normals(finish_block *k)
+MK_INLINE void finish_normals(finish_block *k)
 {
     for (int j = 0; j < FINISH_BLOCK; j++) {
         float sx = k->sum[0][j], sy = k->sum[1][j], sz = k->sum[2][j];
@@ -306,6 +322,43 @@ static void finish_normals(finish_block *k)
         k->out[1][j] = keep != 0 ? by : oy;
         k->out[2][j] = keep != 0 ? bz : oz;
         k->changed[j] = changed;
+    }
+}
+/* The job's vertices [0, n): each one's normal (and tangent) from its group's sum, FINISH_BLOCK
+ * at a time. */
+static MK_CLONES void finish_range(const mk_surface_job *job, uint32_t n, const uint32_t *group_of,
+                                   const float (*sums)[3], const float (*rest)[3], const float *normals,
+                                   const float *tangents, size_t ns, size_t ts)
+{
+    for (uint32_t i0 = 0; i0 < n; i0 += FINISH_BLOCK) {
+        const uint32_t count = n - i0 < FINISH_BLOCK ? n - i0 : FINISH_BLOCK;
+        finish_block block;
+        for (uint32_t j = 0; j < FINISH_BLOCK; j++) {   /* lanes past the range repeat the block's first vertex */
+            uint32_t v = job->first_vertex + i0 + (j < count ? j : 0), g = group_of[v];
+            for (int c = 0; c < 3; c++) {
+                block.sum[c][j] = sums[g][c];
+                block.base[c][j] = normals[3u * v + (uint32_t)c];
+                block.rest[c][j] = rest[g][c];
+            }
+        }
+        finish_normals(&block);
+        for (uint32_t j = 0; j < count; j++) {
+            const uint32_t i = i0 + j, v = job->first_vertex + i;
+            const float out[3] = { block.out[0][j], block.out[1][j], block.out[2][j] };
+            memcpy((uint8_t *)job->normals + ns * i, out, sizeof out);
+            if (job->tangents) {
+                float t[4];
+                memcpy(t, &tangents[4u * v], sizeof t);
+                if (block.changed[j] != 0) {
+                    float dot = t[0] * out[0] + t[1] * out[1] + t[2] * out[2];
+                    float o[3] = { t[0] - out[0] * dot, t[1] - out[1] * dot, t[2] - out[2] * dot };
+                    float len = sqrtf(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
+                    if (len >= 1e-12f)
+                        for (int d = 0; d < 3; d++) t[d] = o[d] / len;
+                }
+                memcpy((uint8_t *)job->tangents + ts * i, t, sizeof t);
+            }
+        }
     }
 }
 #if defined(__GNUC__) && !defined(__clang__)
@@ -332,12 +385,12 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
     const size_t ps = mk_stride_or(job->positions_stride, 12), ns = mk_stride_or(job->normals_stride, 12),
                  ts = mk_stride_or(job->tangents_stride, 16);
     uint8_t *mark = job->scratch;
-    float (*faces)[3] = (float (*)[3])(void *)((uint8_t *)job->scratch + marks_size(m));
+    float (*sums)[3] = (float (*)[3])(void *)((uint8_t *)job->scratch + marks_size(m));
     const uint32_t n = job->vertex_count == MK_VERTICES_TO_END ? m->vertex_count - job->first_vertex : job->vertex_count;
-    /* The face normals the range needs: those of the triangles of its vertices' groups (every
-     * triangle for the whole mesh, which needs no marks). */
+    /* The sums the range needs: those of its vertices' groups, from the triangles of those groups
+     * (every triangle for the whole mesh, which needs no marks). */
     if (n == m->vertex_count) {
-        for (uint32_t t = 0; t < m->triangle_count; t++) face_normal(&triangles[3u * t], p, ps, faces[t]);
+        group_sums(triangles, group_of, h.group_count, 0, m->triangle_count, NULL, p, ps, sums);
     } else {
         uint32_t t_lo = m->triangle_count, t_hi = 0;
         memset(mark, 0, m->triangle_count);
@@ -350,41 +403,8 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
                 if (t + 1 > t_hi) t_hi = t + 1;
             }
         }
-        for (uint32_t t = t_lo; t < t_hi; t++)
-            if (mark[t]) face_normal(&triangles[3u * t], p, ps, faces[t]);
+        group_sums(triangles, group_of, h.group_count, t_lo, t_hi, mark, p, ps, sums);
     }
-    for (uint32_t i0 = 0; i0 < n; i0 += FINISH_BLOCK) {
-        const uint32_t count = n - i0 < FINISH_BLOCK ? n - i0 : FINISH_BLOCK;
-        finish_block block;
-        for (uint32_t j = 0; j < FINISH_BLOCK; j++) {   /* lanes past the range repeat the block's first vertex */
-            uint32_t v = job->first_vertex + i0 + (j < count ? j : 0), g = group_of[v];
-            float sum[3];
-            sum_faces(&group_tris[tri_first[g]], tri_first[g + 1] - tri_first[g], (const float (*)[3])faces, NULL, NULL, 0,
-                      sum);
-            for (int c = 0; c < 3; c++) {
-                block.sum[c][j] = sum[c];
-                block.base[c][j] = normals[3u * v + (uint32_t)c];
-                block.rest[c][j] = rest[g][c];
-            }
-        }
-        finish_normals(&block);
-        for (uint32_t j = 0; j < count; j++) {
-            const uint32_t i = i0 + j, v = job->first_vertex + i;
-            const float out[3] = { block.out[0][j], block.out[1][j], block.out[2][j] };
-            memcpy((uint8_t *)job->normals + ns * i, out, sizeof out);
-            if (job->tangents) {
-                float t[4];
-                memcpy(t, &tangents[4u * v], sizeof t);
-                if (block.changed[j] != 0) {
-                    float dot = t[0] * out[0] + t[1] * out[1] + t[2] * out[2];
-                    float o[3] = { t[0] - out[0] * dot, t[1] - out[1] * dot, t[2] - out[2] * dot };
-                    float len = sqrtf(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
-                    if (len >= 1e-12f)
-                        for (int d = 0; d < 3; d++) t[d] = o[d] / len;
-                }
-                memcpy((uint8_t *)job->tangents + ts * i, t, sizeof t);
-            }
-        }
-    }
+    finish_range(job, n, group_of, (const float (*)[3])sums, rest, normals, tangents, ns, ts);
     return MK_OK;
 }

@@ -76,7 +76,9 @@ const cli_verb cli_verb_bench = {
                    "against baselines measured in the same run: the memory-copy bound for the bytes a frame touches, "
                    "and a naive dense "
                    "loop. With FILE it also measures how far the evaluated normals are from the evaluated surface, per "
-                   "normal mode (docs/semantics.md, Normal quality). Without FILE a synthetic asset is built (--vertices, "
+                   "normal mode (docs/semantics.md, Normal quality), and times positions + surface normals against positions + "
+                   "nlerp, on the asset itself and on a copy without target normals (what `import --target-normals none` "
+                   "writes for surface normals). Without FILE a synthetic asset is built (--vertices, "
                    "--channels, --active, --density).",
     .positional = "FILE",
     .positional_help = "An asset to play instead of the synthetic one (its first clip).",
@@ -240,10 +242,22 @@ static int run_bench(void *p)
      * normal deltas are made up): up to 20 of the frames, evenly spread. */
     pb_normal_stats quality[PB_QUALITY_MODES];
     memset(quality, 0, sizeof quality);
-    double ns_surface_nlerp = 0, ns_surface = 0;
+    double ns_surface_nlerp = 0, ns_surface = 0, ns_bare_nlerp = 0, ns_bare = 0;
     if (file && !profile) {
         cli_progress_update(&progress, "surface normals", -1);
-        bench_surface_frames(&l, weights, frames < 20 ? frames : 20, &ns_surface_nlerp, &ns_surface);
+        bench_surface_frames(&l, &l, weights, frames < 20 ? frames : 20, &ns_surface_nlerp, &ns_surface);
+        /* The same asset without target normals, as `import --target-normals none` writes it for
+         * a program that only uses surface normals. */
+        pb_asset bare;
+        memset(&bare, 0, sizeof bare);
+        mk_raw_init(&bare.raw, NULL);
+        mk_error bare_err;
+        if (mk_read_blob(a, &bare.raw, &bare_err) == MK_OK) {
+            mk_raw_drop_target_normals(&bare.raw);
+            if (pb_asset_open_raw(&bare, NULL, &bare_err) == MK_OK)
+                bench_surface_frames(&l, &bare, weights, frames < 20 ? frames : 20, &ns_bare_nlerp, &ns_bare);
+        }
+        pb_asset_free(&bare);
         cli_progress_update(&progress, "normal quality", -1);
         if (measure_normals(&l, weights, frames, quality, &err) != MK_OK) {
             fprintf(stderr, "morphkit bench: normal quality not measured: %s\n", err.message);
@@ -265,6 +279,10 @@ static int run_bench(void *p)
         if (ns_surface > 0)
             printf(", \"ns_per_frame_surface\": %.0f, \"surface_over_nlerp\": %.3f", ns_surface,
                    ns_surface / ns_surface_nlerp);
+        if (ns_bare > 0)
+            printf(", \"ns_per_frame_surface_without_target_normals\": %.0f, "
+                   "\"surface_without_target_normals_over_nlerp\": %.3f",
+                   ns_bare, ns_bare / ns_bare_nlerp);
         printf("}\n");
     } else {
         uint32_t vertices = 0;
@@ -289,6 +307,10 @@ static int run_bench(void *p)
             printf("surface_over_nlerp       %12.3f  (positions + surface normals %.0f ns, positions + nlerp %.0f ns; "
                    "one thread, alternating)\n",
                    ns_surface / ns_surface_nlerp, ns_surface, ns_surface_nlerp);
+        if (ns_bare > 0)
+            printf("  without target normals %10.3f  (positions + surface normals on the asset without target normals "
+                   "%.0f ns, positions + nlerp %.0f ns)\n",
+                   ns_bare / ns_bare_nlerp, ns_bare, ns_bare_nlerp);
         if (quality[0].count) {
             printf("normal error vs the evaluated surface (degrees over %zu moved vertex-frames: mean / p99 / max):\n",
                    quality[0].count);
