@@ -305,7 +305,7 @@ static int run_bench(void *p)
         printf("sequential_over_additive %12.3f\n", ns_sequential / ns);
         if (ns_surface > 0)
             printf("surface_over_nlerp       %12.3f  (positions + surface normals %.0f ns, positions + nlerp %.0f ns; "
-                   "one thread, alternating)\n",
+                   "one thread, alternating per frame)\n",
                    ns_surface / ns_surface_nlerp, ns_surface, ns_surface_nlerp);
         if (ns_bare > 0)
             printf("  without target normals %10.3f  (positions + surface normals on the asset without target normals "
