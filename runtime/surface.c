@@ -4,8 +4,8 @@
  *
  * The topology, built once per mesh into caller memory, holds the smoothing groups (vertices
  * with the same control point and the same base normal within 1e-5 per component), each
- * group's triangles (a triangle once per distinct corner group, in triangle order) and each
- * group's rest normal. The rules and the order of every sum are those of the offline importer's
+ * group's triangles (a triangle once per distinct corner group, in triangle order), each
+ * triangle's distinct corner groups and each group's rest normal. The rules and the order of every sum are those of the offline importer's
  * target normals (which sums in double precision; here single precision keeps the per-frame
  * pass small), so a single target at its full weight reproduces the normal deltas the importer
  * computed for it up to float rounding. A job walks the triangles it needs in order, adds each
@@ -31,13 +31,13 @@ typedef struct topology_header {
     uint32_t vertex_count, triangle_count, group_count, reserved;
     uint64_t size;                 /* bytes the topology was built for */
     uint64_t checksum;             /* the blob's, to refuse another asset's topology */
-    uint64_t group_of, group_tri_first, group_tris, rest; /* array offsets */
+    uint64_t group_of, group_tri_first, group_tris, corners, rest; /* array offsets */
 } topology_header;
 
 static size_t align16(size_t n) { return (n + 15u) & ~(size_t)15u; }
 
 typedef struct layout {
-    size_t group_of, group_tri_first, group_tris, rest, size;
+    size_t group_of, group_tri_first, group_tris, corners, rest, size;
 } layout;
 
 /* Offsets of the arrays; size 0 when the mesh cannot have a topology (no normals, no
@@ -46,7 +46,7 @@ typedef struct layout {
  * group; their region first serves as the build's scratch. */
 static layout topology_layout(const mk_blob_mesh *m)
 {
-    layout l = { 0, 0, 0, 0, 0 };
+    layout l = { 0, 0, 0, 0, 0, 0 };
     if (!(m->flags & MK_MESH_HAS_NORMALS) || m->triangle_count == 0 || m->vertex_count == 0) return l;
     size_t v = m->vertex_count, t = m->triangle_count, c = m->control_point_count;
     if (3 * (uint64_t)t > UINT32_MAX || 4 * (uint64_t)v > UINT32_MAX || v > SIZE_MAX / 64 || t > SIZE_MAX / 64
@@ -57,7 +57,8 @@ static layout topology_layout(const mk_blob_mesh *m)
     l.group_of = align16(sizeof(topology_header));
     l.group_tri_first = l.group_of + align16(4 * v);
     l.group_tris = l.group_tri_first + align16(4 * (v + 1));
-    l.rest = l.group_tris + align16(12 * t);
+    l.corners = l.group_tris + align16(12 * t);
+    l.rest = l.corners + align16(12 * t);
     l.size = l.rest + align16(rest);
     return l;
 }
@@ -125,29 +126,28 @@ static void corner_groups(const uint32_t *triangles, const uint32_t *group_of, u
 
 /* Each group's sum of the face normals of its triangles, in triangle order, into sums[group]:
  * the triangles [t_lo, t_hi) (only those marked, when mark is not NULL) add their face normal at
- * positions p to the sums of their distinct corner groups, in order. The sums the triangles
- * touch start at zero (all group_count of them without marks), so sums needs no
- * initialization; a group gets its whole sum when all its triangles are in the walk (a range
- * job marks every triangle of its vertices' groups). The build's rest normals and a job's
- * normals are the same sums, at P0 and at P. */
-static void group_sums(const uint32_t *triangles, const uint32_t *group_of, uint32_t group_count, uint32_t t_lo,
+ * positions p to the sums of their distinct corner groups (corners: three per triangle,
+ * NO_GROUP for a repeated one), in order. The sums the triangles touch start at zero (all
+ * group_count of them without marks), so sums needs no initialization; a group gets its whole
+ * sum when all its triangles are in the walk (a range job marks every triangle of its
+ * vertices' groups). The build's rest normals and a job's normals are the same sums, at P0 and
+ * at P. */
+static void group_sums(const uint32_t *triangles, const uint32_t *corners, uint32_t group_count, uint32_t t_lo,
                        uint32_t t_hi, const uint8_t *mark, const uint8_t *p, size_t stride, float (*sums)[3])
 {
     if (!mark) memset(sums, 0, 12 * (size_t)group_count);
     else
         for (uint32_t t = t_lo; t < t_hi; t++)
             if (mark[t]) {
-                uint32_t g[3];
-                corner_groups(triangles, group_of, t, g);
+                const uint32_t *g = &corners[3u * t];
                 for (int c = 0; c < 3; c++)
                     if (g[c] != NO_GROUP) sums[g[c]][0] = sums[g[c]][1] = sums[g[c]][2] = 0;
             }
     for (uint32_t t = t_lo; t < t_hi; t++)
         if (!mark || mark[t]) {
             float f[3];
-            uint32_t g[3];
+            const uint32_t *g = &corners[3u * t];
             face_normal(&triangles[3u * t], p, stride, f);
-            corner_groups(triangles, group_of, t, g);
             for (int c = 0; c < 3; c++)
                 if (g[c] != NO_GROUP)
                     for (int d = 0; d < 3; d++) sums[g[c]][d] += f[d];
@@ -203,8 +203,10 @@ mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *
     }
     /* Rest normals N(P0) by the jobs' own sum (the scratch is no longer needed); (0,0,0) for a
      * group without area, whose vertices then take their own base normal as the rest normal. */
+    uint32_t *corners = (uint32_t *)(void *)(base + l.corners);
+    for (uint32_t t = 0; t < tri_count; t++) corner_groups(triangles, group_of, t, &corners[3u * t]);
     float (*rest)[3] = (float (*)[3])(void *)(base + l.rest);
-    group_sums(triangles, group_of, groups, 0, tri_count, NULL, asset->data + m->positions, 12, rest);
+    group_sums(triangles, corners, groups, 0, tri_count, NULL, asset->data + m->positions, 12, rest);
     for (uint32_t g = 0; g < groups; g++) {
         float *sum = rest[g];
         float len = sqrtf(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
@@ -212,7 +214,7 @@ mk_result mk_surface_topology_build(const mk_asset *asset, uint32_t mesh, void *
     }
     topology_header h = { .magic = TOPOLOGY_MAGIC, .mesh = mesh, .vertex_count = n, .triangle_count = tri_count,
                           .group_count = groups, .size = l.size, .checksum = asset->header->checksum,
-                          .group_of = l.group_of, .group_tri_first = l.group_tri_first, .group_tris = l.group_tris,
+                          .group_of = l.group_of, .group_tri_first = l.group_tri_first, .group_tris = l.group_tris, .corners = l.corners,
                           .rest = l.rest };
     memcpy(base, &h, sizeof h);
     return MK_OK;
@@ -378,6 +380,7 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
     const uint32_t *tri_first = (const uint32_t *)(const void *)(base + h.group_tri_first);
     const uint32_t *group_tris = (const uint32_t *)(const void *)(base + h.group_tris);
     const float (*rest)[3] = (const float (*)[3])(const void *)(base + h.rest);
+    const uint32_t *corners = (const uint32_t *)(const void *)(base + h.corners);
     const uint32_t *triangles = (const uint32_t *)(const void *)(a->data + m->triangles);
     const float *normals = (const float *)(const void *)(a->data + m->normals);
     const float *tangents = m->tangents ? (const float *)(const void *)(a->data + m->tangents) : NULL;
@@ -390,7 +393,7 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
     /* The sums the range needs: those of its vertices' groups, from the triangles of those groups
      * (every triangle for the whole mesh, which needs no marks). */
     if (n == m->vertex_count) {
-        group_sums(triangles, group_of, h.group_count, 0, m->triangle_count, NULL, p, ps, sums);
+        group_sums(triangles, corners, h.group_count, 0, m->triangle_count, NULL, p, ps, sums);
     } else {
         uint32_t t_lo = m->triangle_count, t_hi = 0;
         memset(mark, 0, m->triangle_count);
@@ -403,7 +406,7 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
                 if (t + 1 > t_hi) t_hi = t + 1;
             }
         }
-        group_sums(triangles, group_of, h.group_count, t_lo, t_hi, mark, p, ps, sums);
+        group_sums(triangles, corners, h.group_count, t_lo, t_hi, mark, p, ps, sums);
     }
     finish_range(job, n, group_of, (const float (*)[3])sums, rest, normals, tangents, ns, ts);
     return MK_OK;

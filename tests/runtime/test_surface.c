@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* Surface normals (mk_surface_run) against a brute-force recomputation written from
  * docs/semantics.md, on random grids with UV seams and hard edges and random shape weights;
- * any split into ranges gives the same bytes; unmoved vertices keep their base normal; the
- * topology is refused for another mesh or asset. */
+ * any split into ranges gives the same bytes; unmoved vertices keep their base normal; a triangle
+ * with two corners in one group counts once; the topology is refused for another mesh or asset. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -218,6 +218,84 @@ static void test_ranges_same_bytes(void)
     close_grid(&o);
 }
 
+/* A small mesh with one channel of one target, opened with its topology (o->raw owns the
+ * arrays, o->arena the blob, topology and scratch). cps NULL: every vertex its own control
+ * point. */
+typedef struct small_mesh {
+    const float *positions, *normals, *deltas;
+    const uint32_t *control_points, *triangles, *moved;
+    uint32_t vertex_count, control_point_count, triangle_count, moved_count;
+} small_mesh;
+
+static int open_small(opened *o, const small_mesh *s)
+{
+    mk_raw_init(&o->raw, NULL);
+    mk_arena_init(&o->arena, NULL);
+    mk_raw_mesh *m = mk_raw_add_meshes(&o->raw, 1);
+    m->name = "small";
+    m->vertex_count = s->vertex_count;
+    m->control_point_count = s->control_point_count;
+    m->triangle_count = s->triangle_count;
+    m->positions = mk_arena_array(&o->raw.arena, 3 * (size_t)s->vertex_count, sizeof(float));
+    m->normals = mk_arena_array(&o->raw.arena, 3 * (size_t)s->vertex_count, sizeof(float));
+    m->control_points = mk_arena_array(&o->raw.arena, s->vertex_count, sizeof(uint32_t));
+    m->triangles = mk_arena_array(&o->raw.arena, 3 * (size_t)s->triangle_count, sizeof(uint32_t));
+    memcpy(m->positions, s->positions, 12 * (size_t)s->vertex_count);
+    memcpy(m->normals, s->normals, 12 * (size_t)s->vertex_count);
+    for (uint32_t v = 0; v < s->vertex_count; v++) m->control_points[v] = s->control_points ? s->control_points[v] : v;
+    memcpy(m->triangles, s->triangles, 12 * (size_t)s->triangle_count);
+    mk_raw_channel *ch = mk_raw_add_channels(&o->raw, 1);
+    ch->name = "move";
+    mk_raw_target *tg = mk_raw_add_targets(&o->raw, ch, 1);
+    tg->name = "move";
+    tg->count = s->moved_count;
+    tg->indices = mk_arena_array(&o->raw.arena, s->moved_count, sizeof(uint32_t));
+    tg->positions = mk_arena_array(&o->raw.arena, 3 * (size_t)s->moved_count, sizeof(float));
+    memcpy(tg->indices, s->moved, 4 * (size_t)s->moved_count);
+    memcpy(tg->positions, s->deltas, 12 * (size_t)s->moved_count);
+    size_t size;
+    mk_error err;
+    void *blob = fixture_blob(&o->raw, MK_PRECISION_FLOAT, &o->arena, &size);
+    CHECK(blob && mk_asset_open(blob, size, &o->asset, &err) == MK_OK);
+    if (!blob) return 0;
+    o->topology_size = mk_surface_topology_size(&o->asset, 0);
+    o->scratch_size = mk_surface_scratch_size(&o->asset, 0);
+    o->topology = mk_arena_alloc(&o->arena, o->topology_size);
+    o->scratch = mk_arena_alloc(&o->arena, o->scratch_size);
+    CHECK_MSG(mk_surface_topology_build(&o->asset, 0, o->topology, o->topology_size, &err) == MK_OK, "%s", err.message);
+    return 1;
+}
+
+/* A triangle with two corners in one group (split copies of a control point that a target pulls
+ * apart) adds its face normal to that group's sum once, as every triangle does. */
+static void test_welded_corners(void)
+{
+    static const float p0[15] = { 0, 0, 0, 1, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0 };
+    static const float n0[15] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1 };
+    static const uint32_t cps[5] = { 0, 1, 1, 2, 3 }, tris[6] = { 0, 1, 2, 1, 4, 3 }, moved[2] = { 2, 4 };
+    static const float deltas[6] = { 0, 0.5f, 0.4f, 0, 0, 0.3f };
+    const small_mesh sm = { p0, n0, deltas, cps, tris, moved, 5, 4, 2, 2 };
+    opened o;
+    if (open_small(&o, &sm)) {
+        float p[15], nrm[15];
+        memcpy(p, p0, sizeof p);
+        for (int k = 0; k < 2; k++)
+            for (int d = 0; d < 3; d++) p[3 * moved[k] + (uint32_t)d] += deltas[3 * k + d];
+        mk_error err;
+        CHECK_MSG(surface(&o, p, 0, MK_VERTICES_TO_END, nrm, NULL, &err) == MK_OK, "%s", err.message);
+        /* The group's base and rest normals are both +z (the pulled triangle has no area at
+         * rest), so its vertices take the normalized sum of both faces at P. */
+        double worst = 0;
+        for (uint32_t v = 1; v <= 2; v++) {
+            double want[3];
+            fixture_brute_normal(&o.raw.meshes[0], p, v, 1, want);
+            for (int d = 0; d < 3; d++) worst = fmax(worst, fabs(nrm[3 * v + (uint32_t)d] - want[d]));
+        }
+        CHECK_MSG(worst < 1e-6, "the welded corners' normals are %g from the sum of their group's faces", worst);
+    }
+    close_grid(&o);
+}
+
 static void test_refuses_wrong_topology(void)
 {
     opened a, b;
@@ -307,55 +385,21 @@ static void test_non_finite_positions(void)
  * weight 0 every vertex keeps them. */
 static void test_degenerate_pieces(void)
 {
-    mk_raw_asset raw;
-    mk_arena arena;
-    mk_raw_init(&raw, NULL);
-    mk_arena_init(&arena, NULL);
-    mk_raw_mesh *m = mk_raw_add_meshes(&raw, 1);
-    m->name = "pieces";
-    m->vertex_count = m->control_point_count = 7;
     static const float p0[21] = { 0, 0, 0, 1, 0, 0, 0, 1, 0,  5, 5, 1, 5, 5, 1, 5, 5, 1,  9, 9, 9 };
     static const float n0[21] = { 0, 0, 1, 0, 0, 1, 0, 0, 1,  0.6f, 0, 0.8f, 0, 0.6f, 0.8f, 0, 0, 1,  1, 0, 0 };
-    static const uint32_t tris[6] = { 0, 1, 2, 3, 4, 5 };
-    m->positions = mk_arena_array(&raw.arena, 21, sizeof(float));
-    m->normals = mk_arena_array(&raw.arena, 21, sizeof(float));
-    m->control_points = mk_arena_array(&raw.arena, 7, sizeof(uint32_t));
-    m->triangles = mk_arena_array(&raw.arena, 6, sizeof(uint32_t));
-    memcpy(m->positions, p0, sizeof p0);
-    memcpy(m->normals, n0, sizeof n0);
-    memcpy(m->triangles, tris, sizeof tris);
-    for (uint32_t v = 0; v < 7; v++) m->control_points[v] = v;
-    m->triangle_count = 2;
-    mk_raw_channel *ch = mk_raw_add_channels(&raw, 1);
-    ch->name = "open";
-    mk_raw_target *tg = mk_raw_add_targets(&raw, ch, 1);
-    tg->name = "open";
-    tg->count = 3;
-    tg->indices = mk_arena_array(&raw.arena, 3, sizeof(uint32_t));
-    tg->positions = mk_arena_array(&raw.arena, 9, sizeof(float));
-    static const uint32_t moved[3] = { 4, 5, 6 };
+    static const uint32_t tris[6] = { 0, 1, 2, 3, 4, 5 }, moved[3] = { 4, 5, 6 };
     static const float deltas[9] = { 1, 0, 0.5f, 0, 1, 0.25f, 0.5f, 0.5f, 0.5f };
-    memcpy(tg->indices, moved, sizeof moved);
-    memcpy(tg->positions, deltas, sizeof deltas);
-    size_t size;
-    mk_error err;
-    mk_asset a;
-    void *blob = fixture_blob(&raw, MK_PRECISION_FLOAT, &arena, &size);
-    CHECK(blob && mk_asset_open(blob, size, &a, &err) == MK_OK);
-    if (!blob) goto done;
-    size_t ts = mk_surface_topology_size(&a, 0), ss = mk_surface_scratch_size(&a, 0);
-    void *topology = mk_arena_alloc(&arena, ts), *scratch = mk_arena_alloc(&arena, ss);
-    CHECK_MSG(mk_surface_topology_build(&a, 0, topology, ts, &err) == MK_OK, "%s", err.message);
+    const small_mesh sm = { p0, n0, deltas, NULL, tris, moved, 7, 7, 2, 3 };
+    opened o;
+    if (!open_small(&o, &sm)) goto done;
     for (int opened_up = 0; opened_up < 2; opened_up++) {
         float p[21], nrm[21];
         memcpy(p, p0, sizeof p);
         if (opened_up)
             for (int k = 0; k < 3; k++)
                 for (int d = 0; d < 3; d++) p[3 * moved[k] + (uint32_t)d] += deltas[3 * k + d];
-        mk_surface_job job = { .asset = &a, .topology = topology, .topology_size = ts, .positions = p,
-                               .positions_size = sizeof p, .vertex_count = MK_VERTICES_TO_END, .normals = nrm,
-                               .normals_size = sizeof nrm, .scratch = scratch, .scratch_size = ss };
-        CHECK_MSG(mk_surface_run(&job, &err) == MK_OK, "%s", err.message);
+        mk_error err;
+        CHECK_MSG(surface(&o, p, 0, MK_VERTICES_TO_END, nrm, NULL, &err) == MK_OK, "%s", err.message);
         CHECK_MSG(memcmp(nrm, n0, 9 * sizeof(float)) == 0, "opened %d: the untouched triangle changed", opened_up);
         CHECK_MSG(memcmp(nrm + 18, n0 + 18, 3 * sizeof(float)) == 0, "opened %d: the lone vertex changed", opened_up);
         if (!opened_up) {
@@ -372,9 +416,8 @@ static void test_degenerate_pieces(void)
         CHECK_MSG(worst < 1e-6, "the opened corners are %g from their face's normal", worst);
     }
 done:
-    mk_arena_free_all(&arena);
-    mk_raw_free(&raw);
+    close_grid(&o);
 }
 
 CHECK_MAIN(CASE(test_matches_brute_force), CASE(test_ranges_same_bytes), CASE(test_non_finite_positions),
-           CASE(test_degenerate_pieces), CASE(test_refuses_wrong_topology))
+           CASE(test_degenerate_pieces), CASE(test_welded_corners), CASE(test_refuses_wrong_topology))
