@@ -11,7 +11,7 @@
 
 /* ns per frame of each: per weight set the best of BENCH_PASSES runs, alternating with the
  * other's, averaged over the weight sets (and summed over the meshes that have surface normals): nlerp on nlerp_asset, surface normals on surface_asset (which may be
- * the same). 0 when no mesh has them or on error. */
+ * the same). 0 when no mesh has them; a mesh that fails is left out. */
 void bench_surface_frames(const pb_asset *nlerp_asset, const pb_asset *surface_asset, const float *weight_sets,
                           uint32_t frames, double *ns_nlerp, double *ns_surface);
 

@@ -5,8 +5,8 @@
  * the model and never match an AMD CPU) through a glibc ifunc (GCC target_clones). The helpers
  * such a function calls are MK_INLINE (force-inlined), so each clone gets its own vector code.
  * Both clones give the same bytes: determinism.h keeps multiplies and adds from being fused
- * into FMA, and the loops use only correctly rounded operations. Define MK_NO_TARGET_CLONES to build one baseline copy. GCC
- * only: clang 14 emits the resolver as a global symbol. */
+ * into FMA, and the loops use only correctly rounded operations. Define MK_NO_TARGET_CLONES to
+ * build one baseline copy. GCC only: clang 14 emits the resolver as a global symbol. */
 #ifndef MK_RUNTIME_CLONES_H
 #define MK_RUNTIME_CLONES_H
 

@@ -5,14 +5,15 @@
  * The topology, built once per mesh into caller memory, holds the smoothing groups (vertices
  * with the same control point and the same base normal within 1e-5 per component), each
  * group's triangles (a triangle once per distinct corner group, in triangle order), each
- * triangle's distinct corner groups and each group's rest normal. The rules and the order of every sum are those of the offline importer's
- * target normals (which sums in double precision; here single precision keeps the per-frame
- * pass small), so a single target at its full weight reproduces the normal deltas the importer
- * computed for it up to float rounding. A job walks the triangles it needs in order, adds each
- * one's face normal to the sums of its distinct corner groups (so every group's sum is formed in
- * its triangle order, the order the importer sums in), then finishes sixteen vertices at a time
- * in lanes without branches, compiled per ISA level (clones.h). A vertex's normal depends only
- * on the positions and the topology, never on the job's range. */
+ * triangle's distinct corner groups and each group's rest normal. The rules and the order of
+ * every sum are those of the offline importer's target normals (which sums in double
+ * precision; here single precision keeps the per-frame pass small), so a single target at its
+ * full weight reproduces the normal deltas the importer computed for it up to float rounding.
+ * A job walks the triangles it needs in order, adds each one's face normal to the sums of its
+ * distinct corner groups (so every group's sum is formed in its triangle order, the order the
+ * importer sums in), then finishes sixteen vertices at a time in lanes without branches,
+ * compiled per ISA level (clones.h). A vertex's normal depends only on the positions and the
+ * topology, never on the job's range. */
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -23,7 +24,7 @@
 #include "clones.h"
 #include "determinism.h"
 
-#define TOPOLOGY_MAGIC 0x32534b4du /* "MKS2" */
+#define TOPOLOGY_MAGIC 0x33534b4du /* "MKS3" */
 #define NO_GROUP UINT32_MAX
 
 typedef struct topology_header {
@@ -240,7 +241,7 @@ mk_result mk_surface_validate(const mk_surface_job *job, mk_error *err)
     layout l = topology_layout(m);
     if (h.magic != TOPOLOGY_MAGIC || h.mesh != job->mesh || h.vertex_count != m->vertex_count
         || h.triangle_count != m->triangle_count || h.checksum != a->header->checksum || h.size != l.size
-        || job->topology_size < l.size)
+        || h.group_count > m->vertex_count || job->topology_size < l.size)
         return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET,
                              "surface job: the topology was not built by mk_surface_topology_build for this mesh of this asset");
     if (!job->scratch || (uintptr_t)job->scratch % 16 || job->scratch_size < mk_surface_scratch_size(a, job->mesh))
@@ -399,6 +400,7 @@ mk_result mk_surface_run(const mk_surface_job *job, mk_error *err)
         memset(mark, 0, m->triangle_count);
         for (uint32_t i = 0; i < n; i++) {
             uint32_t g = group_of[job->first_vertex + i];
+            sums[g][0] = sums[g][1] = sums[g][2] = 0;   /* a group without triangles sums to zero too */
             for (uint32_t k = tri_first[g]; k < tri_first[g + 1]; k++) {
                 uint32_t t = group_tris[k];
                 mark[t] = 1;

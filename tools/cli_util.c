@@ -152,3 +152,24 @@ void cli_progress_update(cli_progress *p, const char *stage, double fraction)
     p->last_tenth = tenth;
     fprintf(stderr, "  %s: %3d%%\n", stage, tenth * 10);
 }
+
+void cli_precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *floats, double *max_error_bound)
+{
+    *quantized = *floats = 0;
+    *max_error_bound = 0;
+    for (uint32_t c = 0; c < a->channel_count; c++) {
+        mk_channel_info ch;
+        mk_channel_get(a, c, &ch);
+        for (uint32_t k = 0; k < ch.target_count; k++) {
+            mk_target_info t;
+            mk_target_get(a, c, k, &t);
+            if (t.quantized) {
+                (*quantized)++;
+                /* Rounding to the nearest step: the error is at most half a step. */
+                if (t.position_scale * 0.5 > *max_error_bound) *max_error_bound = t.position_scale * 0.5;
+            } else {
+                (*floats)++;
+            }
+        }
+    }
+}

@@ -10,33 +10,12 @@
 #include "frame_write.h"
 #include "json_write.h"
 
-static void precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *floats, double *max_error_bound)
-{
-    *quantized = *floats = 0;
-    *max_error_bound = 0;
-    for (uint32_t c = 0; c < a->channel_count; c++) {
-        mk_channel_info ch;
-        mk_channel_get(a, c, &ch);
-        for (uint32_t k = 0; k < ch.target_count; k++) {
-            mk_target_info t;
-            mk_target_get(a, c, k, &t);
-            if (t.quantized) {
-                (*quantized)++;
-                /* Rounding to the nearest step: the error is at most half a step. */
-                if (t.position_scale * 0.5 > *max_error_bound) *max_error_bound = t.position_scale * 0.5;
-            } else {
-                (*floats)++;
-            }
-        }
-    }
-}
-
 static void print_text(FILE *f, const pb_asset *l, const char *path)
 {
     const mk_asset *a = &l->asset;
     uint32_t nq, nf;
     double bound;
-    precision_of(a, &nq, &nf, &bound);
+    cli_precision_of(a, &nq, &nf, &bound);
     fprintf(f, "%s: %zu bytes, format v%u\n", path, l->blob_size, MK_FORMAT_VERSION);
     if (l->imported) {
         fprintf(f, "source: %s%s%s\n", l->raw.source_format[0] ? l->raw.source_format : "?",
@@ -85,7 +64,7 @@ static void print_json(FILE *f, const pb_asset *l, const char *path)
     const mk_asset *a = &l->asset;
     uint32_t nq, nf;
     double bound;
-    precision_of(a, &nq, &nf, &bound);
+    cli_precision_of(a, &nq, &nf, &bound);
     json_writer w;
     json_begin(&w, f, 1);
     json_object(&w, NULL);

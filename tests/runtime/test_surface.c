@@ -296,6 +296,43 @@ static void test_welded_corners(void)
     close_grid(&o);
 }
 
+/* A vertex in no triangle keeps its base normal in a range job as in the whole-mesh one, whatever
+ * the scratch held (a finite pattern here: an infinite one would fall back to the base normal by
+ * itself); outputs with their own strides get the packed outputs' bytes. */
+static void test_isolated_vertex_and_strides(void)
+{
+    static const float p0[15] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 3, 3, 3, 1, 1, 0.5f };
+    static const float n0[15] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 1, 0, 0, 0, 0, 1 };
+    static const uint32_t tris[6] = { 0, 1, 2, 1, 4, 2 }, moved[2] = { 1, 4 };
+    static const float deltas[6] = { 0, 0, 0.5f, 0.2f, 0, -0.3f };
+    const small_mesh sm = { p0, n0, deltas, NULL, tris, moved, 5, 5, 2, 2 };
+    opened o;
+    if (open_small(&o, &sm)) {
+        float p[15], whole[15], range[15], wide[30];
+        memcpy(p, p0, sizeof p);
+        for (int k = 0; k < 2; k++)
+            for (int d = 0; d < 3; d++) p[3 * moved[k] + (uint32_t)d] += deltas[3 * k + d];
+        mk_error err;
+        CHECK_MSG(surface(&o, p, 0, MK_VERTICES_TO_END, whole, NULL, &err) == MK_OK, "%s", err.message);
+        CHECK(memcmp(&whole[9], &n0[9], 12) == 0);   /* the isolated vertex */
+        for (uint32_t v = 0; v < 5; v++) {
+            memset(o.scratch, 0x3f, o.scratch_size);
+            CHECK_MSG(surface(&o, p, v, 1, &range[3 * v], NULL, &err) == MK_OK, "%s", err.message);
+        }
+        CHECK_MSG(memcmp(whole, range, sizeof whole) == 0, "one-vertex jobs differ from the whole-mesh job");
+        mk_surface_job job = { .asset = &o.asset, .topology = o.topology, .topology_size = o.topology_size,
+                               .positions = p, .positions_size = sizeof p, .vertex_count = MK_VERTICES_TO_END,
+                               .normals = wide, .normals_stride = 24, .normals_size = sizeof wide,
+                               .scratch = o.scratch, .scratch_size = o.scratch_size };
+        memset(wide, 0, sizeof wide);
+        CHECK_MSG(mk_surface_run(&job, &err) == MK_OK, "%s", err.message);
+        int same = 1;
+        for (uint32_t v = 0; v < 5; v++) same &= memcmp(&wide[6 * v], &whole[3 * v], 12) == 0 && wide[6 * v + 3] == 0;
+        CHECK_MSG(same, "normals written with a stride of 24 bytes differ from the packed ones");
+    }
+    close_grid(&o);
+}
+
 static void test_refuses_wrong_topology(void)
 {
     opened a, b;
@@ -316,6 +353,15 @@ static void test_refuses_wrong_topology(void)
     CHECK_EQ_INT(mk_surface_topology_build(&a.asset, 0, (char *)a.topology + 4, a.topology_size, &err),
                  MK_ERROR_INVALID_ARGUMENT);
     CHECK_EQ_INT(mk_surface_topology_build(&a.asset, 1, a.topology, a.topology_size, &err), MK_ERROR_OUT_OF_RANGE);
+    /* A topology claiming more groups than vertices (its header's fifth u32, after magic, mesh,
+     * vertex and triangle counts) would make a job zero sums past its scratch: refused. */
+    void *forged = mk_arena_alloc(&a.arena, a.topology_size);
+    memcpy(forged, a.topology, a.topology_size);
+    uint32_t groups = nv + 1;
+    memcpy((char *)forged + 16, &groups, 4);
+    mixed = a;
+    mixed.topology = forged;
+    CHECK_EQ_INT(surface(&mixed, p, 0, MK_VERTICES_TO_END, nrm, NULL, &err), MK_ERROR_INVALID_ARGUMENT);
     mk_surface_job job = { .asset = &a.asset, .topology = a.topology, .topology_size = a.topology_size, .positions = p,
                            .positions_size = 12 * (size_t)nv - 4, .vertex_count = MK_VERTICES_TO_END, .normals = nrm,
                            .normals_size = 12 * (size_t)nv, .scratch = a.scratch, .scratch_size = a.scratch_size - 16 };
@@ -420,4 +466,5 @@ done:
 }
 
 CHECK_MAIN(CASE(test_matches_brute_force), CASE(test_ranges_same_bytes), CASE(test_non_finite_positions),
-           CASE(test_degenerate_pieces), CASE(test_welded_corners), CASE(test_refuses_wrong_topology))
+           CASE(test_degenerate_pieces), CASE(test_welded_corners), CASE(test_isolated_vertex_and_strides),
+           CASE(test_refuses_wrong_topology))
