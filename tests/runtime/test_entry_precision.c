@@ -92,6 +92,12 @@ static void test_outlier_block_is_float(void)
                    + (double)weights[w][1] * raw.channels[1].targets[0].positions[3 * OUTLIER + 1]
                    + (double)weights[w][2] * raw.channels[2].targets[0].positions[3 * OUTLIER + 1], 1e-3);
     }
+    /* mk_eval_traffic counts the float entry's bytes as float: target 3 alone, positions only:
+     * the block table (6 values), 20 entry headers, 236 vertices of int16 positions and the
+     * outlier block's 64 of float, the base read and the output written. */
+    mk_eval_job tj = { .asset = &a, .vertex_count = MK_VERTICES_TO_END, .weights = weights[0], .weight_count = 4,
+                       .scratch = scratch, .scratch_size = scratch_size, .positions = p, .positions_size = 12u * VERTICES };
+    CHECK_EQ_INT(mk_eval_traffic(&tj), 4 * 6 + 16 * 20 + 6 * (VERTICES - 64) + 12 * 64 + 24 * VERTICES);
     free(scratch);
     free(p);
     free(n);
