@@ -13,13 +13,16 @@ typedef enum mk_precision {
 
 typedef struct mk_write_options {
     mk_precision precision;
-    /* Largest allowed absolute position error of quantization, in mesh units; a target whose
-     * int16 error would exceed it is stored as float32. 0 = 1e-4 x the mesh's bounding-box
-     * diagonal (a relative default that works for cm and m assets alike). */
+    /* Largest allowed absolute position error of quantization, in mesh units. A quantized
+     * target's scales come from its entries (64-vertex blocks) that fit this with int16; the
+     * entries that do not (outlier deltas) are stored as float32. 0 = 1e-4 x the mesh's
+     * bounding-box diagonal (a relative default that works for cm and m assets alike). */
     float tolerance;
-    /* Blocks of 64 vertices whose moved-vertex count is at least this are stored dense (all 64
-     * vertices); 0 = 24. */
-    uint32_t dense_threshold;
+    /* The entry mask rule (mk_block_mask, block_mask.h) with gap = gap_limit - 1: gaps of at
+     * most `gap` unmoved vertices between moved ones are stored as zeros, and a block that
+     * still lacks at most 3 x gap is stored whole. 1 stores exactly the moved vertices, 65
+     * every touched block whole; 0 = the default (MK_DEFAULT_FILL_GAP + 1). */
+    uint32_t gap_limit;
     /* Phases of the write (quantize, lay out blocks, assemble); may be NULL. */
     mk_phase_log *phases;
     /* Threads for quantizing and laying out targets; 0 = one per core. The blob is the same
@@ -33,6 +36,8 @@ typedef struct mk_write_report {
     double max_tangent_error;   /* tolerance; int16 of a unit-vector difference errs < 3.1e-5 */
     double tolerance_used;      /* the largest per-mesh tolerance that was applied */
     uint32_t quantized_targets, float_targets;
+    uint64_t float_entries;     /* entries of quantized targets stored as float32 (outliers) */
+    uint64_t entry_count;       /* all block entries */
     uint64_t target_bytes;      /* bytes of block data (entries + deltas) */
     uint64_t total_bytes;
 } mk_write_report;

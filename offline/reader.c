@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
-/* mk_read_blob: an opened .morph asset back into a raw model (deltas dequantized). Dense
- * blocks store zeros for vertices a target does not move; all-zero vertices of dense blocks
- * are dropped again (a vertex the author stored with a zero delta inside a dense block is
- * indistinguishable from padding; sparse entries keep every stored vertex). */
+/* mk_read_blob: an opened .morph asset back into a raw model (deltas dequantized, each
+ * entry by its own precision). An entry's mask may cover vertices a target does not move (the
+ * writer fills short gaps and nearly full blocks), stored as zeros; all-zero vertices are
+ * dropped again (a vertex the author stored with a zero delta is indistinguishable from that
+ * padding, and moves nothing). */
 #include <stdio.h>
 #include <string.h>
 #include "blob_io.h"
@@ -34,11 +35,10 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
     const mk_blob_target *bt = &a->targets[bm->first_target + local];
     const uint32_t *block_first = (const uint32_t *)(a->data + bm->block_entries);
     const mk_blob_entry *entries = (const mk_blob_entry *)(a->data + bm->entries);
-    const int q = (bt->flags & MK_TARGET_QUANTIZED) != 0;
     const int hn = (bt->flags & MK_TARGET_HAS_NORMALS) != 0, ht = (bt->flags & MK_TARGET_HAS_TANGENTS) != 0;
     uint64_t capacity = 0;
     for (uint64_t e = 0; e < bm->entry_count; e++)
-        if (entries[e].target == local) capacity += (uint64_t)mk_popcount64(entries[e].mask);
+        if (mk_entry_target(&entries[e]) == local) capacity += (uint64_t)mk_popcount64(entries[e].mask);
     t->indices = mk_arena_array(arena, capacity + 1, sizeof(uint32_t));
     t->positions = mk_arena_array(arena, 3 * capacity + 3, sizeof(float));
     t->normals = hn ? mk_arena_array(arena, 3 * capacity + 3, sizeof(float)) : NULL;
@@ -49,12 +49,11 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
     for (uint32_t b = 0; b < bm->block_count; b++) {
         for (uint32_t e = block_first[b]; e < block_first[b + 1]; e++) {
             const mk_blob_entry *en = &entries[e];
-            if (en->target != local) continue;
+            if (mk_entry_target(en) != local) continue;
+            const int q = mk_entry_quantized(en);   /* per entry: a quantized target's outliers are float */
             uint32_t m = mk_popcount64(en->mask);
             size_t attr = (size_t)m * 3 * (q ? 2 : 4);
             const uint8_t *p = a->data + bm->target_data + (size_t)en->data * MK_ALIGN;
-            uint32_t in_block = bm->vertex_count - b * MK_BLOCK_SIZE;
-            int dense = m == (in_block < MK_BLOCK_SIZE ? in_block : MK_BLOCK_SIZE);
             uint32_t j = 0;
             for (uint64_t bits = en->mask; bits; bits &= bits - 1, j++) {
                 float pv[3], nv[3] = { 0, 0, 0 }, tv[3] = { 0, 0, 0 };
@@ -65,7 +64,7 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
                     if (ht) tv[c] = decode(p + attr * (hn ? 2 : 1), q, c, j, bt->tangent_scale);
                     nonzero |= pv[c] != 0 || nv[c] != 0 || tv[c] != 0;
                 }
-                if (!nonzero && dense) continue;
+                if (!nonzero) continue;   /* a vertex the mask covers but the target does not move */
                 t->indices[n] = b * MK_BLOCK_SIZE + mk_ctz64(bits);
                 memcpy(&t->positions[3u * n], pv, sizeof pv);
                 if (hn) memcpy(&t->normals[3u * n], nv, sizeof nv);

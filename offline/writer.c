@@ -5,12 +5,14 @@
  * KEYS | DATA, every piece 16-aligned. DATA holds, per mesh: base positions, normals,
  * tangents, triangles, control-point map, the block table, the entries and the delta data.
  *
- * Targets are cut into blocks of 64 vertices. A block where a target moves at least
- * dense_threshold vertices is stored dense (all the block's vertices, zeros included), so
- * the runtime runs a plain vectorized loop; sparser blocks store only the moved vertices
- * with a bit mask. Quantized targets store int16 per component with a per-target,
- * per-attribute scale = max|component| / 32767; a target whose position error would exceed
- * the tolerance is stored as float32 instead.
+ * Targets are cut into blocks of 64 vertices, one entry per touched block. An entry's mask
+ * (mk_block_mask) holds the moved vertices plus short gaps between them, or the whole block
+ * when little of it is unmoved, so the runtime adds few, long runs (a whole block is its
+ * constant-trip loop) while few zeros are stored. Quantized targets store int16 per component
+ * with a per-target, per-attribute scale = max|component| / 32767 over their int16 entries;
+ * when the whole target's position error would exceed the tolerance, the entries whose deltas
+ * do not fit it (outliers) are stored as float32 and the scales come from the others (a target
+ * with no entry that fits is stored as float32).
  *
  * Deterministic: fixed iteration order, all padding zero, nothing taken from pointers/time.
  */
@@ -19,6 +21,7 @@
 #include <string.h>
 #include <threads.h>
 #include "blob_io.h"
+#include "block_mask.h"
 #include "format.h"
 #include "parallel.h"
 
@@ -119,14 +122,69 @@ static float mesh_diagonal(const mk_raw_mesh *m)
 typedef struct target_plan {
     uint32_t flags;
     float position_scale, normal_scale, tangent_scale;
+    /* A quantized target's entries whose largest |position component| exceeds this are
+     * float32 (INFINITY: none). */
+    float entry_limit;
+    uint32_t float_entries;            /* how many (counted by the plan) */
     double tolerance;                  /* the mesh's */
 } target_plan;
 
+/* The moved vertices [first, end) of a target in one block: from `first`, the target's
+ * indices below the block's end. */
+static uint32_t block_end(const mk_raw_target *t, uint32_t first, uint32_t block_limit)
+{
+    uint32_t end = first;
+    while (end < t->count && t->indices[end] < block_limit) end++;
+    return end;
+}
+
+/* The largest position magnitude an int16 entry may hold: the largest L whose scale
+ * L / 32767 keeps quant_error_bound within the tolerance (0 when even the smallest normal
+ * scale does not). */
+static float entry_limit_for(double tolerance)
+{
+    float limit = (float)(tolerance / (0.5 + 1.0 / 256) * 32767.0);
+    if (!(limit < FLT_MAX)) limit = FLT_MAX;
+    while (limit > 0 && !(quant_scale(limit) >= FLT_MIN && quant_error_bound(quant_scale(limit)) <= tolerance))
+        limit = quant_scale(limit) >= FLT_MIN ? nextafterf(limit, 0.0f) : 0.0f;
+    return limit;
+}
+
+/* Per-entry precision of a target the tolerance does not fit whole: the blocks whose
+ * positions exceed entry_limit_for(tolerance) are float32, the scales come from the rest. A
+ * target without such a rest stays float32. */
+static void plan_entries(const mk_raw_target *t, target_plan *p)
+{
+    const float limit = entry_limit_for(p->tolerance);
+    float pm = 0, nm = 0, tm = 0;
+    uint32_t int16_entries = 0, float_entries = 0;
+    for (uint32_t first = 0; first < t->count;) {
+        const uint32_t start = t->indices[first] / MK_BLOCK_SIZE * MK_BLOCK_SIZE;
+        const uint32_t end = block_end(t, first, start + MK_BLOCK_SIZE);
+        const size_t at = 3u * (size_t)first, n = 3u * (size_t)(end - first);
+        const float bm = max_abs(t->positions + at, n);
+        first = end;
+        if (bm > limit) { float_entries++; continue; }
+        int16_entries++;
+        pm = bm > pm ? bm : pm;
+        if (t->normals) { float x = max_abs(t->normals + at, n); nm = x > nm ? x : nm; }
+        if (t->tangents) { float x = max_abs(t->tangents + at, n); tm = x > tm ? x : tm; }
+    }
+    if (!int16_entries) return;
+    p->flags |= MK_TARGET_QUANTIZED;
+    p->entry_limit = limit;
+    p->float_entries = float_entries;
+    p->position_scale = quant_scale(pm);
+    if (t->normals) p->normal_scale = quant_scale(nm);
+    if (t->tangents) p->tangent_scale = quant_scale(tm);
+}
+
 /* Decides a target's storage: int16 with per-attribute scales when the positions' error stays
- * within the tolerance, float32 otherwise (or when asked). */
+ * within the tolerance, else per entry (plan_entries); float32 when asked. */
 static void plan_target(const mk_raw_target *t, mk_precision precision, target_plan *p)
 {
     p->flags = (t->normals ? MK_TARGET_HAS_NORMALS : 0u) | (t->tangents ? MK_TARGET_HAS_TANGENTS : 0u);
+    p->entry_limit = INFINITY;
     if (precision == MK_PRECISION_FLOAT) return;
     size_t n = 3 * (size_t)t->count;
     float ps = quant_scale(max_abs(t->positions, n));
@@ -134,12 +192,20 @@ static void plan_target(const mk_raw_target *t, mk_precision precision, target_p
      * while writing the data, in write_block). */
     if (!(ps >= FLT_MIN && quant_error_bound(ps) <= p->tolerance) && ps != 0) {
         double pe = quant_error(t->positions, n, ps);
-        if (pe > p->tolerance) return;
+        if (pe > p->tolerance) { plan_entries(t, p); return; }
     }
     p->flags |= MK_TARGET_QUANTIZED;
     p->position_scale = ps;
     if (t->normals) p->normal_scale = quant_scale(max_abs(t->normals, n));
     if (t->tangents) p->tangent_scale = quant_scale(max_abs(t->tangents, n));
+}
+
+/* Whether the target's moved vertices [first, end) of one block are stored as float32. */
+static int entry_is_float(const mk_raw_target *t, const target_plan *p, uint32_t first, uint32_t end)
+{
+    if (!(p->flags & MK_TARGET_QUANTIZED)) return 1;
+    if (p->entry_limit == INFINITY) return 0;
+    return max_abs(t->positions + 3u * (size_t)first, 3u * (size_t)(end - first)) > p->entry_limit;
 }
 
 typedef struct plan_loop {
@@ -156,16 +222,15 @@ static void plan_item(void *user, uint32_t item, uint32_t worker)
 }
 
 /* Writes one entry's data for the vertices of `mask` in block `block`, in bit order: the
- * position triples, then the normal triples, then the tangent triples (`attr` bytes each). A
- * vertex the target does not move (a dense block) keeps the zeros dst already holds (the blob
- * is zeroed, and 0 quantizes to 0 without error). cursor is the target's first
- * index in the block; each vertex is looked up once for all attributes. A quantized target's
- * largest error per attribute is kept in error[] (every value is written once, so this is the
- * error over the whole target). */
-static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p, uint32_t cursor, uint64_t mask,
-                      uint32_t block, size_t attr, double error[3])
+ * position triples, then the normal triples, then the tangent triples (`attr` bytes each),
+ * int16 when `quantized`, else float32. A vertex the mask covers but the target does not move
+ * keeps the zeros dst already holds (the blob is zeroed, and 0 quantizes to 0 without error).
+ * cursor is the target's first index in the block; each vertex is looked up once for all
+ * attributes. The largest int16 error per attribute is kept in error[] (every value is
+ * written once, so this is the error over the whole target). */
+static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p, int quantized, uint32_t cursor,
+                      uint64_t mask, uint32_t block, size_t attr, double error[3])
 {
-    const int quantized = (p->flags & MK_TARGET_QUANTIZED) != 0;
     const float *src[3] = { t->positions, t->normals, t->tangents };
     const float scale[3] = { p->position_scale, p->normal_scale, p->tangent_scale };
     uint8_t *out[3] = { dst, dst + attr, dst + (t->normals ? 2 * attr : attr) };
@@ -205,29 +270,30 @@ typedef struct target_layout {
 typedef struct layout_loop {
     const mk_raw_mesh *m;
     const target_plan *plans;
-    uint32_t dense_threshold;
+    uint32_t gap;                      /* mk_block_mask's */
     target_layout *targets;
     uint32_t *entry_block;             /* per entry, target-major */
+    uint8_t *entry_float;              /* per entry: its data is float32 */
     uint64_t *entry_mask, *entry_data; /* the entry's vertices; its data's offset in the target data */
     uint8_t *data;                     /* the mesh's target data */
     mk_arena *owner;                   /* consuming: the raw arena the written targets go back to */
     mtx_t *owner_lock;
 } layout_loop;
 
-/* Calls fn(user, block, mask) for each block a target touches, in block order; the mask has
- * the moved vertices, or all the block's vertices when it is dense. */
+/* Calls fn(user, block, first, end, mask) for each block a target touches, in block order:
+ * the target's moved vertices in it are indices [first, end), the mask is mk_block_mask's. */
 static void target_blocks(const layout_loop *l, const mk_raw_target *tg,
-                          void (*fn)(void *user, uint32_t block, uint32_t first, uint64_t mask), void *user)
+                          void (*fn)(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask),
+                          void *user)
 {
     const uint32_t vertex_count = l->m->vertex_count;
     for (uint32_t first = 0; first < tg->count;) {
         uint32_t block = tg->indices[first] / MK_BLOCK_SIZE, start = block * MK_BLOCK_SIZE;
         uint32_t in_block = vertex_count - start < MK_BLOCK_SIZE ? vertex_count - start : MK_BLOCK_SIZE;
-        uint64_t mask = 0;
-        uint32_t end = first;
-        while (end < tg->count && tg->indices[end] < start + in_block) mask |= 1ull << (tg->indices[end++] - start);
-        if (mk_popcount64(mask) >= l->dense_threshold) mask = in_block == 64 ? ~0ull : ((1ull << in_block) - 1);
-        fn(user, block, first, mask);
+        uint32_t end = block_end(tg, first, start + in_block);
+        uint64_t moved = 0;
+        for (uint32_t k = first; k < end; k++) moved |= 1ull << (tg->indices[k] - start);
+        fn(user, block, first, end, mk_block_mask(moved, in_block, l->gap));
         first = end;
     }
 }
@@ -238,11 +304,18 @@ typedef struct layout_item {
     uint32_t index;
 } layout_item;
 
-static void count_block(void *user, uint32_t block, uint32_t first, uint64_t mask)
+/* The flags that size an entry's data (mk_entry_flags): the target's, int16 or not per entry. */
+static uint32_t entry_flags(const target_plan *p, int is_float)
+{
+    return is_float ? p->flags & ~(uint32_t)MK_TARGET_QUANTIZED : p->flags;
+}
+
+static void count_block(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask)
 {
     layout_item *it = user;
-    (void)block; (void)first;
-    uint64_t size = mk_entry_data_size(it->l->plans[it->index].flags, mk_popcount64(mask));
+    (void)block;
+    const target_plan *p = &it->l->plans[it->index];
+    uint64_t size = mk_entry_data_size(entry_flags(p, entry_is_float(it->tl->t, p, first, end)), mk_popcount64(mask));
     it->tl->data_size = pad16((size_t)it->tl->data_size) + size;
     it->tl->entry_count++;
 }
@@ -255,7 +328,7 @@ static void layout_count(void *user, uint32_t item, uint32_t worker)
     target_blocks(l, it.tl->t, count_block, &it);
 }
 
-static void write_block(void *user, uint32_t block, uint32_t first, uint64_t mask)
+static void write_block(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask)
 {
     layout_item *it = user;
     const layout_loop *l = it->l;
@@ -263,13 +336,15 @@ static void write_block(void *user, uint32_t block, uint32_t first, uint64_t mas
     const mk_raw_target *tg = tl->t;
     const target_plan *p = &l->plans[it->index];
     uint64_t e = tl->cursor++;
-    uint64_t at = pad16((size_t)tl->data_size), size = mk_entry_data_size(p->flags, mk_popcount64(mask));
+    const int is_float = entry_is_float(tg, p, first, end);
+    uint64_t at = pad16((size_t)tl->data_size), size = mk_entry_data_size(entry_flags(p, is_float), mk_popcount64(mask));
     tl->data_size = at + size;
     l->entry_block[e] = block;
+    l->entry_float[e] = (uint8_t)is_float;
     l->entry_mask[e] = mask;
     l->entry_data[e] = tl->base + at;
     size_t attr = (size_t)size / (1u + (tg->normals ? 1u : 0u) + (tg->tangents ? 1u : 0u));
-    put_entry(l->data + tl->base + at, tg, p, first, mask, block, attr, tl->error);
+    put_entry(l->data + tl->base + at, tg, p, !is_float, first, mask, block, attr, tl->error);
 }
 
 static void layout_write(void *user, uint32_t item, uint32_t worker)
@@ -314,7 +389,7 @@ static uint64_t place(uint64_t *cursor, uint64_t n)
  * data written straight into the blob by write_mesh_data, both on worker threads (no
  * allocation there); the entries are merged block by block afterwards. */
 static mk_result plan_mesh_data(const mk_raw_asset *raw, mk_raw_asset *consume, uint32_t mi, uint32_t first_channel,
-                                uint32_t channel_count, const target_plan *plans, uint32_t dense_threshold,
+                                uint32_t channel_count, const target_plan *plans, uint32_t gap,
                                 uint32_t threads, mk_arena *arena, uint64_t *cursor, mesh_out *out, mk_error *err)
 {
     const mk_raw_mesh *m = &raw->meshes[mi];
@@ -328,7 +403,9 @@ static mk_result plan_mesh_data(const mk_raw_asset *raw, mk_raw_asset *consume, 
     uint32_t target_count = 0;
     for (uint32_t c = first_channel; c < first_channel + channel_count; c++) target_count += raw->channels[c].target_count;
     layout_loop *l = &out->l;
-    *l = (layout_loop){ m, plans, dense_threshold, NULL, NULL, NULL, NULL, NULL, consume ? &consume->arena : NULL, NULL };
+    if (target_count > MK_MAX_MESH_TARGETS)
+        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: more than 2^24 targets", mi);
+    *l = (layout_loop){ m, plans, gap, NULL, NULL, NULL, NULL, NULL, NULL, consume ? &consume->arena : NULL, NULL };
     l->targets = mk_arena_array(arena, target_count + 1, sizeof *l->targets);
     if (!l->targets) return mk_error_oom(err, "planning blocks");
     uint32_t k = 0;
@@ -379,7 +456,9 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, uint32_t threads, mk_aren
     l->entry_block = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_block);
     l->entry_mask = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_mask);
     l->entry_data = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_data);
-    if (!l->entry_block || !l->entry_mask || !l->entry_data) return mk_error_oom(err, "planning blocks");
+    l->entry_float = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_float);
+    if (!l->entry_block || !l->entry_mask || !l->entry_data || !l->entry_float)
+        return mk_error_oom(err, "planning blocks");
     l->data = data + out->target_data;
     mtx_t lock;
     if (l->owner) {
@@ -397,20 +476,23 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, uint32_t threads, mk_aren
         for (uint32_t t = 0; t < target_count; t++) {
             target_layout *tl = &l->targets[t];
             if (tl->cursor == tl->first_entry + tl->entry_count || l->entry_block[tl->cursor] != b) continue;
-            mk_blob_entry be = { t, (uint32_t)(l->entry_data[tl->cursor] / MK_ALIGN), l->entry_mask[tl->cursor] };
+            const uint32_t flags = l->entry_float[tl->cursor] ? (uint32_t)MK_ENTRY_FLOAT : 0u;
+            mk_blob_entry be = { t | flags, (uint32_t)(l->entry_data[tl->cursor] / MK_ALIGN), l->entry_mask[tl->cursor] };
+            report->float_entries += flags && (l->plans[t].flags & MK_TARGET_QUANTIZED);
             entries[e++] = be;
             tl->cursor++;
         }
     }
     block_first[blocks] = (uint32_t)e;
     report->target_bytes += entry_count * sizeof(mk_blob_entry) + out->target_data_size;
+    report->entry_count += entry_count;
     for (uint32_t t = 0; t < target_count; t++) {
         const double *te = l->targets[t].error;
         if (te[0] > report->max_position_error) report->max_position_error = te[0];
         if (te[1] > report->max_normal_error) report->max_normal_error = te[1];
         if (te[2] > report->max_tangent_error) report->max_tangent_error = te[2];
     }
-    void *scratch[] = { l->targets, l->entry_block, l->entry_mask, l->entry_data };
+    void *scratch[] = { l->targets, l->entry_block, l->entry_mask, l->entry_data, l->entry_float };
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
     l->targets = NULL;
     return MK_OK;
@@ -438,7 +520,7 @@ static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, cons
                             mk_error *err)
 {
     mk_write_options opt = options ? *options : (mk_write_options){ 0 };
-    if (opt.dense_threshold == 0) opt.dense_threshold = 24;
+    if (opt.gap_limit == 0) opt.gap_limit = MK_DEFAULT_FILL_GAP + 1;
     if (opt.precision != MK_PRECISION_Q16 && opt.precision != MK_PRECISION_FLOAT)
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "write: unknown precision");
     if (!(opt.tolerance >= 0) || !isfinite(opt.tolerance))
@@ -525,7 +607,7 @@ static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, cons
         bm->target_count = t_index - bm->first_target;
         mk_phase_log_mark(opt.phases, "quantize");
         r = plan_mesh_data(raw, consume, mi, bm->first_channel, bm->channel_count, &plans[bm->first_target],
-                           opt.dense_threshold, opt.threads, arena, &data_size, &mesh_data[mi], err);
+                           opt.gap_limit - 1, opt.threads, arena, &data_size, &mesh_data[mi], err);
         mk_phase_log_mark(opt.phases, "lay out blocks");
         if (r) return r;
         bm->vertex_count = m->vertex_count;

@@ -432,19 +432,20 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
         uint64_t touched = 0;
         for (uint32_t e = block_first[b]; e < block_first[b + 1]; e++) {
             const mk_blob_entry *en = &entries[e];
-            const float c = f.coef[en->target];
+            const uint32_t ti = mk_entry_target(en);
+            const float c = f.coef[ti];
             if (c == 0.0f) continue;
-            const mk_blob_target *tg = &f.targets[en->target];
-            const int q = (tg->flags & MK_TARGET_QUANTIZED) != 0;
+            const mk_blob_target *tg = &f.targets[ti];
+            const int q = mk_entry_quantized(en);   /* per entry: a quantized target's outliers are float */
             const uint32_t moved = mk_popcount64(en->mask);
-            const size_t attribute_bytes = (size_t)mk_entry_data_size(tg->flags & MK_TARGET_QUANTIZED, moved);
+            const size_t attribute_bytes = (size_t)mk_entry_data_size(q ? MK_TARGET_QUANTIZED : 0u, moved);
             const uint8_t *p = data + (size_t)en->data * MK_ALIGN;
-            prefetch_ahead(p, (size_t)mk_entry_data_size(tg->flags, moved));
+            prefetch_ahead(p, (size_t)mk_entry_data_size(mk_entry_flags(tg->flags, en), moved));
             add_attribute(acc_p, en->mask, p, q, c * (q ? tg->position_scale : 1.0f));
             if (!want_normals && !want_tangents) continue;
             p += attribute_bytes;
             if (tg->flags & MK_TARGET_HAS_NORMALS) {
-                const int32_t sc = f.slerp_channel[en->target];
+                const int32_t sc = f.slerp_channel[ti];
                 if (sc < 0) {
                     if (want_normals) add_attribute(acc_n, en->mask, p, q, c * (q ? tg->normal_scale : 1.0f));
                 } else {
@@ -456,7 +457,7 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
                         open_channel = sc;
                         touched = 0;
                     }
-                    float *dst = (int32_t)en->target == f.spans[sc].target_a ? slerp_a : slerp_b;
+                    float *dst = (int32_t)ti == f.spans[sc].target_a ? slerp_a : slerp_b;
                     add_attribute(dst, en->mask, p, q, q ? tg->normal_scale : 1.0f);
                     touched |= en->mask;
                 }
@@ -532,8 +533,9 @@ uint64_t mk_eval_traffic(const mk_eval_job *job)
     uint64_t bytes = 4u * (uint64_t)(b1 - b0 + 1);                      /* block table */
     for (uint32_t e = block_first[b0]; e < block_first[b1]; e++) {
         bytes += sizeof(mk_blob_entry);                                 /* every header is read */
-        if (f.coef[entries[e].target] == 0.0f) continue;
-        uint32_t flags = f.targets[entries[e].target].flags & ~strip;
+        const uint32_t ti = mk_entry_target(&entries[e]);
+        if (f.coef[ti] == 0.0f) continue;
+        uint32_t flags = mk_entry_flags(f.targets[ti].flags, &entries[e]) & ~strip;
         bytes += mk_entry_data_size(flags, mk_popcount64(entries[e].mask));
     }
     /* Base arrays read and outputs written. */

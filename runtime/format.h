@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The .morph blob layout, version 2 (docs/format.md is the prose description).
+/* The .morph blob layout, version 3 (docs/format.md is the prose description).
  *
  * Little-endian. Every record and array starts at a multiple of 16 bytes from the blob start.
  * Offsets are absolute byte offsets from the blob start. Strings are offsets into the STRINGS
@@ -90,7 +90,7 @@ typedef struct mk_blob_channel {
 } mk_blob_channel;                 /* 32 bytes */
 
 enum {
-    MK_TARGET_QUANTIZED = 1u,      /* int16 components times the per-attribute scale */
+    MK_TARGET_QUANTIZED = 1u,      /* has int16 entries: components times the per-attribute scale */
     MK_TARGET_HAS_NORMALS = 2u,
     MK_TARGET_HAS_TANGENTS = 4u
 };
@@ -110,11 +110,17 @@ typedef struct mk_blob_target {
  * (mesh-local index), so a channel's targets are adjacent. The data holds m = popcount(mask)
  * xyz triples in mask-bit order, interleaved like the outputs: the position deltas
  * x0 y0 z0 x1 y1 z1 ..., then the normal deltas if the target has normals, then the tangent
- * deltas (xyz) if it has tangents; int16 for quantized targets, float otherwise. A run of
- * consecutive mask bits is one contiguous span of data and output. A block stored dense has
- * all its vertices' bits set. */
+ * deltas (xyz) if it has tangents; float32 when the entry has MK_ENTRY_FLOAT, else int16 times
+ * the target's scales (only a quantized target has int16 entries; a float target's entries all
+ * have the flag). A run of consecutive mask bits is one contiguous span of data and output. The
+ * mask may cover vertices the target does not move (their deltas are zeros). */
+#define MK_ENTRY_TARGET_MASK 0x00FFFFFFu   /* target_and_flags: the mesh-local target index */
+#define MK_MAX_MESH_TARGETS (MK_ENTRY_TARGET_MASK + 1u)   /* targets per mesh: 2^24 */
+#define MK_ENTRY_FLOAT 0x80000000u       /* target_and_flags: the entry's data is float32 */
+#define MK_ENTRY_FLAGS_KNOWN MK_ENTRY_FLOAT
+
 typedef struct mk_blob_entry {
-    uint32_t target;               /* mesh-local target index */
+    uint32_t target_and_flags;     /* mesh-local target index (low 24 bits) | MK_ENTRY_* */
     uint32_t data;                 /* offset from mesh.target_data, in 16-byte units */
     uint64_t mask;                 /* bit i: vertex block*64 + i has data */
 } mk_blob_entry;                   /* 16 bytes */
@@ -163,12 +169,23 @@ static inline unsigned mk_ctz64(uint64_t x)
 /* 64-bit checksum (documented in docs/format.md). */
 uint64_t mk_checksum(const void *data, uint64_t size);
 
-/* Bytes of one entry's data: m values per component, 3 components per attribute. */
-static inline uint64_t mk_entry_data_size(uint32_t target_flags, uint32_t m)
+static inline uint32_t mk_entry_target(const mk_blob_entry *e) { return e->target_and_flags & MK_ENTRY_TARGET_MASK; }
+static inline int mk_entry_quantized(const mk_blob_entry *e) { return (e->target_and_flags & MK_ENTRY_FLOAT) == 0; }
+
+/* The flags that size an entry's data: its target's attributes, MK_TARGET_QUANTIZED when the
+ * entry holds int16. */
+static inline uint32_t mk_entry_flags(uint32_t target_flags, const mk_blob_entry *e)
 {
-    uint64_t elem = (target_flags & MK_TARGET_QUANTIZED) ? 2u : 4u;
-    uint64_t attributes = 1u + ((target_flags & MK_TARGET_HAS_NORMALS) ? 1u : 0u)
-                        + ((target_flags & MK_TARGET_HAS_TANGENTS) ? 1u : 0u);
+    return (target_flags & ~(uint32_t)MK_TARGET_QUANTIZED) | (mk_entry_quantized(e) ? (uint32_t)MK_TARGET_QUANTIZED : 0u);
+}
+
+/* Bytes of one entry's data: m values per component, 3 components per attribute; flags as
+ * mk_entry_flags gives them (MK_TARGET_QUANTIZED: int16, else float32). */
+static inline uint64_t mk_entry_data_size(uint32_t flags, uint32_t m)
+{
+    uint64_t elem = (flags & MK_TARGET_QUANTIZED) ? 2u : 4u;
+    uint64_t attributes = 1u + ((flags & MK_TARGET_HAS_NORMALS) ? 1u : 0u)
+                        + ((flags & MK_TARGET_HAS_TANGENTS) ? 1u : 0u);
     return attributes * 3u * elem * m;
 }
 

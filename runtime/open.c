@@ -282,6 +282,9 @@ static mk_result validate_meshes(validator *v, const mk_asset *a)
         if (FAILS("mesh.first_target", m->first_target != next_target))
             return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": first target ", m->first_target,
                          " does not follow the previous mesh's targets (expected ", next_target, ")");
+        if (FAILS("mesh.target_count_max", m->target_count > MK_MAX_MESH_TARGETS))   /* an entry holds 24 bits */
+            return fail2(v->err, MK_ERROR_UNSUPPORTED, at, "mesh ", i, ": has ", m->target_count,
+                         " targets, more than a mesh may have (2^24)");
         if (FAILS("mesh.target_count", m->target_count > a->target_count - next_target))
             return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", i, ": its ", m->target_count,
                          " targets run past the end of the target table (", a->target_count, " targets)");
@@ -466,25 +469,32 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
         for (uint32_t e = first[b]; e < first[b + 1]; e++) {
             const mk_blob_entry *en = &entries[e];
             uint64_t at = m->entries + (uint64_t)e * sizeof(mk_blob_entry);
-            if (FAILS("entry.target", en->target >= m->target_count))
-                return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": target index ", en->target,
+            const uint32_t target = mk_entry_target(en);
+            if (FAILS("entry.flags", (en->target_and_flags & ~(MK_ENTRY_TARGET_MASK | MK_ENTRY_FLAGS_KNOWN)) != 0))
+                return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": unknown flag bits ",
+                             en->target_and_flags & ~(MK_ENTRY_TARGET_MASK | MK_ENTRY_FLAGS_KNOWN), "");
+            if (FAILS("entry.target", target >= m->target_count))
+                return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": target index ", target,
                              " is out of range");
-            if (FAILS("entry.order", e > first[b] && en->target <= entries[e - 1].target))
-                return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": target ", en->target,
+            if (FAILS("entry.order", e > first[b] && target <= mk_entry_target(&entries[e - 1])))
+                return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": target ", target,
                              " repeats or precedes the previous entry's (a block's targets strictly increase)");
             if (FAILS("entry.mask_empty", en->mask == 0))
                 return fail2(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": vertex mask is empty");
             if (FAILS("entry.mask_past_end", (en->mask & ~allowed) != 0))
                 return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": vertex mask has bits past the mesh's last vertex (block ",
                              b, ")");
-            const mk_blob_target *tg = &a->targets[m->first_target + en->target];
+            const mk_blob_target *tg = &a->targets[m->first_target + target];
+            if (FAILS("entry.precision", mk_entry_quantized(en) && !(tg->flags & MK_TARGET_QUANTIZED)))
+                return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": int16 data for float target ", target,
+                             "");
             uint32_t count = mk_popcount64(en->mask);
-            uint64_t bytes = mk_entry_data_size(tg->flags, count);
+            uint64_t bytes = mk_entry_data_size(mk_entry_flags(tg->flags, en), count);
             uint64_t offset = (uint64_t)en->data * MK_ALIGN;
             if (FAILS("entry.data", offset > m->target_data_size || bytes > m->target_data_size - offset))
                 return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": its ", bytes,
                              " bytes of data run past the mesh's target data");
-            uint64_t bad = (tg->flags & MK_TARGET_QUANTIZED) ? bytes / 4
+            uint64_t bad = mk_entry_quantized(en) ? bytes / 4
                          : first_not_finite((const float *)(v->data + m->target_data + offset), bytes / 4);
             if (FAILS("entry.data_finite", bad < bytes / 4))
                 return fail3(v->err, MK_ERROR_NOT_FINITE, m->target_data + offset + 4 * bad, "mesh ", mi, " entry ", e,
@@ -654,6 +664,10 @@ int mk_mesh_get(const mk_asset *a, uint32_t mesh, mk_mesh_info *out)
     out->target_count = m->target_count;
     out->target_bytes = m->target_data_size;
     out->entry_count = m->entry_count;
+    const mk_blob_entry *entries = (const mk_blob_entry *)(a->data + m->entries);
+    for (uint64_t e = 0; e < m->entry_count; e++)
+        out->float_entries += !mk_entry_quantized(&entries[e])
+                           && (a->targets[m->first_target + mk_entry_target(&entries[e])].flags & MK_TARGET_QUANTIZED);
     out->stacking = (mk_stacking)m->stacking;
     out->has_normals = (m->flags & MK_MESH_HAS_NORMALS) != 0;
     out->has_tangents = (m->flags & MK_MESH_HAS_TANGENTS) != 0;

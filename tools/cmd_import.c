@@ -23,8 +23,9 @@ static const cli_option options[] = {
       "one (which this option replaces).",
       NULL, "additive|sequential", 0, 0, 0, offsetof(import_args, stacking_given) },
     { "--precision", "P", CLI_CHOICE, offsetof(import_args, precision),
-      "How deltas are stored: q16 (int16 with a per-target scale; a target that would exceed --tolerance falls back to "
-      "float) or float (lossless float32).",
+      "How deltas are stored: q16 (int16 with a per-target scale; the 64-vertex blocks whose deltas would exceed "
+      "--tolerance with int16 are stored as float32, and the scale comes from the others) or float (lossless "
+      "float32).",
       "q16", "q16|float", 0, 0, 0, 0 },
     { "--target-normals", "HOW", CLI_CHOICE, offsetof(import_args, target_normals),
       "The targets' normal deltas: auto (the file's own; FBX also computes them where the file has none) or none "
@@ -33,7 +34,8 @@ static const cli_option options[] = {
       "are kept.",
       "auto", "auto|none", 0, 0, 0, 0 },
     { "--tolerance", "D", CLI_NUMBER, offsetof(import_args, tolerance),
-      "Largest quantization error of a position, in mesh units. Default: 1e-4 x each mesh's bounding-box diagonal.",
+      "Largest quantization error of a position, in mesh units (q16: blocks that would exceed it are float32). "
+      "Default: 1e-4 x each mesh's bounding-box diagonal.",
       NULL, NULL, 1e-30, 1e30, 0, 0 },
     { "--channels", "SIDECAR.json", CLI_STRING, offsetof(import_args, channels),
       "glTF input only: a channel sidecar (written by 'morphkit export') that groups targets into progressive "
@@ -141,8 +143,9 @@ static int run_import(void *p)
         printf("%s -> %s: %u meshes, %u channels, %u targets, %u clips, %zu bytes, %u warning%s\n", a->input, a->output,
                raw.mesh_count, raw.channel_count, targets, raw.clip_count, size, raw.warning_count,
                raw.warning_count == 1 ? "" : "s");
-        printf("precision: %u int16 targets, %u float targets; max position quantization error %.3g (tolerance %.3g)\n",
-               report.quantized_targets, report.float_targets, report.max_position_error, report.tolerance_used);
+        printf("precision: %u int16 targets (%llu of %llu blocks float), %u float targets; max position quantization error "
+               "%.3g (tolerance %.3g)\n", report.quantized_targets, (unsigned long long)report.float_entries,
+               (unsigned long long)report.entry_count, report.float_targets, report.max_position_error, report.tolerance_used);
         if (report.max_normal_error > 0 || report.max_tangent_error > 0)
             printf("max normal quantization error %.3g, tangent %.3g\n", report.max_normal_error,
                    report.max_tangent_error);

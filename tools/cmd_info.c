@@ -14,8 +14,9 @@ static void print_text(FILE *f, const pb_asset *l, const char *path)
 {
     const mk_asset *a = &l->asset;
     uint32_t nq, nf;
+    uint64_t fe;
     double bound;
-    cli_precision_of(a, &nq, &nf, &bound);
+    cli_precision_of(a, &nq, &nf, &fe, &bound);
     fprintf(f, "%s: %zu bytes, format v%u\n", path, l->blob_size, MK_FORMAT_VERSION);
     if (l->imported) {
         fprintf(f, "source: %s%s%s\n", l->raw.source_format[0] ? l->raw.source_format : "?",
@@ -24,8 +25,8 @@ static void print_text(FILE *f, const pb_asset *l, const char *path)
         if (l->raw.up_axis >= 0) fprintf(f, "up axis: %c\n", "XYZ"[l->raw.up_axis % 3]);
         fprintf(f, "import warnings: %u\n", l->raw.warning_count);
     }
-    fprintf(f, "precision: %u quantized (int16) targets, %u float targets; max quantization error <= %.3g\n", nq, nf,
-            bound);
+    fprintf(f, "precision: %u quantized (int16) targets (%llu float blocks), %u float targets; max quantization error <= %.3g\n",
+            nq, (unsigned long long)fe, nf, bound);
     for (uint32_t i = 0; i < a->mesh_count; i++) {
         mk_mesh_info m;
         mk_mesh_get(a, i, &m);
@@ -34,8 +35,8 @@ static void print_text(FILE *f, const pb_asset *l, const char *path)
                 m.has_tangents ? "tangents, " : "", m.stacking == MK_STACKING_SEQUENTIAL ? "sequential" : "additive");
         if (m.gltf_node >= 0)
             fprintf(f, ", glTF node %d mesh %d primitive %d", m.gltf_node, m.gltf_mesh, m.gltf_primitive);
-        fprintf(f, "\n  target data: %llu bytes in %llu block entries\n", (unsigned long long)m.target_bytes,
-                (unsigned long long)m.entry_count);
+        fprintf(f, "\n  target data: %llu bytes in %llu block entries (%llu float in quantized targets)\n",
+                (unsigned long long)m.target_bytes, (unsigned long long)m.entry_count, (unsigned long long)m.float_entries);
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
             mk_channel_info ch;
             mk_channel_get(a, c, &ch);
@@ -63,8 +64,9 @@ static void print_json(FILE *f, const pb_asset *l, const char *path)
 {
     const mk_asset *a = &l->asset;
     uint32_t nq, nf;
+    uint64_t fe;
     double bound;
-    cli_precision_of(a, &nq, &nf, &bound);
+    cli_precision_of(a, &nq, &nf, &fe, &bound);
     json_writer w;
     json_begin(&w, f, 1);
     json_object(&w, NULL);
@@ -80,6 +82,7 @@ static void print_json(FILE *f, const pb_asset *l, const char *path)
     }
     json_int(&w, "quantized_targets", nq);
     json_int(&w, "float_targets", nf);
+    json_int(&w, "float_entries", (long long)fe);
     json_number(&w, "max_quantization_error", bound);
     json_array(&w, "meshes");
     for (uint32_t i = 0; i < a->mesh_count; i++) {
@@ -90,6 +93,7 @@ static void print_json(FILE *f, const pb_asset *l, const char *path)
         json_bool(&w, "tangents", m.has_tangents);
         json_string(&w, "stacking", m.stacking == MK_STACKING_SEQUENTIAL ? "sequential" : "additive");
         json_int(&w, "target_bytes", (long long)m.target_bytes);
+        json_int(&w, "float_entries", (long long)m.float_entries);
         json_array(&w, "channels");
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
             mk_channel_info ch;

@@ -35,7 +35,7 @@ extern "C" {
 #define MK_VERSION_STRING "0.2.0"
 
 /* The version of the blob format this runtime reads and the tools write. */
-#define MK_FORMAT_VERSION 2u
+#define MK_FORMAT_VERSION 3u
 
 /* Consecutive key points of a channel (its full weights and the implicit 0) are at least this
  * far apart, so span parameters stay finite (docs/semantics.md). */
@@ -148,6 +148,7 @@ typedef struct mk_mesh_info {
     uint32_t target_count;        /* targets of all the mesh's channels */
     uint64_t target_bytes;        /* bytes of the mesh's block data (entry headers + deltas) */
     uint64_t entry_count;         /* block entries: (target, 64-vertex block) pairs with data */
+    uint64_t float_entries;       /* entries of quantized targets stored as float32 (outliers) */
     mk_stacking stacking;         /* stored stacking: additive or sequential */
     int has_normals, has_tangents;
     int32_t gltf_node, gltf_mesh, gltf_primitive; /* -1 when not from glTF */
@@ -172,7 +173,7 @@ typedef struct mk_target_info {
     float full_weight;            /* normalized (FBX FullWeights / 100) */
     uint32_t channel;
     uint32_t moved_vertices;      /* vertices with stored data */
-    int quantized;                /* int16 with per-target scale, else float32 */
+    int quantized;                /* int16 with per-target scale (outlier blocks float32), else float32 */
     int has_normals, has_tangents;
     float position_scale;         /* quantization step of positions (0 for float) */
 } mk_target_info;

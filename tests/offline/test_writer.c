@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Offline core: deterministic writer, raw -> blob -> raw round trip, quantization within the
- * tolerance (with float fallback), raw validation errors, failing allocation K for every K,
+ * tolerance (outlier blocks stored as float), raw validation errors, failing allocation K for every K,
  * atomic file writes. */
 
 #include <stdlib.h>
@@ -22,7 +22,10 @@ static void test_deterministic(void)
             mk_write_report report[5];
             for (int k = 0; k < 5; k++) {
                 mk_raw_init(&raw[k], NULL);
-                if (fixture == 0) fixture_line(&raw[k], 700, 9, 2);
+                if (fixture == 0) {
+                    fixture_line(&raw[k], 700, 9, 2);
+                    raw[k].channels[4].targets[0].positions[3 * 100] = 1e4f;   /* an outlier block: float */
+                }
                 else if (fixture == 1) fixture_rich(&raw[k]);
                 else fixture_wavy_grid(&raw[k], 40, 17);
                 mk_write_options wo = { .precision = (mk_precision)p, .threads = k == 2 || k == 4 ? 5u : 1u };
@@ -38,6 +41,7 @@ static void test_deterministic(void)
                         CHECK(tg->count == 0 && !tg->indices && !tg->positions && !tg->normals && !tg->tangents);
                     }
             }
+            if (fixture == 0 && p == MK_PRECISION_Q16) CHECK_EQ_INT(report[0].float_entries, 1);
             for (int k = 1; k < 5; k++) {
                 CHECK_MSG(size[0] == size[k] && memcmp(blob[0], blob[k], size[0]) == 0,
                           "fixture %d, precision %d: run %d (%s) differs", fixture, p, k, runs[k]);
@@ -78,7 +82,8 @@ static void test_quantization_tolerance(void)
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     fixture_line(&raw, 300, 4, 1);
-    /* One target with a huge range next to tiny deltas: int16 error = range / 65534. */
+    /* One target with a huge delta next to tiny ones: int16 error = range / 65534, so its block
+     * (block 0 of 5) is stored as float and the rest of the target as int16. */
     raw.channels[3].targets[0].positions[1] = 1000.0f;
     mk_write_options o = { .precision = MK_PRECISION_Q16, .tolerance = 0.001f };
     void *blob;
@@ -86,8 +91,9 @@ static void test_quantization_tolerance(void)
     mk_write_report rep;
     mk_error err;
     CHECK(mk_write_blob(&raw, &o, &raw.arena, &blob, &size, &rep, &err) == MK_OK);
-    CHECK_EQ_INT(rep.float_targets, 1);        /* 1000 / 65534 > 0.001: stored as float */
-    CHECK_EQ_INT(rep.quantized_targets, 3);
+    CHECK_EQ_INT(rep.float_targets, 0);
+    CHECK_EQ_INT(rep.float_entries, 1);        /* 1000 / 65534 > 0.001: that block is float */
+    CHECK_EQ_INT(rep.quantized_targets, 4);
     CHECK(rep.max_position_error <= 0.001);
     /* Read back: every delta within the reported error. */
     mk_asset a;
@@ -110,13 +116,13 @@ static void test_quantization_tolerance(void)
         }
     }
     CHECK_MSG(worst <= rep.max_position_error + 1e-9, "worst %g > reported %g", worst, rep.max_position_error);
-    /* A tolerance below the worst quantized target's error: that target (at least) is stored as
-     * float now, and every target still quantized errs by no more than the tolerance. */
+    /* A tolerance below the worst int16 error: more blocks (at least the worst one's) are stored
+     * as float now, and every int16 value errs by no more than the tolerance. */
     const double before = rep.max_position_error;
     o.tolerance = (float)(0.75 * before);
     CHECK(before > 0 && mk_write_blob(&raw, &o, &raw.arena, &blob, &size, &rep, &err) == MK_OK);
-    CHECK_MSG(rep.float_targets >= 2, "tolerance %g below the worst error %g: %u float targets", (double)o.tolerance,
-              before, rep.float_targets);
+    CHECK_MSG(rep.float_entries + rep.float_targets >= 2, "tolerance %g below the worst error %g: %llu float blocks, %u float targets",
+              (double)o.tolerance, before, (unsigned long long)rep.float_entries, rep.float_targets);
     CHECK_MSG(rep.max_position_error <= o.tolerance, "a quantized target errs by %g, over the tolerance %g",
               rep.max_position_error, (double)o.tolerance);
     mk_raw_free(&back);

@@ -130,17 +130,23 @@ typedef struct loaded {
     size_t scratch_size;
 } loaded;
 
-static void load(loaded *l, mk_precision precision)
+/* gap_limit: the writer's mask rule (0 = default; 1 stores exactly the moved vertices, so
+ * target 3's every other vertex is 32 one-vertex runs). */
+static void load_gap(loaded *l, mk_precision precision, uint32_t gap_limit)
 {
     build(&l->raw);
     mk_arena_init(&l->arena, NULL);
     size_t size;
-    void *blob = fixture_blob(&l->raw, precision, &l->arena, &size);
+    void *blob;
     mk_error err;
+    mk_write_options o = { .precision = precision, .gap_limit = gap_limit };
+    CHECK_MSG(mk_write_blob(&l->raw, &o, &l->arena, &blob, &size, NULL, &err) == MK_OK, "write: %s", err.message);
     CHECK_MSG(mk_asset_open(blob, size, &l->asset, &err) == MK_OK, "open: %s", err.message);
     l->scratch_size = mk_eval_scratch_size(&l->asset, 0);
     l->scratch = aligned_alloc(16, (l->scratch_size + 15) & ~(size_t)15);
 }
+
+static void load(loaded *l, mk_precision precision) { load_gap(l, precision, 0); }
 
 static void unload(loaded *l)
 {
@@ -151,10 +157,10 @@ static void unload(loaded *l)
 
 /* tolerance: float storage is exact up to rounding; int16 errs by max|delta| / 65534 per
  * target (deltas here are below 0.2, 24 targets with |w| <= 1), before renormalization. */
-static void masks_match_reference(mk_precision precision, double tolerance)
+static void masks_match_reference(mk_precision precision, double tolerance, uint32_t gap_limit)
 {
     loaded l;
-    load(&l, precision);
+    load_gap(&l, precision, gap_limit);
     /* The hand-picked masks really are stored as intended: block 1 of target 1 masked, with 21
      * moved vertices in three runs; block 0 of target 0 full. */
     const mk_blob_mesh *bm = &l.asset.meshes[0];
@@ -162,9 +168,9 @@ static void masks_match_reference(mk_precision precision, double tolerance)
     const mk_blob_entry *entries = (const mk_blob_entry *)(l.asset.data + bm->entries);
     int seen_runs = 0, seen_full = 0;
     for (uint32_t e = first[1]; e < first[2]; e++)
-        if (entries[e].target == 1) seen_runs = mk_popcount64(entries[e].mask) == 21;
+        if (mk_entry_target(&entries[e]) == 1) seen_runs = mk_popcount64(entries[e].mask) == 21;
     for (uint32_t e = first[0]; e < first[1]; e++)
-        if (entries[e].target == 0) seen_full = entries[e].mask == ~0ull;
+        if (mk_entry_target(&entries[e]) == 0) seen_full = entries[e].mask == ~0ull;
     CHECK(seen_runs && seen_full);
 
     float w[TARGETS], p[3 * VERTICES], n[3 * VERTICES], t[4 * VERTICES];
@@ -191,8 +197,16 @@ static void masks_match_reference(mk_precision precision, double tolerance)
     unload(&l);
 }
 
-static void test_masks_match_reference_float(void) { masks_match_reference(MK_PRECISION_FLOAT, 1e-5); }
-static void test_masks_match_reference_q16(void) { masks_match_reference(MK_PRECISION_Q16, 1e-4); }
+static void test_masks_match_reference_float(void)
+{
+    masks_match_reference(MK_PRECISION_FLOAT, 1e-5, 0);
+    masks_match_reference(MK_PRECISION_FLOAT, 1e-5, 1);
+}
+static void test_masks_match_reference_q16(void)
+{
+    masks_match_reference(MK_PRECISION_Q16, 1e-4, 0);
+    masks_match_reference(MK_PRECISION_Q16, 1e-4, 1);
+}
 
 /* Evaluates [first, first + count) into out (+ offset bytes) with the given store mode. */
 static void eval_range(loaded *l, const float *w, mk_store_mode mode, uint32_t first, uint32_t count, size_t stride,

@@ -154,6 +154,7 @@ PATCH(size_0) { c->size = 0; }
 PATCH(magic) { c->b[0] = 'X'; }
 PATCH(magic_last_byte) { c->b[7] = 'k'; }
 PATCH(version_next) { header(c)->version = MK_FORMAT_VERSION + 1; }
+PATCH(version_2) { header(c)->version = 2; }
 PATCH(version_1) { header(c)->version = 1; }
 PATCH(header_size) { header(c)->header_size = 72; }
 PATCH(header_flags) { header(c)->flags = 1; }
@@ -224,6 +225,7 @@ PATCH(mesh_channel_count) { mesh(c, 2)->channel_count = 5; }
 PATCH(mesh_channel_count_huge) { mesh(c, 3)->channel_count = UINT32_MAX; }
 PATCH(mesh_first_target) { mesh(c, 2)->first_target = 3; }
 PATCH(mesh_target_count) { mesh(c, 3)->target_count = 2; }
+PATCH(mesh_target_count_max) { mesh(c, 3)->target_count = MK_MAX_MESH_TARGETS + 1; }
 PATCH(mesh_stacking_0) { mesh(c, 0)->stacking = 0; }
 PATCH(mesh_stacking_3) { mesh(c, 2)->stacking = 3; }
 PATCH(mesh_flags) { mesh(c, 1)->flags |= 4; }
@@ -312,10 +314,13 @@ PATCH(block_table_last_huge) { block_table(c, 0)[1] = 0xFFFFFFFFu; }
 PATCH(entry_count_more) { mesh(c, 2)->entry_count++; }
 PATCH(block_table_order) { block_table(c, 2)[1] = 1000000; }
 PATCH(block_table_order_dip) { block_table(c, 2)[2] = block_table(c, 2)[1] - 1; }
-PATCH(entry_target) { entry(c, 0, 3)->target = 4; }
-PATCH(entry_target_huge) { entry(c, 3, 0)->target = 0x7FFFFFF0u; }
-PATCH(entry_duplicate) { entry(c, 0, 1)->target = entry(c, 0, 0)->target; }
-PATCH(entry_misordered) { entry(c, 2, 2)->target = 0; }
+PATCH(entry_target) { entry(c, 0, 3)->target_and_flags = 4 | MK_ENTRY_FLOAT; }
+PATCH(entry_target_huge) { entry(c, 3, 0)->target_and_flags = MK_ENTRY_TARGET_MASK - 15; }
+PATCH(entry_flags) { entry(c, 0, 1)->target_and_flags |= 1u << 24; }
+PATCH(entry_flags_top) { entry(c, 2, 3)->target_and_flags |= 0x40000000u; }
+PATCH(entry_int16_of_float_target) { entry(c, 2, 4)->target_and_flags &= ~MK_ENTRY_FLOAT; }
+PATCH(entry_duplicate) { entry(c, 0, 1)->target_and_flags = entry(c, 0, 0)->target_and_flags; }
+PATCH(entry_misordered) { entry(c, 2, 2)->target_and_flags = 0; }
 PATCH(entry_mask_empty) { entry(c, 2, 5)->mask = 0; }
 PATCH(entry_mask_past_end_small) { entry(c, 0, 2)->mask |= 1ull << 4; }
 PATCH(entry_mask_past_end_block) { entry(c, 2, mesh(c, 2)->entry_count - 1)->mask |= 1ull << 22; }
@@ -325,6 +330,15 @@ PATCH(entry_data_nan)
 {
     mk_blob_entry *e = entry(c, 2, dense_entry(c, 2));
     floats_at(c, mesh(c, 2)->target_data + 16ull * e->data)[100] = NAN;
+}
+/* A quantized blob's last entry flagged float: twice the bytes, past the target data. */
+PATCH(entry_float_last) { entry(c, last_mesh(c), entry_with_last_data(c, last_mesh(c)))->target_and_flags |= MK_ENTRY_FLOAT; }
+/* A quantized target's dense entry flagged float, with a NaN among its (now float) deltas. */
+PATCH(entry_float_nan)
+{
+    mk_blob_entry *e = entry(c, 2, dense_entry(c, 2));
+    e->target_and_flags |= MK_ENTRY_FLOAT;
+    floats_at(c, mesh(c, 2)->target_data + 16ull * e->data)[7] = NAN;
 }
 PATCH(entry_normal_delta_inf)
 {
@@ -388,7 +402,8 @@ static const corruption corruptions[] = {
     { "header.truncated", size_0, "0 bytes", MK_ERROR_TRUNCATED, "blob of 0 bytes is shorter", 0 },
     { "header.magic", magic, "magic XORPHKIT", MK_ERROR_BAD_MAGIC, "magic is not MORPHKIT", 0 },
     { "header.magic", magic_last_byte, "magic MORPHKIt", MK_ERROR_BAD_MAGIC, "magic is not MORPHKIT", 0 },
-    { "header.version", version_next, "next version", MK_ERROR_BAD_VERSION, "version 3 is not supported; this runtime reads version 2 (byte offset 8)", 0 },
+    { "header.version", version_next, "next version", MK_ERROR_BAD_VERSION, "version 4 is not supported; this runtime reads version 3 (byte offset 8)", 0 },
+    { "header.version", version_2, "version 2 (no entry flags)", MK_ERROR_BAD_VERSION, "version 2 is not supported; this runtime reads version 3 (byte offset 8)", 0 },
     { "header.version", version_1, "version 1", MK_ERROR_BAD_VERSION, "blob format version 1 is not supported", 0 },
     { "header.size", header_size, "header size 72", MK_ERROR_CORRUPT, "header size 72 is not 64", 0 },
     { "header.flags", header_flags, "header flags 1", MK_ERROR_CORRUPT, "header flags (1) are not zero", 0 },
@@ -435,6 +450,7 @@ static const corruption corruptions[] = {
     { "mesh.channel_count", mesh_channel_count, "mesh 2 has 5 channels", MK_ERROR_CORRUPT, "mesh 2: its 5 channels run past the end of the channel table (6 channels)", 0 },
     { "mesh.channel_count", mesh_channel_count_huge, "mesh 3 has 2^32 - 1 channels", MK_ERROR_CORRUPT, "mesh 3: its 4294967295 channels run past", 0 },
     { "mesh.first_target", mesh_first_target, "mesh 2 starts at target 3", MK_ERROR_CORRUPT, "mesh 2: first target 3 does not follow the previous mesh's targets (expected 4)", 0 },
+    { "mesh.target_count_max", mesh_target_count_max, "2^24 + 1 targets", MK_ERROR_UNSUPPORTED, "mesh 3: has 16777217 targets, more than a mesh may have (2^24)", 0 },
     { "mesh.target_count", mesh_target_count, "mesh 3 has 2 targets", MK_ERROR_CORRUPT, "mesh 3: its 2 targets run past the end of the target table (9 targets)", 0 },
     { "mesh.stacking", mesh_stacking_0, "stacking 0", MK_ERROR_CORRUPT, "mesh 0: unknown stacking mode 0", 0 },
     { "mesh.stacking", mesh_stacking_3, "stacking 3", MK_ERROR_CORRUPT, "mesh 2: unknown stacking mode 3", 0 },
@@ -516,7 +532,11 @@ static const corruption corruptions[] = {
     { "block_table.order", block_table_order, "block 1 starts at 10^6", MK_ERROR_CORRUPT, "mesh 2: block table decreases at block 2", 0 },
     { "block_table.order", block_table_order_dip, "block 2 starts before block 1", MK_ERROR_CORRUPT, "mesh 2: block table decreases at block 2", 0 },
     { "entry.target", entry_target, "target 4 of 4", MK_ERROR_CORRUPT, "mesh 0 entry 3: target index 4 is out of range", 0 },
-    { "entry.target", entry_target_huge, "target 2^31 - 16", MK_ERROR_CORRUPT, "mesh 3 entry 0: target index 2147483632 is out of range", 0 },
+    { "entry.target", entry_target_huge, "target 2^24 - 16", MK_ERROR_CORRUPT, "mesh 3 entry 0: target index 16777200 is out of range", 0 },
+    { "entry.target", entry_target_huge, "quantized: target 2^24 - 16", MK_ERROR_CORRUPT, "mesh 3 entry 0: target index 16777200 is out of range", Q16 },
+    { "entry.flags", entry_flags, "flag bit 24", MK_ERROR_CORRUPT, "mesh 0 entry 1: unknown flag bits 16777216", 0 },
+    { "entry.flags", entry_flags_top, "quantized: flag bit 30", MK_ERROR_CORRUPT, "mesh 2 entry 3: unknown flag bits 1073741824", Q16 },
+    { "entry.precision", entry_int16_of_float_target, "a float target's entry without the float flag", MK_ERROR_CORRUPT, "mesh 2 entry 4: int16 data for float target", 0 },
     { "entry.order", entry_duplicate, "two entries for target 0 in block 0", MK_ERROR_CORRUPT, "mesh 0 entry 1: target 0 repeats or precedes the previous entry's", 0 },
     { "entry.order", entry_misordered, "target 0 after target 1", MK_ERROR_CORRUPT, "mesh 2 entry 2: target 0 repeats or precedes", 0 },
     { "entry.mask_empty", entry_mask_empty, "mask 0", MK_ERROR_CORRUPT, "mesh 2 entry 5: vertex mask is empty", 0 },
@@ -526,6 +546,8 @@ static const corruption corruptions[] = {
     { "entry.data", entry_data_straddles, "quantized: the last data over the end", MK_ERROR_CORRUPT, "bytes of data run past the mesh's target data", Q16 },
     { "entry.data", entry_data_far, "data at 64 GiB", MK_ERROR_CORRUPT, "mesh 2 entry 0: its 1536 bytes of data run past", 0 },
     { "entry.data_finite", entry_data_nan, "a dense position delta NaN", MK_ERROR_NOT_FINITE, "mesh 2 entry 0: delta value 100 is not finite", 0 },
+    { "entry.data", entry_float_last, "quantized: the last entry flagged float", MK_ERROR_CORRUPT, "bytes of data run past the mesh's target data", Q16 },
+    { "entry.data_finite", entry_float_nan, "quantized: a float-flagged entry's delta NaN", MK_ERROR_NOT_FINITE, "mesh 2 entry 0: delta value 7 is not finite", Q16 },
     { "entry.data_finite", entry_normal_delta_inf, "a normal delta inf", MK_ERROR_NOT_FINITE, "mesh 0 entry 2: delta value 13 is not finite", 0 },
 
     { "clip.name", clip_name, "name = string section size", MK_ERROR_CORRUPT, "clip 1: name string offset", 0 },
@@ -876,13 +898,16 @@ static void test_fixture_has_every_structure(void)
         CHECK_EQ_INT(a.meshes[2].entry_count, 11);
         CHECK_EQ_INT(a.targets[2].flags & ~(uint32_t)MK_TARGET_QUANTIZED, MK_TARGET_HAS_NORMALS | MK_TARGET_HAS_TANGENTS);
         CHECK(a.targets[0].full_weight < 0);
-        int dense = 0, sparse = 0, quantized = 0;
+        int dense = 0, sparse = 0, quantized = 0, float_entries = 0, entries = 0;
         for (uint32_t m = 0; m < a.mesh_count; m++)
             for (uint64_t e = 0; e < a.meshes[m].entry_count; e++) {
                 const mk_blob_entry *en = (const mk_blob_entry *)(a.data + a.meshes[m].entries) + e;
                 dense += en->mask == ~0ull;
                 sparse += mk_popcount64(en->mask) < 8;
+                float_entries += !mk_entry_quantized(en);
+                entries++;
             }
+        CHECK(p ? float_entries == 0 : float_entries == entries);   /* a float blob's entries all say so */
         for (uint32_t t = 0; t < a.target_count; t++) quantized += (a.targets[t].flags & MK_TARGET_QUANTIZED) != 0;
         CHECK(dense >= 2);
         CHECK(sparse >= 4);

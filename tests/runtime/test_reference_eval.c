@@ -251,11 +251,12 @@ static int run_case(uint64_t seed, int verbose, totals *tot)
     random_asset(&r, &raw);
     const mk_raw_mesh *m = &raw.meshes[0];
     const uint32_t n = m->vertex_count;
-    static const uint32_t dense[] = { 0, 1, 8, 64 };
-    const uint32_t dense_threshold = dense[below(&r, 4)];
+    /* The writer's mask rule: the default (0), exact masks (1), whole blocks (65), or any. */
+    static const uint32_t limits[] = { 0, 1, 2, 5, 9, 65 };
+    const uint32_t pick = below(&r, 7), gap_limit = pick < 6 ? limits[pick] : below(&r, 66);
 
-    /* The two blobs. q16 sometimes with the default tolerance (targets that would err too
-     * much stay float), else one that quantizes every target. */
+    /* The two blobs. q16 sometimes with the default tolerance (entries that would err too
+     * much are float), else one that quantizes every target. */
     mk_arena arena;
     mk_arena_init(&arena, NULL);
     mk_asset assets[2];
@@ -264,7 +265,7 @@ static int run_case(uint64_t seed, int verbose, totals *tot)
     int failed = 0;
     for (int q = 0; q < 2; q++) {
         mk_write_options o = { .precision = q ? MK_PRECISION_Q16 : MK_PRECISION_FLOAT,
-                               .tolerance = q && chance(&r, 0.7) ? 1e3f : 0.0f, .dense_threshold = dense_threshold };
+                               .tolerance = q && chance(&r, 0.7) ? 1e3f : 0.0f, .gap_limit = gap_limit };
         void *blob;
         size_t size;
         mk_write_report report;

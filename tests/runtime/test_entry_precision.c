@@ -1,0 +1,194 @@
+/* SPDX-License-Identifier: MIT */
+/* The writer's per-entry choices and what the runtime makes of them: a quantized target with
+ * one outlier block stores that block's entry as float32 and the others as int16, its scales
+ * taken from the int16 entries; evaluation and read-back stay within the tolerance. And the
+ * mask rule (mk_block_mask): which vertices an entry stores. */
+#include <math.h>
+#include <stdlib.h>
+#include "block_mask.h"
+#include "check.h"
+#include "fixtures.h"
+#include "format.h"
+
+#define VERTICES 300u
+#define OUTLIER 70u                /* vertex in block 1 */
+#define TOLERANCE 0.001f
+
+static void write_open(const mk_raw_asset *raw, const mk_write_options *o, mk_arena *arena, mk_asset *a,
+                       mk_write_report *rep)
+{
+    void *blob;
+    size_t size;
+    mk_error err;
+    CHECK_MSG(mk_write_blob(raw, o, arena, &blob, &size, rep, &err) == MK_OK, "write: %s", err.message);
+    CHECK_MSG(mk_asset_open(blob, size, a, &err) == MK_OK, "open: %s", err.message);
+}
+
+static void test_outlier_block_is_float(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_line(&raw, VERTICES, 4, 1);   /* every target moves all 300 vertices: 5 blocks */
+    mk_raw_target *t3 = &raw.channels[3].targets[0];
+    t3->positions[3 * OUTLIER + 1] = 1000.0f;   /* needs a step of 1000 / 32767: far over the tolerance */
+    /* The scale the int16 entries should get: from every block but the outlier's. */
+    float others = 0;
+    for (uint32_t j = 0; j < t3->count; j++)
+        if (t3->indices[j] / 64 != OUTLIER / 64)
+            for (int k = 0; k < 3; k++) others = fmaxf(others, fabsf(t3->positions[3 * j + (uint32_t)k]));
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    mk_write_options o = { .precision = MK_PRECISION_Q16, .tolerance = TOLERANCE };
+    mk_asset a;
+    mk_write_report rep;
+    write_open(&raw, &o, &arena, &a, &rep);
+    CHECK_EQ_INT(rep.quantized_targets, 4);
+    CHECK_EQ_INT(rep.float_targets, 0);
+    CHECK_EQ_INT(rep.float_entries, 1);
+    CHECK_MSG(rep.max_position_error <= TOLERANCE, "error %g over the tolerance", rep.max_position_error);
+    const mk_blob_target *bt = &a.targets[3];
+    CHECK(bt->flags & MK_TARGET_QUANTIZED);
+    CHECK_MSG(bt->position_scale == others / 32767.0f, "scale %g, expected %g (the other blocks')",
+              (double)bt->position_scale, (double)(others / 32767.0f));
+    const mk_blob_mesh *bm = &a.meshes[0];
+    const uint32_t *first = (const uint32_t *)(a.data + bm->block_entries);
+    const mk_blob_entry *entries = (const mk_blob_entry *)(a.data + bm->entries);
+    int float_seen = 0, int16_seen = 0;
+    for (uint32_t b = 0; b < bm->block_count; b++)
+        for (uint32_t e = first[b]; e < first[b + 1]; e++) {
+            if (mk_entry_target(&entries[e]) != 3) { CHECK(mk_entry_quantized(&entries[e])); continue; }
+            if (b == OUTLIER / 64) float_seen += !mk_entry_quantized(&entries[e]);
+            else int16_seen += mk_entry_quantized(&entries[e]);
+        }
+    CHECK_EQ_INT(float_seen, 1);
+    CHECK_EQ_INT(int16_seen, 4);
+    mk_mesh_info mi;
+    CHECK(mk_mesh_get(&a, 0, &mi) && mi.float_entries == 1);
+
+    /* Evaluation against the float model: every position within sum |w| x tolerance. */
+    static const float weights[][4] = { { 0, 0, 0, 1 }, { 0.5f, -1, 0.25f, 0.75f }, { 1, 1, 1, -0.5f } };
+    size_t scratch_size = mk_eval_scratch_size(&a, 0);
+    void *scratch = aligned_alloc(16, (scratch_size + 15) & ~(size_t)15);
+    float *p = malloc(12u * VERTICES), *n = malloc(12u * VERTICES);
+    for (size_t w = 0; w < sizeof weights / sizeof weights[0]; w++) {
+        mk_eval_job job = { .asset = &a, .vertex_count = MK_VERTICES_TO_END, .weights = weights[w], .weight_count = 4,
+                            .scratch = scratch, .scratch_size = scratch_size, .positions = p,
+                            .positions_size = 12u * VERTICES, .normals = n, .normals_size = 12u * VERTICES };
+        mk_error err;
+        CHECK_MSG(mk_eval_run(&job, &err) == MK_OK, "%s", err.message);
+        double worst = 0, bound = 0;
+        for (int c = 0; c < 4; c++) bound += fabs(weights[w][c]) * TOLERANCE;
+        for (uint32_t v = 0; v < VERTICES; v++)
+            for (uint32_t k = 0; k < 3; k++) {
+                double expect = raw.meshes[0].positions[3 * v + k];
+                for (uint32_t c = 0; c < 4; c++) {
+                    const mk_raw_target *t = &raw.channels[c].targets[0];
+                    expect += (double)weights[w][c] * t->positions[3 * v + k];   /* stride 1: index j = v */
+                }
+                worst = fmax(worst, fabs(p[3 * v + k] - expect));
+            }
+        CHECK_MSG(worst <= bound + 1e-4 * 1e-3, "weights %zu: worst position error %g over %g", w, worst, bound);
+        CHECK_NEAR(p[3 * OUTLIER + 1], (double)weights[w][3] * 1000.0 + (double)weights[w][0] * raw.channels[0].targets[0].positions[3 * OUTLIER + 1]
+                   + (double)weights[w][1] * raw.channels[1].targets[0].positions[3 * OUTLIER + 1]
+                   + (double)weights[w][2] * raw.channels[2].targets[0].positions[3 * OUTLIER + 1], 1e-3);
+    }
+    /* mk_eval_traffic counts the float entry's bytes as float: target 3 alone, positions only:
+     * the block table (6 values), 20 entry headers, 236 vertices of int16 positions and the
+     * outlier block's 64 of float, the base read and the output written. */
+    mk_eval_job tj = { .asset = &a, .vertex_count = MK_VERTICES_TO_END, .weights = weights[0], .weight_count = 4,
+                       .scratch = scratch, .scratch_size = scratch_size, .positions = p, .positions_size = 12u * VERTICES };
+    CHECK_EQ_INT(mk_eval_traffic(&tj), 4 * 6 + 16 * 20 + 6 * (VERTICES - 64) + 12 * 64 + 24 * VERTICES);
+    free(scratch);
+    free(p);
+    free(n);
+
+    /* Read back: the outlier exact, the rest within the reported error. */
+    mk_raw_asset back;
+    mk_raw_init(&back, NULL);
+    mk_error err;
+    CHECK(mk_read_blob(&a, &back, &err) == MK_OK);
+    const mk_raw_target *u = &back.channels[3].targets[0];
+    int found = 0;
+    for (uint32_t j = 0; j < u->count; j++)
+        if (u->indices[j] == OUTLIER) found = u->positions[3 * j + 1] == 1000.0f;
+    CHECK(found);
+    mk_raw_free(&back);
+
+    /* A target whose every block is an outlier stays a float target. */
+    for (uint32_t j = 0; j < t3->count; j++) t3->positions[3 * j] = 500.0f;
+    write_open(&raw, &o, &arena, &a, &rep);
+    CHECK_EQ_INT(rep.float_targets, 1);
+    CHECK_EQ_INT(rep.float_entries, 0);
+    CHECK(!(a.targets[3].flags & MK_TARGET_QUANTIZED));
+    mk_arena_free_all(&arena);
+    mk_raw_free(&raw);
+}
+
+static uint64_t bits(const unsigned *list, size_t n)
+{
+    uint64_t m = 0;
+    for (size_t i = 0; i < n; i++) m |= 1ull << list[i];
+    return m;
+}
+
+static uint64_t range(unsigned lo, unsigned hi) { return (hi >= 63 ? ~0ull : (1ull << (hi + 1)) - 1) & ~((1ull << lo) - 1); }
+
+static void test_gap_rule(void)
+{
+    static const unsigned moved[] = { 0, 1, 2, 5, 20 };
+    const uint64_t m = bits(moved, 5);
+    CHECK_EQ_INT(mk_block_mask(m, 64, 2), range(0, 5) | 1ull << 20);   /* gap 3-4 filled, 6-19 not */
+    CHECK_EQ_INT(mk_block_mask(m, 64, 1), m);                           /* a gap of 2 stays */
+    CHECK_EQ_INT(mk_block_mask(m, 64, 0), m);
+    CHECK_EQ_INT(mk_block_mask(m, 64, 14), range(0, 20));   /* 6-19 is 14; 43 left (tail 21-63) > 3 x 14 */
+    CHECK_EQ_INT(mk_block_mask(m, 64, 15), ~0ull);          /* 43 left <= 3 x 15: the whole block */
+    /* Only the head and tail missing, each short: the whole block (the runtime's fast path). */
+    CHECK_EQ_INT(mk_block_mask(range(2, 62), 64, 1), ~0ull);       /* 3 left <= 3 x 1 */
+    CHECK_EQ_INT(mk_block_mask(range(2, 62), 64, 0), range(2, 62));
+    CHECK_EQ_INT(mk_block_mask(range(0, 61), 64, 2), ~0ull);
+    static const unsigned ends[] = { 0, 1, 2, 3, 60, 61, 62 };    /* 57 left: 4-59 and the tail 63 */
+    CHECK_EQ_INT(mk_block_mask(bits(ends, 7), 64, 18), bits(ends, 7));
+    CHECK_EQ_INT(mk_block_mask(bits(ends, 7), 64, 19), ~0ull);
+    /* Interior gaps filled, head 1 + tail 1 <= 2. */
+    static const unsigned sparse[] = { 1, 3, 5, 60, 62 };
+    CHECK_EQ_INT(mk_block_mask(bits(sparse, 5) | range(5, 60), 64, 2), ~0ull);
+    /* A partial last block (40 vertices): full means its 40 bits. */
+    CHECK_EQ_INT(mk_block_mask(range(1, 38), 40, 2), range(0, 39));
+    CHECK_EQ_INT(mk_block_mask(range(1, 38), 40, 0), range(1, 38));
+    /* Every bit, the last bit, one bit. */
+    CHECK_EQ_INT(mk_block_mask(~0ull, 64, 0), ~0ull);
+    CHECK_EQ_INT(mk_block_mask(1ull << 63, 64, 4), 1ull << 63);
+    CHECK_EQ_INT(mk_block_mask(1ull << 63, 64, 64), ~0ull);
+    CHECK_EQ_INT(mk_block_mask(1, 1, 0), 1);
+    static const unsigned pair[] = { 62, 63 };
+    CHECK_EQ_INT(mk_block_mask(bits(pair, 2) | 1, 64, 20), bits(pair, 2) | 1);   /* the gap 1-61: 61 > 3 x 20 */
+    CHECK_EQ_INT(mk_block_mask(bits(pair, 2) | 1, 64, 21), ~0ull);
+}
+
+/* The writer uses the rule: a target moving {0, 1, 2, 5, 20} of block 0 stores bits 0-5 and 20
+ * with gap_limit 3 (G = 2); with gap_limit 1 exactly the moved vertices. */
+static void test_writer_masks(void)
+{
+    static const unsigned moved[] = { 0, 1, 2, 5, 20 };
+    for (int g = 0; g < 2; g++) {
+        mk_raw_asset raw;
+        mk_raw_init(&raw, NULL);
+        fixture_line(&raw, 64, 1, 1);
+        mk_raw_target *t = &raw.channels[0].targets[0];
+        for (uint32_t j = 0; j < 5; j++) {
+            t->indices[j] = moved[j];
+            for (int k = 0; k < 3; k++) t->positions[3 * j + (uint32_t)k] = 0.01f * (float)(j + 1);
+        }
+        t->count = 5;
+        mk_write_options o = { .gap_limit = g ? 3 : 1 };
+        mk_asset a;
+        mk_write_report rep;
+        write_open(&raw, &o, &raw.arena, &a, &rep);
+        const mk_blob_entry *e = (const mk_blob_entry *)(a.data + a.meshes[0].entries);
+        CHECK_EQ_INT(a.meshes[0].entry_count, 1);
+        CHECK_EQ_INT(e->mask, g ? range(0, 5) | 1ull << 20 : bits(moved, 5));
+        mk_raw_free(&raw);
+    }
+}
+
+CHECK_MAIN(CASE(test_outlier_block_is_float), CASE(test_gap_rule), CASE(test_writer_masks))
