@@ -21,7 +21,8 @@ typedef struct mk_write_options {
     /* The entry mask rule (mk_block_mask, block_mask.h) with gap = gap_limit - 1: gaps of at
      * most `gap` unmoved vertices between moved ones are stored as zeros, and a block that
      * still lacks at most 3 x gap is stored whole. 1 stores exactly the moved vertices, 65
-     * every touched block whole; 0 = the default (MK_DEFAULT_FILL_GAP + 1). */
+     * every touched block whole (larger values count as 65); 0 = the default
+     * (MK_DEFAULT_FILL_GAP + 1). */
     uint32_t gap_limit;
     /* Phases of the write (quantize, lay out blocks, assemble); may be NULL. */
     mk_phase_log *phases;

@@ -521,6 +521,7 @@ static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, cons
 {
     mk_write_options opt = options ? *options : (mk_write_options){ 0 };
     if (opt.gap_limit == 0) opt.gap_limit = MK_DEFAULT_FILL_GAP + 1;
+    if (opt.gap_limit > MK_BLOCK_SIZE + 1) opt.gap_limit = MK_BLOCK_SIZE + 1;   /* 65: every touched block whole */
     if (opt.precision != MK_PRECISION_Q16 && opt.precision != MK_PRECISION_FLOAT)
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "write: unknown precision");
     if (!(opt.tolerance >= 0) || !isfinite(opt.tolerance))

@@ -650,6 +650,18 @@ int mk_is_blob(const void *data, size_t size)
     return data && size >= 8 && memcmp(data, MK_MAGIC, 8) == 0;
 }
 
+uint64_t mk_mesh_float_entries(const mk_asset *a, uint32_t mesh)
+{
+    if (!a || mesh >= a->mesh_count) return 0;
+    const mk_blob_mesh *m = &a->meshes[mesh];
+    const mk_blob_entry *entries = (const mk_blob_entry *)(a->data + m->entries);
+    uint64_t n = 0;
+    for (uint64_t e = 0; e < m->entry_count; e++)
+        n += !mk_entry_quantized(&entries[e])
+             && (a->targets[m->first_target + mk_entry_target(&entries[e])].flags & MK_TARGET_QUANTIZED);
+    return n;
+}
+
 int mk_mesh_get(const mk_asset *a, uint32_t mesh, mk_mesh_info *out)
 {
     if (!a || !out || mesh >= a->mesh_count) return 0;
@@ -664,10 +676,6 @@ int mk_mesh_get(const mk_asset *a, uint32_t mesh, mk_mesh_info *out)
     out->target_count = m->target_count;
     out->target_bytes = m->target_data_size;
     out->entry_count = m->entry_count;
-    const mk_blob_entry *entries = (const mk_blob_entry *)(a->data + m->entries);
-    for (uint64_t e = 0; e < m->entry_count; e++)
-        out->float_entries += !mk_entry_quantized(&entries[e])
-                           && (a->targets[m->first_target + mk_entry_target(&entries[e])].flags & MK_TARGET_QUANTIZED);
     out->stacking = (mk_stacking)m->stacking;
     out->has_normals = (m->flags & MK_MESH_HAS_NORMALS) != 0;
     out->has_tangents = (m->flags & MK_MESH_HAS_TANGENTS) != 0;

@@ -159,11 +159,7 @@ void cli_precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *floats, 
     *quantized = *floats = 0;
     *float_entries = 0;
     *max_error_bound = 0;
-    for (uint32_t i = 0; i < a->mesh_count; i++) {
-        mk_mesh_info m;
-        mk_mesh_get(a, i, &m);
-        *float_entries += m.float_entries;
-    }
+    for (uint32_t i = 0; i < a->mesh_count; i++) *float_entries += mk_mesh_float_entries(a, i);
     for (uint32_t c = 0; c < a->channel_count; c++) {
         mk_channel_info ch;
         mk_channel_get(a, c, &ch);

@@ -36,7 +36,8 @@ static void print_text(FILE *f, const pb_asset *l, const char *path)
         if (m.gltf_node >= 0)
             fprintf(f, ", glTF node %d mesh %d primitive %d", m.gltf_node, m.gltf_mesh, m.gltf_primitive);
         fprintf(f, "\n  target data: %llu bytes in %llu block entries (%llu float in quantized targets)\n",
-                (unsigned long long)m.target_bytes, (unsigned long long)m.entry_count, (unsigned long long)m.float_entries);
+                (unsigned long long)m.target_bytes, (unsigned long long)m.entry_count,
+                (unsigned long long)mk_mesh_float_entries(a, i));
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
             mk_channel_info ch;
             mk_channel_get(a, c, &ch);
@@ -93,7 +94,7 @@ static void print_json(FILE *f, const pb_asset *l, const char *path)
         json_bool(&w, "tangents", m.has_tangents);
         json_string(&w, "stacking", m.stacking == MK_STACKING_SEQUENTIAL ? "sequential" : "additive");
         json_int(&w, "target_bytes", (long long)m.target_bytes);
-        json_int(&w, "float_entries", (long long)m.float_entries);
+        json_int(&w, "float_entries", (long long)mk_mesh_float_entries(a, i));
         json_array(&w, "channels");
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
             mk_channel_info ch;

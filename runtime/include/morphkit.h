@@ -148,7 +148,6 @@ typedef struct mk_mesh_info {
     uint32_t target_count;        /* targets of all the mesh's channels */
     uint64_t target_bytes;        /* bytes of the mesh's block data (entry headers + deltas) */
     uint64_t entry_count;         /* block entries: (target, 64-vertex block) pairs with data */
-    uint64_t float_entries;       /* entries of quantized targets stored as float32 (outliers) */
     mk_stacking stacking;         /* stored stacking: additive or sequential */
     int has_normals, has_tangents;
     int32_t gltf_node, gltf_mesh, gltf_primitive; /* -1 when not from glTF */
@@ -185,6 +184,10 @@ typedef struct mk_clip_info {
 } mk_clip_info;
 
 int mk_mesh_get(const mk_asset *asset, uint32_t mesh, mk_mesh_info *out);
+/* Block entries of the mesh's quantized targets stored as float32 (outlier blocks whose deltas
+ * do not fit int16 within the import tolerance); 0 for an invalid mesh. Counted by reading
+ * every entry header of the mesh: for tools, not for a frame loop. */
+uint64_t mk_mesh_float_entries(const mk_asset *asset, uint32_t mesh);
 int mk_channel_get(const mk_asset *asset, uint32_t channel, mk_channel_info *out);
 /* Targets of a channel are numbered 0..target_count-1 in increasing full weight. */
 int mk_target_get(const mk_asset *asset, uint32_t channel, uint32_t target, mk_target_info *out);

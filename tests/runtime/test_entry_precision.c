@@ -5,6 +5,7 @@
  * mask rule (mk_block_mask): which vertices an entry stores. */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 #include "block_mask.h"
 #include "check.h"
 #include "fixtures.h"
@@ -63,7 +64,7 @@ static void test_outlier_block_is_float(void)
     CHECK_EQ_INT(float_seen, 1);
     CHECK_EQ_INT(int16_seen, 4);
     mk_mesh_info mi;
-    CHECK(mk_mesh_get(&a, 0, &mi) && mi.float_entries == 1);
+    CHECK(mk_mesh_get(&a, 0, &mi) && mk_mesh_float_entries(&a, 0) == 1);
 
     /* Evaluation against the float model: every position within sum |w| x tolerance. */
     static const float weights[][4] = { { 0, 0, 0, 1 }, { 0.5f, -1, 0.25f, 0.75f }, { 1, 1, 1, -0.5f } };
@@ -133,6 +134,83 @@ static uint64_t bits(const unsigned *list, size_t n)
 
 static uint64_t range(unsigned lo, unsigned hi) { return (hi >= 63 ? ~0ull : (1ull << (hi + 1)) - 1) & ~((1ull << lo) - 1); }
 
+/* One job's outputs: positions, normals and tangents of [first, first + count). */
+static void eval_range(const mk_asset *a, const float *w, mk_normal_mode mode, uint32_t first, uint32_t count, float *p,
+                       float *n, float *t)
+{
+    size_t scratch_size = mk_eval_scratch_size(a, 0);
+    void *scratch = aligned_alloc(16, (scratch_size + 15) & ~(size_t)15);
+    mk_eval_job job = { .asset = a, .first_vertex = first, .vertex_count = count, .weights = w, .weight_count = 4,
+                        .normal_mode = mode, .scratch = scratch, .scratch_size = scratch_size,
+                        .positions = p + 3 * first, .positions_size = 12u * count,
+                        .normals = n + 3 * first, .normals_size = 12u * count,
+                        .tangents = t + 4 * first, .tangents_size = 16u * count };
+    mk_error err;
+    CHECK_MSG(mk_eval_run(&job, &err) == MK_OK, "%s", err.message);
+    free(scratch);
+}
+
+/* The outlier block's float entry in normals and tangents too, with nlerp and slerp, and in
+ * range jobs: the mixed blob plays like the all-float one within the quantization error, and
+ * any split of the vertices gives the whole-mesh bytes. */
+static void test_outlier_block_every_path(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_line(&raw, VERTICES, 4, 1);
+    mk_raw_mesh *m = &raw.meshes[0];
+    m->tangents = mk_arena_array(&raw.arena, 4u * VERTICES, sizeof(float));
+    for (uint32_t v = 0; v < VERTICES; v++) { m->tangents[4 * v] = 1; m->tangents[4 * v + 3] = v % 2 ? 1.0f : -1.0f; }
+    for (uint32_t c = 0; c < 4; c++) {
+        mk_raw_target *t = &raw.channels[c].targets[0];
+        t->tangents = mk_arena_array(&raw.arena, 3u * t->count, sizeof(float));
+        for (uint32_t j = 0; j < t->count; j++) t->tangents[3 * j + 2] = 0.02f * (float)((t->indices[j] + c) % 4);
+    }
+    mk_raw_target *t3 = &raw.channels[3].targets[0];
+    t3->positions[3 * OUTLIER + 1] = 1000.0f;
+    t3->normals[3 * OUTLIER + 2] = 0.5f;      /* the outlier block's normal and tangent deltas are float too */
+    t3->tangents[3 * OUTLIER + 1] = 0.25f;
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    mk_asset mixed, exact;
+    mk_write_report rep;
+    mk_write_options q = { .precision = MK_PRECISION_Q16, .tolerance = TOLERANCE }, f = { .precision = MK_PRECISION_FLOAT };
+    write_open(&raw, &q, &arena, &mixed, &rep);
+    CHECK_EQ_INT(rep.float_entries, 1);
+    write_open(&raw, &f, &arena, &exact, &rep);
+    static const float w[4] = { 0.5f, -1, 0.25f, 0.75f };
+    float *p = malloc(12u * VERTICES), *n = malloc(12u * VERTICES), *t = malloc(16u * VERTICES);
+    float *pe = malloc(12u * VERTICES), *ne = malloc(12u * VERTICES), *te = malloc(16u * VERTICES);
+    float *ps = malloc(12u * VERTICES), *ns = malloc(12u * VERTICES), *ts = malloc(16u * VERTICES);
+    for (int mode = 0; mode < 2; mode++) {
+        mk_normal_mode nm = mode ? MK_NORMALS_SLERP : MK_NORMALS_NLERP;
+        eval_range(&mixed, w, nm, 0, VERTICES, p, n, t);
+        eval_range(&exact, w, nm, 0, VERTICES, pe, ne, te);
+        double dp = 0, dn = 0, dt = 0;
+        for (uint32_t k = 0; k < 3 * VERTICES; k++) { dp = fmax(dp, fabs(p[k] - pe[k])); dn = fmax(dn, fabs(n[k] - ne[k])); }
+        for (uint32_t k = 0; k < 4 * VERTICES; k++) dt = fmax(dt, fabs(t[k] - te[k]));
+        CHECK_MSG(dp <= 2.5 * TOLERANCE && dn <= 1e-3 && dt <= 1e-3, "mode %d: positions %g, normals %g, tangents %g from the float blob",
+                  mode, dp, dn, dt);
+        /* With only the outlier's target playing, its block plays exactly as in the float blob
+         * (the whole entry, normals and tangents too, is float). */
+        static const float only3[4] = { 0, 0, 0, 0.75f };
+        eval_range(&mixed, only3, nm, 0, VERTICES, ps, ns, ts);
+        eval_range(&exact, only3, nm, 0, VERTICES, pe, ne, te);
+        const size_t b0 = OUTLIER / 64 * 64;
+        CHECK_MSG(memcmp(&ps[3 * b0], &pe[3 * b0], 12 * 64) == 0 && memcmp(&ns[3 * b0], &ne[3 * b0], 12 * 64) == 0
+                  && memcmp(&ts[4 * b0], &te[4 * b0], 16 * 64) == 0,
+                  "mode %d: the outlier block differs from the float blob's", mode);
+        static const uint32_t cuts[] = { 0, 70, 128, 129, VERTICES };
+        for (size_t r = 0; r + 1 < sizeof cuts / sizeof cuts[0]; r++)
+            eval_range(&mixed, w, nm, cuts[r], cuts[r + 1] - cuts[r], ps, ns, ts);
+        CHECK_MSG(memcmp(p, ps, 12u * VERTICES) == 0 && memcmp(n, ns, 12u * VERTICES) == 0 && memcmp(t, ts, 16u * VERTICES) == 0,
+                  "mode %d: range jobs differ from the whole-mesh job", mode);
+    }
+    free(p); free(n); free(t); free(pe); free(ne); free(te); free(ps); free(ns); free(ts);
+    mk_arena_free_all(&arena);
+    mk_raw_free(&raw);
+}
+
 static void test_gap_rule(void)
 {
     static const unsigned moved[] = { 0, 1, 2, 5, 20 };
@@ -158,6 +236,10 @@ static void test_gap_rule(void)
     /* Every bit, the last bit, one bit. */
     CHECK_EQ_INT(mk_block_mask(~0ull, 64, 0), ~0ull);
     CHECK_EQ_INT(mk_block_mask(1ull << 63, 64, 4), 1ull << 63);
+    /* Nothing moved: nothing stored; a gap so large that 3 x gap would wrap in 32 bits still
+     * stores the whole block. */
+    CHECK_EQ_INT(mk_block_mask(0, 64, 8), 0);
+    CHECK_EQ_INT(mk_block_mask(1, 64, 0x55555556u), ~0ull);
     CHECK_EQ_INT(mk_block_mask(1ull << 63, 64, 64), ~0ull);
     CHECK_EQ_INT(mk_block_mask(1, 1, 0), 1);
     static const unsigned pair[] = { 62, 63 };
@@ -191,4 +273,5 @@ static void test_writer_masks(void)
     }
 }
 
-CHECK_MAIN(CASE(test_outlier_block_is_float), CASE(test_gap_rule), CASE(test_writer_masks))
+CHECK_MAIN(CASE(test_outlier_block_is_float), CASE(test_outlier_block_every_path), CASE(test_gap_rule),
+           CASE(test_writer_masks))
