@@ -304,18 +304,13 @@ typedef struct layout_item {
     uint32_t index;
 } layout_item;
 
-/* The flags that size an entry's data (mk_entry_flags): the target's, int16 or not per entry. */
-static uint32_t entry_flags(const target_plan *p, int is_float)
-{
-    return is_float ? p->flags & ~(uint32_t)MK_TARGET_QUANTIZED : p->flags;
-}
-
 static void count_block(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask)
 {
     layout_item *it = user;
     (void)block;
     const target_plan *p = &it->l->plans[it->index];
-    uint64_t size = mk_entry_data_size(entry_flags(p, entry_is_float(it->tl->t, p, first, end)), mk_popcount64(mask));
+    const int quantized = !entry_is_float(it->tl->t, p, first, end);
+    uint64_t size = mk_entry_data_size(mk_entry_flags(p->flags, quantized), mk_popcount64(mask));
     it->tl->data_size = pad16((size_t)it->tl->data_size) + size;
     it->tl->entry_count++;
 }
@@ -337,7 +332,8 @@ static void write_block(void *user, uint32_t block, uint32_t first, uint32_t end
     const target_plan *p = &l->plans[it->index];
     uint64_t e = tl->cursor++;
     const int is_float = entry_is_float(tg, p, first, end);
-    uint64_t at = pad16((size_t)tl->data_size), size = mk_entry_data_size(entry_flags(p, is_float), mk_popcount64(mask));
+    uint64_t at = pad16((size_t)tl->data_size);
+    uint64_t size = mk_entry_data_size(mk_entry_flags(p->flags, !is_float), mk_popcount64(mask));
     tl->data_size = at + size;
     l->entry_block[e] = block;
     l->entry_float[e] = (uint8_t)is_float;

@@ -440,7 +440,7 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
             const uint32_t moved = mk_popcount64(en->mask);
             const size_t attribute_bytes = (size_t)mk_entry_data_size(q ? MK_TARGET_QUANTIZED : 0u, moved);
             const uint8_t *p = data + (size_t)en->data * MK_ALIGN;
-            prefetch_ahead(p, (size_t)mk_entry_data_size(mk_entry_flags(tg->flags, en), moved));
+            prefetch_ahead(p, (size_t)mk_entry_data_size(mk_entry_flags(tg->flags, q), moved));
             add_attribute(acc_p, en->mask, p, q, c * (q ? tg->position_scale : 1.0f));
             if (!want_normals && !want_tangents) continue;
             p += attribute_bytes;
@@ -535,7 +535,7 @@ uint64_t mk_eval_traffic(const mk_eval_job *job)
         bytes += sizeof(mk_blob_entry);                                 /* every header is read */
         const uint32_t ti = mk_entry_target(&entries[e]);
         if (f.coef[ti] == 0.0f) continue;
-        uint32_t flags = mk_entry_flags(f.targets[ti].flags, &entries[e]) & ~strip;
+        uint32_t flags = mk_entry_flags(f.targets[ti].flags, mk_entry_quantized(&entries[e])) & ~strip;
         bytes += mk_entry_data_size(flags, mk_popcount64(entries[e].mask));
     }
     /* Base arrays read and outputs written. */

@@ -173,10 +173,10 @@ static inline uint32_t mk_entry_target(const mk_blob_entry *e) { return e->targe
 static inline int mk_entry_quantized(const mk_blob_entry *e) { return (e->target_and_flags & MK_ENTRY_FLOAT) == 0; }
 
 /* The flags that size an entry's data: its target's attributes, MK_TARGET_QUANTIZED when the
- * entry holds int16. */
-static inline uint32_t mk_entry_flags(uint32_t target_flags, const mk_blob_entry *e)
+ * entry holds int16 (quantized: mk_entry_quantized of a stored entry, or the writer's choice). */
+static inline uint32_t mk_entry_flags(uint32_t target_flags, int quantized)
 {
-    return (target_flags & ~(uint32_t)MK_TARGET_QUANTIZED) | (mk_entry_quantized(e) ? (uint32_t)MK_TARGET_QUANTIZED : 0u);
+    return (target_flags & ~(uint32_t)MK_TARGET_QUANTIZED) | (quantized ? (uint32_t)MK_TARGET_QUANTIZED : 0u);
 }
 
 /* Bytes of one entry's data: m values per component, 3 components per attribute; flags as

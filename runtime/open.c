@@ -489,7 +489,7 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
                 return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": int16 data for float target ", target,
                              "");
             uint32_t count = mk_popcount64(en->mask);
-            uint64_t bytes = mk_entry_data_size(mk_entry_flags(tg->flags, en), count);
+            uint64_t bytes = mk_entry_data_size(mk_entry_flags(tg->flags, mk_entry_quantized(en)), count);
             uint64_t offset = (uint64_t)en->data * MK_ALIGN;
             if (FAILS("entry.data", offset > m->target_data_size || bytes > m->target_data_size - offset))
                 return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": its ", bytes,

@@ -583,17 +583,10 @@ static mk_result found_add(scene *s, found_channels *f, const char *name, uint32
         f->keys = keys;
         f->cap = cap;
     }
-    fbx_channel_plan *p = &f->plans[f->count];
-    memset(p, 0, sizeof *p);
-    p->name = name;
-    p->name_length = name_length;
-    p->default_percent = default_percent;
-    p->shapes = shapes;
-    p->shape_count = shape_count;
-    p->full_weights = full_weights;
-    p->full_weight_count = full_weight_count;
-    p->vertex_weights = vertex_weights;
-    p->channel = UINT32_MAX;
+    f->plans[f->count] = (fbx_channel_plan){ .name = name, .name_length = name_length, .default_percent = default_percent,
+                                            .shapes = shapes, .shape_count = shape_count, .full_weights = full_weights,
+                                            .full_weight_count = full_weight_count, .vertex_weights = vertex_weights,
+                                            .channel = UINT32_MAX };
     f->keys[f->count++] = key;
     return MK_OK;
 }

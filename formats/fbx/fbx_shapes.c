@@ -83,15 +83,8 @@ static mk_result decode_and_expand(const shape_loop *l, shape_worker *w, shape_j
     if (j->usable) {
         char path[160];
         fbx_node_path(node, path, sizeof path);
-        fbx_shape_data data;
-        memset(&data, 0, sizeof data);
-        data.count = n_idx;
-        data.indexes = indexes;
-        data.positions = positions;
-        data.path = path;
-        data.node = node;
-        data.name = j->ref->name;
-        data.name_length = j->ref->name_length;
+        fbx_shape_data data = { .count = n_idx, .indexes = indexes, .positions = positions, .path = path, .node = node,
+                                .name = j->ref->name, .name_length = j->ref->name_length };
         if (normals && n_nrm != n_pos) j->normals_mismatch = 1;
         else if (normals && (l->options->keep_shape_normals || any_nonzero(normals, n_nrm))) data.normals = normals;
         if (j->vertex_weights) {
