@@ -1061,6 +1061,7 @@ static mk_result parse_shell(recipe_ctx *ctx, channel_plan *plan, const cJSON *c
 {
     shell_params *p = &plan->shell;
     memset(p, 0, sizeof *p);
+    p->threads = ctx->options ? ctx->options->threads : 0;
     p->pressure = 20;
     p->dt = 0.01;
     p->frames = 100;

@@ -2,6 +2,7 @@
 #define _GNU_SOURCE
 #include "parallel.h"
 #include <stdatomic.h>
+#include <stdlib.h>
 #include <threads.h>
 #include <unistd.h>
 #if defined(__linux__)
@@ -36,6 +37,7 @@ typedef struct loop {
 typedef struct worker {
     loop *l;
     uint32_t index;
+    mk_team *team;            /* a team's worker (mk_team_create), else NULL */
 } worker;
 
 static void drain(loop *l, uint32_t index)
@@ -66,10 +68,136 @@ void mk_parallel_for(uint32_t items, uint32_t threads, mk_parallel_fn fn, void *
     worker workers[MK_PARALLEL_MAX_THREADS];
     uint32_t started = 0;
     for (uint32_t i = 1; i < n; i++) {
-        workers[started] = (worker){ &l, started + 1 };
+        workers[started] = (worker){ &l, started + 1, NULL };
         if (thrd_create(&ids[started], worker_main, &workers[started]) != thrd_success) break;
         started++;
     }
     drain(&l, 0);
     for (uint32_t i = 0; i < started; i++) thrd_join(ids[i], NULL);
+}
+
+/* The team: workers 1 .. count - 1 wait for the generation to change, drain the loop, and the
+ * last one out wakes the caller. Waiting spins for a moment first (a sweep's loops come every few
+ * hundred microseconds; a sleep and wake-up costs tens of them), then sleeps. */
+struct mk_team {
+    mtx_t lock;
+    cnd_t start, done;
+    atomic_ulong generation;  /* loops started; changed under lock */
+    atomic_uint running;      /* workers still in the current loop */
+    atomic_int stop;
+    loop l;
+    uint32_t count;           /* threads, the caller included */
+    uint32_t started;         /* worker threads running */
+    thrd_t ids[MK_PARALLEL_MAX_THREADS];
+    worker workers[MK_PARALLEL_MAX_THREADS];
+};
+
+#define TEAM_SPINS 20000
+
+static void spin_pause(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+}
+
+static int team_main(void *p)
+{
+    worker *w = p;
+    mk_team *t = w->team;
+    unsigned long seen = 0;
+    for (;;) {
+        for (int i = 0; i < TEAM_SPINS && atomic_load(&t->generation) == seen && !atomic_load(&t->stop); i++) spin_pause();
+        mtx_lock(&t->lock);
+        while (atomic_load(&t->generation) == seen && !atomic_load(&t->stop)) cnd_wait(&t->start, &t->lock);
+        mtx_unlock(&t->lock);
+        if (atomic_load(&t->stop)) return 0;
+        seen = atomic_load(&t->generation);
+        drain(&t->l, w->index);
+        if (atomic_fetch_sub(&t->running, 1u) == 1u) {
+            mtx_lock(&t->lock);
+            cnd_signal(&t->done);
+            mtx_unlock(&t->lock);
+        }
+    }
+}
+
+mk_team *mk_team_create(uint32_t threads)
+{
+    uint32_t n = mk_parallel_threads(threads, UINT32_MAX);
+    if (n < 2) return NULL;
+    mk_team *t = calloc(1, sizeof *t);
+    if (!t) return NULL;
+    atomic_init(&t->l.next, 0u);
+    atomic_init(&t->generation, 0ul);
+    atomic_init(&t->running, 0u);
+    atomic_init(&t->stop, 0);
+    if (mtx_init(&t->lock, mtx_plain) != thrd_success) {
+        free(t);
+        return NULL;
+    }
+    if (cnd_init(&t->start) != thrd_success) {
+        mtx_destroy(&t->lock);
+        free(t);
+        return NULL;
+    }
+    if (cnd_init(&t->done) != thrd_success) {
+        cnd_destroy(&t->start);
+        mtx_destroy(&t->lock);
+        free(t);
+        return NULL;
+    }
+    for (uint32_t i = 1; i < n; i++) {
+        t->workers[t->started] = (worker){ &t->l, t->started + 1, t };
+        if (thrd_create(&t->ids[t->started], team_main, &t->workers[t->started]) != thrd_success) break;
+        t->started++;
+    }
+    t->count = t->started + 1;
+    if (t->started == 0) {
+        mk_team_destroy(t);
+        return NULL;
+    }
+    return t;
+}
+
+void mk_team_for(mk_team *t, uint32_t items, mk_parallel_fn fn, void *user)
+{
+    if (!t || items < 2) {
+        for (uint32_t i = 0; i < items; i++) fn(user, i, 0);
+        return;
+    }
+    /* No worker is in a loop here (the last call waited for all of them). */
+    atomic_store(&t->l.next, 0u);
+    t->l.items = items;
+    t->l.fn = fn;
+    t->l.user = user;
+    atomic_store(&t->running, t->started);
+    mtx_lock(&t->lock);
+    atomic_fetch_add(&t->generation, 1ul);
+    cnd_broadcast(&t->start);
+    mtx_unlock(&t->lock);
+    drain(&t->l, 0);
+    for (int i = 0; i < TEAM_SPINS && atomic_load(&t->running) > 0; i++) spin_pause();
+    mtx_lock(&t->lock);
+    while (atomic_load(&t->running) > 0) cnd_wait(&t->done, &t->lock);
+    mtx_unlock(&t->lock);
+}
+
+uint32_t mk_team_threads(const mk_team *t)
+{
+    return t ? t->count : 1;
+}
+
+void mk_team_destroy(mk_team *t)
+{
+    if (!t) return;
+    mtx_lock(&t->lock);
+    atomic_store(&t->stop, 1);
+    cnd_broadcast(&t->start);
+    mtx_unlock(&t->lock);
+    for (uint32_t i = 0; i < t->started; i++) thrd_join(t->ids[i], NULL);
+    cnd_destroy(&t->done);
+    cnd_destroy(&t->start);
+    mtx_destroy(&t->lock);
+    free(t);
 }

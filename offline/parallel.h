@@ -22,4 +22,21 @@ uint32_t mk_parallel_threads(uint32_t requested, uint32_t items);
  * the others do its share. */
 void mk_parallel_for(uint32_t items, uint32_t threads, mk_parallel_fn fn, void *user);
 
+/* A team of threads kept between loops, for many short loops in a row (a simulation's sweeps),
+ * where starting threads per loop (mk_parallel_for) would cost more than the loop. The same
+ * rules for what a loop may depend on. */
+typedef struct mk_team mk_team;
+
+/* A team of mk_parallel_threads(threads, UINT32_MAX) threads, the caller of mk_team_for being
+ * one of them. NULL when only one thread is asked for or available, or when a thread or the
+ * memory for the team cannot be had; mk_team_for then runs the loop on the calling thread. */
+mk_team *mk_team_create(uint32_t threads);
+/* Runs fn for every item in [0, items) on the team (worker 0 is the caller); returns when all
+ * are done. team may be NULL. */
+void mk_team_for(mk_team *team, uint32_t items, mk_parallel_fn fn, void *user);
+/* The team's thread count (1 for NULL). */
+uint32_t mk_team_threads(const mk_team *team);
+/* Stops and frees the team (NULL: nothing). */
+void mk_team_destroy(mk_team *team);
+
 #endif

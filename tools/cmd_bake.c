@@ -12,6 +12,7 @@
 typedef struct bake_args {
     const char *input, *output, *recipe, *depfile, *plot;
     int precision, quiet, all_meshes;
+    uint64_t threads;
 } bake_args;
 
 static int run_bake(void *p);
@@ -26,6 +27,10 @@ static const cli_option options[] = {
       "How deltas are stored (as for 'morphkit import').", "q16", "q16|float", 0, 0, 0, 0 },
     { "--all-meshes", NULL, CLI_FLAG, offsetof(bake_args, all_meshes),
       "Also write meshes that end up without channels (by default they are left out).", NULL, NULL, 0, 0, 0, 0 },
+    { "--threads", "N", CLI_UINT, offsetof(bake_args, threads),
+      "Threads for the parts of a bake that run in parallel (the shell simulation's sweeps); 0 = one per core. "
+      "The blob is the same for any count.",
+      "0", NULL, 0, 64, 0, 0 },
     { "--depfile", "PATH", CLI_STRING, offsetof(bake_args, depfile),
       "Also write a depfile for build systems (make syntax, as ninja and meson read it): the blob and every file the bake "
       "read (the input, the recipe, the cages it names).",
@@ -235,7 +240,8 @@ static int run_bake(void *p)
     char dir[4096];
     dir_of(a->recipe, dir, sizeof dir);
     mk_bake_options bo = { .base_dir = dir, .progress = on_progress, .channel_done = on_channel, .user = &ui,
-                           .file_read = a->depfile ? on_file_read : NULL, .load_asset = mk_import_load_asset };
+                           .file_read = a->depfile ? on_file_read : NULL, .load_asset = mk_import_load_asset,
+                           .threads = (uint32_t)a->threads };
     mk_bake_report report;
     if (r == MK_OK) r = mk_bake_recipe(&raw, recipe, recipe_size, &bo, &report, &err);
     if (r == MK_OK && !a->all_meshes) mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");

@@ -83,6 +83,35 @@ typedef struct shell_mesh {
  * unit area. Memory from arena. */
 mk_result shell_mesh_build(const mk_raw_mesh *mesh, double density, mk_arena *arena, shell_mesh *out, mk_error *err);
 
+/* A sweep's order of its elements (shell_order.c): phases, one after the other; phase f has
+ * parts phase_part[f] .. phase_part[f + 1], which share no vertex with each other (swept at the
+ * same time); part q is batches part_batch[q] .. part_batch[q + 1]; batch b is
+ * order[start[b] .. start[b + 1]): at most SHELL_BATCH elements that share no vertex, taken from
+ * the next SHELL_BATCH_WINDOW elements of its part not yet placed, in mesh order. The first
+ * phases have up to count / SHELL_PART_MIN parts (at least 1, at most SHELL_PARTS_MAX), the last
+ * possible one (SHELL_PHASES_MAX) one part. */
+#define SHELL_BATCH 4
+#define SHELL_BATCH_WINDOW 32
+#define SHELL_PART_MIN 2048
+#define SHELL_PARTS_MAX 16
+#define SHELL_PHASES_MAX 4
+typedef struct shell_sweep_order {
+    uint32_t *order;
+    uint32_t *start;          /* batch_count + 1 */
+    uint32_t batch_count;
+    uint32_t phase_count;
+    uint32_t phase_part[SHELL_PHASES_MAX + 1];
+    uint32_t part_count;
+    uint32_t part_batch[SHELL_PHASES_MAX * SHELL_PARTS_MAX + 1];
+} shell_sweep_order;
+
+/* The most parts a phase of count elements has: count / SHELL_PART_MIN, at least 1, at most
+ * SHELL_PARTS_MAX. */
+uint32_t shell_sweep_parts(uint32_t count);
+/* The order of count elements of k vertex indices each (idx), vertices below n. */
+mk_result shell_sweep_order_build(const uint32_t *idx, int k, uint32_t count, uint32_t n, mk_arena *arena,
+                                  shell_sweep_order *out, mk_error *err);
+
 /* Enclosed volume (1/6) sum x_a . (x_b x_c), and optionally its gradient (3 per vertex). */
 double shell_volume(const shell_mesh *m, const double *x, double *grad);
 /* Area-weighted unit vertex normals of positions x (3 per vertex). */
@@ -109,6 +138,7 @@ typedef struct shell_params {
     double aniso_mu;          /* stiffness of the anisotropic energy */
     double aniso_kA;          /* inward pressure on region vertices (force k_A times the vertex's rest area) */
     double aniso_direction[3];/* fibre direction (world), projected into each triangle */
+    uint32_t threads;         /* threads for the sweeps (0: one per core); the result does not depend on it */
 } shell_params;
 
 /* Upper limit of the automatic substep count. */

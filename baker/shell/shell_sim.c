@@ -8,62 +8,132 @@
 #include <string.h>
 #include "shell.h"
 #include "bake_util.h"
+#include "parallel.h"
 
 typedef struct shell_state {
     const shell_mesh *m;
     const shell_params *p;
     uint32_t *aniso_tris;     /* triangles of the anisotropic region */
+    uint32_t *aniso_idx;      /* their vertices, 3 per region triangle */
     uint32_t aniso_count;
     double *fibre;            /* 2 per region triangle */
     double *sign;             /* per region triangle: orientation against the neighbourhood */
     double *lambda;           /* per constraint: triangles, hinges, region triangles */
+    shell_sweep_order tri_order, hinge_order;  /* the sweeps' order */
+    mk_team *team;            /* threads for the sweeps' parts (NULL: the caller's only) */
 } shell_state;
 
-/* One XPBD projection of the energy constraint C = sqrt(2 W) over k vertices with gradient g of W. */
-static void project(const shell_mesh *m, double *p, const uint32_t *idx, int k, double W, const double *g,
-                    double alpha, double *lambda)
+/* XPBD projections of the energy constraints C = sqrt(2 W) of a batch of elements (k vertices each,
+ * sharing no vertex; element j has vertices idx[k e[j] ..], energy W[j], gradient g[j] of W and
+ * multiplier lambda[e[j]]). grad C = g / C, so with C^2 = 2 W the step is
+ * dl = (-C - alpha lambda) 2 W / (2 W alpha + sum_i w_i |g_i|^2) and each vertex moves by
+ * w_i g_i dl / C: one division per element. All steps are computed before any vertex moves,
+ * which is the same as one element after the other because the elements share no vertex, and
+ * lets their square roots and divisions overlap. */
+static void project_batch(const shell_mesh *m, double *x, const uint32_t *idx, int k, const uint32_t *e, uint32_t size,
+                          const double *W, double g[][12], double alpha, double *lambda)
 {
-    if (!(W > 1e-300)) return;
-    double C = sqrt(2 * W), denom = alpha;
-    for (int i = 0; i < k; i++) denom += m->inv_mass[idx[i]] * vec3_dot(g + 3 * i, g + 3 * i) / (C * C);
-    if (!(denom > 0)) return;
-    double dl = (-C - alpha * *lambda) / denom;
-    *lambda += dl;
-    for (int i = 0; i < k; i++)
-        for (int c = 0; c < 3; c++) p[3 * (size_t)idx[i] + c] += m->inv_mass[idx[i]] * g[3 * i + c] / C * dl;
+    double step[SHELL_BATCH];
+    for (uint32_t j = 0; j < size; j++) {
+        const uint32_t *v = idx + (size_t)k * e[j];
+        double sum = 0;
+        for (int i = 0; i < k; i++) sum += m->inv_mass[v[i]] * vec3_dot(g[j] + 3 * i, g[j] + 3 * i);
+        double C = sqrt(2 * W[j]), den = (2 * W[j] * alpha + sum) * C;
+        double s = 0;
+        if (W[j] > 1e-300 && den > 0) {
+            s = (-C - alpha * lambda[e[j]]) * 2 * W[j] / den;
+            lambda[e[j]] += s * C;
+        }
+        step[j] = s;
+    }
+    for (uint32_t j = 0; j < size; j++) {
+        const uint32_t *v = idx + (size_t)k * e[j];
+        for (int i = 0; i < k; i++) {
+            double f = m->inv_mass[v[i]] * step[j];
+            for (int c = 0; c < 3; c++) x[3 * (size_t)v[i] + c] += f * g[j][3 * i + c];
+        }
+    }
 }
 
-/* Energies of the three kinds at positions x; with project_alpha >= 0 each element is also
- * projected right after it is evaluated (one Gauss-Seidel sweep). */
-static void sweep(shell_state *s, double *x, double project_alpha, double energy[3])
+/* Evaluates (energy W, gradient) and, with alpha >= 0, projects the triangles (hinges = 0) or
+ * hinges (hinges = 1) of batches [first, last) of their sweep order; adds their energies to *energy
+ * in order. */
+static void sweep_batches(const shell_state *s, double *x, double alpha, int hinges, uint32_t first, uint32_t last,
+                          double *energy)
 {
     const shell_mesh *m = s->m;
     const shell_params *p = s->p;
-    double g[12];
-    energy[0] = energy[1] = energy[2] = 0;
-    for (uint32_t t = 0; t < m->tri_count; t++) {
-        const uint32_t *tri = m->tris + 3 * (size_t)t;
-        double W = shell_membrane_energy(p->material, p->mu, p->lambda, m->Dm_inv + 4 * (size_t)t, m->basis + 6 * (size_t)t,
-                                         m->area[t], x + 3 * (size_t)tri[0], x + 3 * (size_t)tri[1], x + 3 * (size_t)tri[2], g);
-        energy[0] += W;
-        if (project_alpha >= 0) project(m, x, tri, 3, W, g, project_alpha, s->lambda + t);
+    const shell_sweep_order *o = hinges ? &s->hinge_order : &s->tri_order;
+    const uint32_t *idx = hinges ? m->hinges : m->tris;
+    double g[SHELL_BATCH][12], W[SHELL_BATCH], sum = *energy;  /* summed here: parts' sums share cache lines */
+    for (uint32_t b = first; b < last; b++) {
+        const uint32_t *e = o->order + o->start[b];
+        uint32_t size = o->start[b + 1] - o->start[b];
+        for (uint32_t j = 0; j < size; j++) {
+            const uint32_t *v = idx + (hinges ? 4 : 3) * (size_t)e[j];
+            if (hinges) {
+                const double *xs[4] = { x + 3 * (size_t)v[0], x + 3 * (size_t)v[1], x + 3 * (size_t)v[2], x + 3 * (size_t)v[3] };
+                W[j] = shell_bending_energy(m->hinge_K + 4 * (size_t)e[j], m->hinge_scale[e[j]], m->hinge_rest[e[j]], p->kB,
+                                            xs, g[j]);
+            } else {
+                uint32_t t = e[j];
+                W[j] = shell_membrane_energy(p->material, p->mu, p->lambda, m->Dm_inv + 4 * (size_t)t, m->basis + 6 * (size_t)t,
+                                             m->area[t], x + 3 * (size_t)v[0], x + 3 * (size_t)v[1], x + 3 * (size_t)v[2], g[j]);
+            }
+        }
+        for (uint32_t j = 0; j < size; j++) sum += W[j];
+        if (alpha >= 0) project_batch(m, x, idx, hinges ? 4 : 3, e, size, W, g, alpha, s->lambda + (hinges ? m->tri_count : 0));
     }
-    for (uint32_t h = 0; h < m->hinge_count && p->kB > 0; h++) {
-        const uint32_t *q = m->hinges + 4 * (size_t)h;
-        const double *xs[4] = { x + 3 * (size_t)q[0], x + 3 * (size_t)q[1], x + 3 * (size_t)q[2], x + 3 * (size_t)q[3] };
-        double W = shell_bending_energy(m->hinge_K + 4 * (size_t)h, m->hinge_scale[h], m->hinge_rest[h], p->kB, xs, g);
-        energy[1] += W;
-        if (project_alpha >= 0) project(m, x, q, 4, W, g, project_alpha, s->lambda + m->tri_count + h);
+    *energy = sum;
+}
+
+/* One part of a parallel sweep (shell_order.c): parts share no vertex. */
+typedef struct sweep_job {
+    const shell_state *s;
+    double *x;
+    double alpha;
+    int hinges;
+    uint32_t first_part;      /* the phase's */
+    double energy[SHELL_PHASES_MAX * SHELL_PARTS_MAX];  /* per part */
+} sweep_job;
+
+static void sweep_part(void *user, uint32_t part, uint32_t worker)
+{
+    (void)worker;
+    sweep_job *j = user;
+    const shell_sweep_order *o = j->hinges ? &j->s->hinge_order : &j->s->tri_order;
+    uint32_t q = j->first_part + part;
+    sweep_batches(j->s, j->x, j->alpha, j->hinges, o->part_batch[q], o->part_batch[q + 1], &j->energy[q]);
+}
+
+/* Energies of the three kinds at positions x; with project_alpha >= 0 each element is also
+ * projected right after it is evaluated (one Gauss-Seidel sweep). Triangles, then hinges, in
+ * their sweep orders (shell_order.c): phase after phase, a phase's parts on the team's threads;
+ * the result is the same for any thread count. Energies are summed per part, then in part order. */
+static void sweep(const shell_state *s, double *x, double project_alpha, double energy[3])
+{
+    const shell_mesh *m = s->m;
+    const shell_params *p = s->p;
+    energy[0] = energy[1] = energy[2] = 0;
+    for (int hinges = 0; hinges < 2; hinges++) {
+        if (hinges && !(p->kB > 0)) break;
+        const shell_sweep_order *o = hinges ? &s->hinge_order : &s->tri_order;
+        sweep_job job = { .s = s, .x = x, .alpha = project_alpha, .hinges = hinges };
+        for (uint32_t f = 0; f < o->phase_count; f++) {
+            job.first_part = o->phase_part[f];
+            mk_team_for(s->team, o->phase_part[f + 1] - o->phase_part[f], sweep_part, &job);
+        }
+        for (uint32_t q = 0; q < o->part_count; q++) energy[hinges] += job.energy[q];
     }
     for (uint32_t i = 0; i < s->aniso_count && p->aniso_mu > 0; i++) {
         uint32_t t = s->aniso_tris[i];
-        const uint32_t *tri = m->tris + 3 * (size_t)t;
-        double W = shell_aniso_energy(p->aniso_energy, p->aniso_mu, s->sign[i], s->fibre + 2 * (size_t)i,
-                                      m->Dm_inv + 4 * (size_t)t, m->area[t], x + 3 * (size_t)tri[0],
-                                      x + 3 * (size_t)tri[1], x + 3 * (size_t)tri[2], g);
-        energy[2] += W;
+        double g[1][12], W[1];
+        W[0] = shell_aniso_energy(p->aniso_energy, p->aniso_mu, s->sign[i], s->fibre + 2 * (size_t)i,
+                                  m->Dm_inv + 4 * (size_t)t, m->area[t], x + 3 * (size_t)s->aniso_idx[3 * (size_t)i],
+                                  x + 3 * (size_t)s->aniso_idx[3 * (size_t)i + 1], x + 3 * (size_t)s->aniso_idx[3 * (size_t)i + 2], g[0]);
+        energy[2] += W[0];
         if (project_alpha >= 0)
-            project(m, x, tri, 3, W, g, project_alpha, s->lambda + m->tri_count + m->hinge_count + i);
+            project_batch(m, x, s->aniso_idx, 3, &i, 1, W, g, project_alpha, s->lambda + m->tri_count + m->hinge_count);
     }
 }
 
@@ -80,7 +150,8 @@ static mk_result setup_region(shell_state *s, mk_arena *arena, mk_error *err)
     s->aniso_tris = mk_arena_array(arena, s->aniso_count + 1, sizeof(uint32_t));
     s->fibre = mk_arena_array(arena, 2 * (size_t)s->aniso_count + 2, sizeof(double));
     s->sign = mk_arena_array(arena, s->aniso_count + 1, sizeof(double));
-    if (!s->aniso_tris || !s->fibre || !s->sign) return mk_error_oom(err, "shell region");
+    s->aniso_idx = mk_arena_array(arena, 3 * (size_t)s->aniso_count + 3, sizeof(uint32_t));
+    if (!s->aniso_tris || !s->fibre || !s->sign || !s->aniso_idx) return mk_error_oom(err, "shell region");
     uint32_t k = 0;
     for (uint32_t t = 0; t < m->tri_count; t++) {
         const uint32_t *tri = m->tris + 3 * (size_t)t;
@@ -92,6 +163,7 @@ static mk_result setup_region(shell_state *s, mk_arena *arena, mk_error *err)
         s->fibre[2 * (size_t)k] = a[0] / l;
         s->fibre[2 * (size_t)k + 1] = a[1] / l;
         s->sign[k] = 1;
+        memcpy(s->aniso_idx + 3 * (size_t)k, tri, 3 * sizeof(uint32_t));
         s->aniso_tris[k++] = t;
     }
     return MK_OK;
@@ -113,17 +185,16 @@ static void update_signs(shell_state *s, const double *x, const double *normals)
     }
 }
 
-mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *arena,
-                         void (*progress)(void *user, double fraction), void *user, shell_run *run,
-                         mk_error *err)
+static mk_result simulate(shell_state *sp, mk_arena *arena, void (*progress)(void *user, double fraction), void *user,
+                          shell_run *run, mk_error *err)
 {
-    memset(run, 0, sizeof *run);
+    shell_state s = *sp;
+    const shell_mesh *m = s.m;
+    const shell_params *p = s.p;
     size_t n3 = 3 * (size_t)m->n;
-    shell_state s;
-    memset(&s, 0, sizeof s);
-    s.m = m;
-    s.p = p;
     mk_result r = setup_region(&s, arena, err);
+    if (r == MK_OK) r = shell_sweep_order_build(m->tris, 3, m->tri_count, m->n, arena, &s.tri_order, err);
+    if (r == MK_OK) r = shell_sweep_order_build(m->hinges, 4, m->hinge_count, m->n, arena, &s.hinge_order, err);
     if (r != MK_OK) return r;
     double *x = mk_arena_array(arena, n3, sizeof(double));
     double *v = mk_arena_array(arena, n3, sizeof(double));
@@ -218,6 +289,20 @@ mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *a
         }
     }
     return MK_OK;
+}
+
+mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *arena,
+                         void (*progress)(void *user, double fraction), void *user, shell_run *run,
+                         mk_error *err)
+{
+    memset(run, 0, sizeof *run);
+    /* Threads for the sweeps: no more than a phase has parts (shell_order.c). */
+    shell_state s = { .m = m, .p = p };
+    uint32_t parts = shell_sweep_parts(m->tri_count), hinge_parts = shell_sweep_parts(m->hinge_count);
+    s.team = mk_team_create(mk_parallel_threads(p->threads, parts > hinge_parts ? parts : hinge_parts));
+    mk_result r = simulate(&s, arena, progress, user, run, err);
+    mk_team_destroy(s.team);
+    return r;
 }
 
 int shell_write_log(FILE *f, const shell_run *run)

@@ -14,6 +14,7 @@
 #include "blob_io.h"
 #include "check.h"
 #include "fixtures.h"
+#include "shell/shell.h"
 #include "shell/shell_ccd.h"
 #include "shell/shell_channel.h"
 
@@ -493,6 +494,106 @@ static void same_recipe_gives_identical_bytes(void)
     mk_raw_free(&raws[1]);
 }
 
+/* The sweeps' order (shell_order.c) on the 10 000-triangle sphere and a 1 280-triangle icosphere:
+ * every element exactly once; no two elements of a batch share a vertex; no two parts of a phase
+ * share a vertex (they are swept at the same time); batches no larger than SHELL_BATCH; on the
+ * large mesh, the parts of the phases that run on several threads hold nearly all elements. */
+static void sweep_order_keeps_parts_and_batches_apart(void)
+{
+    for (int large = 0; large < 2; large++) {
+        mk_raw_asset raw;
+        mk_raw_init(&raw, NULL);
+        const mk_raw_mesh *mesh = make_ball(&raw, large ? 10000 : 1280);
+        shell_mesh m;
+        mk_error err;
+        CHECK(shell_mesh_build(mesh, 1, &raw.arena, &m, &err) == MK_OK);
+        for (int hinges = 0; hinges < 2; hinges++) {
+            const uint32_t *idx = hinges ? m.hinges : m.tris;
+            uint32_t k = hinges ? 4 : 3, count = hinges ? m.hinge_count : m.tri_count;
+            shell_sweep_order o;
+            CHECK(shell_sweep_order_build(idx, (int)k, count, m.n, &raw.arena, &o, &err) == MK_OK);
+            uint32_t *seen = calloc(count, sizeof *seen), *owner = malloc(m.n * sizeof *owner), *mark = calloc(m.n, sizeof *mark);
+            uint32_t once = 1, batch_clash = 0, part_clash = 0, largest = 0, alone = 0;
+            CHECK(o.phase_part[0] == 0 && o.phase_part[o.phase_count] == o.part_count && o.part_batch[0] == 0 &&
+                  o.part_batch[o.part_count] == o.batch_count && o.start[o.batch_count] == count);
+            printf("%u %s: %u phases, parts", count, hinges ? "hinges" : "triangles", o.phase_count);
+            for (uint32_t f = 0; f < o.phase_count; f++) {
+                uint32_t in_phase = 0, parts = o.phase_part[f + 1] - o.phase_part[f];
+                for (uint32_t v = 0; v < m.n; v++) owner[v] = UINT32_MAX;
+                for (uint32_t q = o.phase_part[f]; q < o.phase_part[f + 1]; q++)
+                    for (uint32_t b = o.part_batch[q]; b < o.part_batch[q + 1]; b++) {
+                        uint32_t size = o.start[b + 1] - o.start[b];
+                        if (size > largest) largest = size;
+                        in_phase += size;
+                        for (uint32_t i = o.start[b]; i < o.start[b + 1]; i++) {
+                            uint32_t e = o.order[i];
+                            if (e >= count || seen[e]++) once = 0;
+                            for (uint32_t j = 0; j < k && e < count; j++) {
+                                uint32_t v = idx[k * e + j];
+                                int repeated = 0;  /* an element's own vertices are distinct */
+                                for (uint32_t l = 0; l < j; l++) repeated |= idx[k * e + l] == v;
+                                if (!repeated && mark[v] == b + 1) batch_clash++;
+                                mark[v] = b + 1;
+                                if (owner[v] != UINT32_MAX && owner[v] != q) part_clash++;
+                                owner[v] = q;
+                            }
+                        }
+                    }
+                if (parts == 1) alone += in_phase;
+                printf(" %u (%u elements)", parts, in_phase);
+            }
+            printf(", %u batches (largest %u); every element once: %s, clashes in batches %u, between parts %u\n",
+                   o.batch_count, largest, once ? "yes" : "NO", batch_clash, part_clash);
+            CHECK(once && batch_clash == 0 && part_clash == 0 && largest <= SHELL_BATCH && largest > 1);
+            CHECK(o.phase_part[1] == (large ? count / SHELL_PART_MIN : 1));
+            if (large) CHECK(alone < count / 50);
+            free(seen);
+            free(owner);
+            free(mark);
+        }
+        mk_raw_free(&raw);
+    }
+}
+
+/* The sweeps' parts run on several threads: one, two and three threads give the same positions
+ * and volumes bit for bit (10 000 triangles, with collisions, 6 frames). */
+static void thread_count_does_not_change_the_run(void)
+{
+    float *first = NULL;
+    size_t floats = 0;
+    double volume = 0;
+    for (uint32_t threads = 1; threads <= 3; threads++) {
+        mk_raw_asset raw;
+        mk_raw_init(&raw, NULL);
+        const mk_raw_mesh *mesh = make_ball(&raw, 10000);
+        shell_params p = default_params();
+        p.frames = 6;
+        p.pressure = 200;
+        p.thickness = 0.0005;
+        p.threads = threads;
+        shell_mesh m;
+        shell_run run;
+        if (!run_shell(&raw, mesh, &p, NULL, &m, &run)) {
+            mk_raw_free(&raw);
+            break;
+        }
+        size_t n = 3 * (size_t)m.n * (run.frames + 1);
+        double v = run.stats[run.frames].volume_ratio;
+        printf("%u thread%s: V/V0 %.9f after %u frames\n", threads, threads == 1 ? "" : "s", v, run.frames);
+        if (threads == 1) {
+            first = malloc(n * sizeof *first);
+            if (first) memcpy(first, run.positions, n * sizeof *first);
+            floats = n;
+            volume = v;
+        } else {
+            CHECK(first && n == floats && memcmp(first, run.positions, n * sizeof *first) == 0 && v == volume);
+        }
+        CHECK(v < 1);
+        mk_raw_free(&raw);
+    }
+    free(first);
+}
+
 /* ---- triangle-triangle intersection over all non-adjacent pairs, with certain signs ---- */
 
 /* Sign of the orientation determinant (b - a) . ((c - a) x (d - a)), or 0 when rounding could
@@ -682,5 +783,7 @@ CHECK_MAIN(CASE(energy_gradients_match_finite_differences),
            CASE(anisotropic_region_contracts_faster),
            CASE(baked_channel_plays_the_recorded_frames),
            CASE(same_recipe_gives_identical_bytes),
+           CASE(sweep_order_keeps_parts_and_batches_apart),
+           CASE(thread_count_does_not_change_the_run),
            CASE(collisions_keep_every_inbetween_free_of_self_intersections),
            CASE(collisions_hold_at_10000_triangles))
