@@ -17,6 +17,7 @@
 
 #include <stdio.h>
 #include "raw.h"
+#include "parallel.h"
 
 typedef enum shell_material {
     SHELL_STVK, SHELL_COROTATED, SHELL_LINEAR, SHELL_MOONEY_RIVLIN
@@ -183,9 +184,10 @@ shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena);
 /* Collision handling between the collision-free positions x and the new positions p: moves
  * colliding vertices back until no vertex-triangle or edge-edge pair crosses over the step and
  * no vertex is closer than thickness to a triangle it did not start closer to. Returns the hits
- * found (*vt, *ee) and rounds. */
+ * found (*vt, *ee) and rounds. The box tests and the narrow phase run on team (may be NULL);
+ * the result does not depend on it. */
 mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *x, double *p, double thickness,
-                        mk_arena *arena, uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err);
+                        mk_team *team, mk_arena *arena, uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err);
 
 /* Writes the per-frame log as CSV (header line, then one line per frame). */
 int shell_write_log(FILE *f, const shell_run *run);

@@ -34,6 +34,7 @@
 #include <string.h>
 #include "shell.h"
 #include "bake_util.h"
+#include "parallel.h"
 #include "shell_bvh.h"
 #include "shell_ccd.h"
 
@@ -237,25 +238,23 @@ typedef struct collide_ctx {
      * or edge and edge. */
     uint32_t *pairs[2];
     size_t pair_count[2], pair_capacity[2];
+    double *hit_time[2];      /* per candidate: this round's time of impact, or -1 */
+    int round;
     mk_arena *arena;
+    mk_team *team;            /* for the parallel parts (NULL: the caller's thread only) */
     int oom;
 } collide_ctx;
 
-/* One pair: on a hit, the four vertices keep at most 0.8 of the time of impact (round 0) or
- * nothing (later rounds). */
-static void test_pair(collide_ctx *c, int kind, const uint32_t idx[4], int round)
+/* One pair's time of impact this round, or -1 (no hit, or not retested). */
+static double pair_time(const collide_ctx *c, int kind, const uint32_t idx[4], int round)
 {
     /* After the first round only pairs with a vertex pulled back in the previous round can
      * change: the others move as they did when they were tested. */
-    if (round > 0 && !c->moved[idx[0]] && !c->moved[idx[1]] && !c->moved[idx[2]] && !c->moved[idx[3]]) return;
+    if (round > 0 && !c->moved[idx[0]] && !c->moved[idx[1]] && !c->moved[idx[2]] && !c->moved[idx[3]]) return -1;
     const double *s[4], *e[4];
     for (int i = 0; i < 4; i++) { s[i] = c->x + 3 * (size_t)idx[i]; e[i] = c->p + 3 * (size_t)idx[i]; }
     double t = shell_ccd_hit(kind, s, e, c->tol, c->thickness);
-    if (t < 0) return;
-    if (kind == 0) c->vt++; else c->ee++;
-    double keep = round == 0 ? 0.8 * t : 0;
-    for (int i = 0; i < 4; i++)
-        if (keep < c->scale[idx[i]]) c->scale[idx[i]] = keep;
+    return t < 0 ? -1 : t;
 }
 
 /* The four vertices of a candidate: triangle then vertex (kind 0), or edge then edge (kind 1). */
@@ -273,15 +272,56 @@ static void pair_vertices(const shell_mesh *m, int kind, uint32_t a, uint32_t b,
 /* Boxes stored as six values (lo, hi) overlap. */
 static int boxes_overlap(const double *a, const double *b) { return shell_boxes_overlap(a, a + 3, b, b + 3); }
 
-/* Round 0 meets a pair that shares no vertex and whose boxes overlap: it is kept for the later
- * rounds and tested. */
+/* Round 0 meets a pair that shares no vertex and whose boxes overlap: a candidate, tested in
+ * every round (narrow_phase). */
 static void add_candidate(collide_ctx *c, int kind, uint32_t a, uint32_t b)
 {
     if (kind == 1 && b < a) { uint32_t t = a; a = b; b = t; }  /* the smaller edge first: the same rounding either way round */
-    if (!push_pair(c->arena, &c->pairs[kind], &c->pair_count[kind], &c->pair_capacity[kind], a, b)) { c->oom = 1; return; }
-    uint32_t idx[4];
-    pair_vertices(c->m, kind, a, b, idx);
-    test_pair(c, kind, idx, 0);
+    if (!push_pair(c->arena, &c->pairs[kind], &c->pair_count[kind], &c->pair_capacity[kind], a, b)) c->oom = 1;
+}
+
+/* Work split for the team: items of CHUNK list entries. */
+#define CHUNK 2048
+
+static uint32_t chunks(size_t count)
+{
+    return (uint32_t)((count + CHUNK - 1) / CHUNK);
+}
+
+/* The times of impact of candidates [CHUNK item, ...) of both kinds (items of kind 0 first). */
+static void narrow_item(void *user, uint32_t item, uint32_t worker)
+{
+    (void)worker;
+    collide_ctx *c = user;
+    int kind = item >= chunks(c->pair_count[0]);
+    size_t first = (size_t)(item - (kind ? chunks(c->pair_count[0]) : 0)) * CHUNK;
+    size_t last = first + CHUNK < c->pair_count[kind] ? first + CHUNK : c->pair_count[kind];
+    for (size_t i = first; i < last; i++) {
+        uint32_t idx[4];
+        pair_vertices(c->m, kind, c->pairs[kind][2 * i], c->pairs[kind][2 * i + 1], idx);
+        c->hit_time[kind][i] = pair_time(c, kind, idx, c->round);
+    }
+}
+
+/* Every candidate tested this round (on the team), then the hits applied in list order: the
+ * four vertices of a hit keep at most 0.8 of the time of impact (round 0) or nothing (later
+ * rounds). Times and the smallest keep per vertex do not depend on the order, so neither does
+ * the result. */
+static void narrow_phase(collide_ctx *c, int round)
+{
+    c->round = round;
+    mk_team_for(c->team, chunks(c->pair_count[0]) + chunks(c->pair_count[1]), narrow_item, c);
+    for (int kind = 0; kind < 2; kind++)
+        for (size_t i = 0; i < c->pair_count[kind]; i++) {
+            double t = c->hit_time[kind][i];
+            if (t < 0) continue;
+            if (kind == 0) c->vt++; else c->ee++;
+            uint32_t idx[4];
+            pair_vertices(c->m, kind, c->pairs[kind][2 * i], c->pairs[kind][2 * i + 1], idx);
+            double keep = round == 0 ? 0.8 * t : 0;
+            for (int k = 0; k < 4; k++)
+                if (keep < c->scale[idx[k]]) c->scale[idx[k]] = keep;
+        }
 }
 
 /* The vertices owned by slot u against slot s's triangle (the two share no vertex). */
@@ -309,21 +349,59 @@ static void visit_triangles(collide_ctx *c, uint32_t s, uint32_t u)
     }
 }
 
-/* Listed pairs of neighbouring triangles (near, or live) whose boxes overlap: as candidates
- * (c), or copied to out (then c is NULL). */
-static void near_pairs(collide_ctx *c, const shell_collider *col, uint32_t *const lists[2], const size_t counts[2],
-                       uint32_t *out[2], size_t out_count[2])
+/* Box tests of listed pairs on the team: overlap[kind][k] for pair k of lists[kind] (kind 0:
+ * an owned vertex and a slot, kind 1: two owned edges; kind 2: two slots, lists[2] far pairs). */
+typedef struct box_job {
+    const shell_collider *col;
+    const uint32_t *lists[3];
+    size_t counts[3];
+    unsigned char *overlap[3];
+} box_job;
+
+static void box_item(void *user, uint32_t item, uint32_t worker)
+{
+    (void)worker;
+    box_job *j = user;
+    int kind = 0;
+    while (item >= chunks(j->counts[kind])) item -= chunks(j->counts[kind++]);
+    const shell_collider *col = j->col;
+    const double *boxes_a = kind == 0 ? col->vertex_boxes : kind == 1 ? col->edge_boxes : col->tri_boxes;
+    const double *boxes_b = kind == 0 ? col->tri_boxes : kind == 1 ? col->edge_boxes : col->tri_boxes;
+    size_t first = (size_t)item * CHUNK, last = first + CHUNK < j->counts[kind] ? first + CHUNK : j->counts[kind];
+    const uint32_t *list = j->lists[kind];
+    for (size_t k = first; k < last; k++)
+        j->overlap[kind][k] = (unsigned char)boxes_overlap(boxes_a + 6 * (size_t)list[2 * k], boxes_b + 6 * (size_t)list[2 * k + 1]);
+}
+
+/* The overlap flags of the near lists (and the far list when far is nonzero), tested on the
+ * team; 0 when out of memory. */
+static int box_tests(collide_ctx *c, mk_team *team, const shell_collider *col, uint32_t *const lists[2],
+                     const size_t counts[2], int far, box_job *j)
+{
+    memset(j, 0, sizeof *j);
+    j->col = col;
+    for (int kind = 0; kind < 3; kind++) {
+        j->lists[kind] = kind < 2 ? lists[kind] : far ? col->far : NULL;
+        j->counts[kind] = kind < 2 ? counts[kind] : far ? col->far_count : 0;
+        j->overlap[kind] = mk_arena_array(c->arena, j->counts[kind] + 1, 1);
+        if (!j->overlap[kind]) return 0;
+    }
+    mk_team_for(team, chunks(j->counts[0]) + chunks(j->counts[1]) + chunks(j->counts[2]), box_item, j);
+    return 1;
+}
+
+/* Listed pairs of neighbouring triangles (near, or live) whose boxes overlap (flags from
+ * box_tests), in list order: as candidates (c), or copied to out (then c is NULL). */
+static void near_pairs(collide_ctx *c, const shell_collider *col, const box_job *j, uint32_t *out[2], size_t out_count[2])
 {
     for (int kind = 0; kind < 2; kind++) {
-        const uint32_t *list = lists[kind];
-        for (size_t k = 0; k < counts[kind]; k++) {
-            uint32_t i = list[2 * k], j = list[2 * k + 1];
-            const double *a = kind == 0 ? col->vertex_boxes + 6 * (size_t)i : col->edge_boxes + 6 * (size_t)i;
-            const double *b = kind == 0 ? col->tri_boxes + 6 * (size_t)j : col->edge_boxes + 6 * (size_t)j;
-            if (!boxes_overlap(a, b)) continue;
-            if (!c) put_pair(out[kind], &out_count[kind], i, j);
-            else if (kind == 0) add_candidate(c, 0, col->slot_tri[j], col->owned_vertices[i]);
-            else add_candidate(c, 1, col->owned_edges[i], col->owned_edges[j]);
+        const uint32_t *list = j->lists[kind];
+        for (size_t k = 0; k < j->counts[kind]; k++) {
+            if (!j->overlap[kind][k]) continue;
+            uint32_t i = list[2 * k], jj = list[2 * k + 1];
+            if (!c) put_pair(out[kind], &out_count[kind], i, jj);
+            else if (kind == 0) add_candidate(c, 0, col->slot_tri[jj], col->owned_vertices[i]);
+            else add_candidate(c, 1, col->owned_edges[i], col->owned_edges[jj]);
         }
     }
 }
@@ -381,12 +459,34 @@ static void union_box(const double *vertex_box, const uint32_t *idx, int k, doub
     for (int c = 0; c < 3; c++) { box[c] -= pad; box[3 + c] += pad; }
 }
 
-/* Every slot's, owned vertex's and owned edge's box from their vertices' boxes, inflated by pad. */
-static void all_boxes(shell_collider *col, const shell_mesh *m, const double *vertex_box, double pad)
+/* Every slot's, owned vertex's and owned edge's box from their vertices' boxes, inflated by pad:
+ * CHUNK of them per item (slots, then vertices, then edges), on the team. */
+typedef struct boxes_job {
+    shell_collider *col;
+    const shell_mesh *m;
+    const double *vertex_box;
+    double pad;
+} boxes_job;
+
+static void boxes_item(void *user, uint32_t item, uint32_t worker)
 {
-    for (uint32_t s = 0; s < m->tri_count; s++) union_box(vertex_box, col->slot_corners + 3 * (size_t)s, 3, pad, col->tri_boxes + 6 * (size_t)s);
-    for (uint32_t i = 0; i < m->n; i++) union_box(vertex_box, col->owned_vertices + i, 1, pad, col->vertex_boxes + 6 * (size_t)i);
-    for (uint32_t i = 0; i < m->hinge_count; i++) union_box(vertex_box, col->edge_ends + 2 * (size_t)i, 2, pad, col->edge_boxes + 6 * (size_t)i);
+    (void)worker;
+    boxes_job *j = user;
+    shell_collider *col = j->col;
+    uint32_t counts[3] = { j->m->tri_count, j->m->n, j->m->hinge_count }, kind = 0;
+    while (item >= chunks(counts[kind])) item -= chunks(counts[kind++]);
+    uint32_t first = item * CHUNK, last = first + CHUNK < counts[kind] ? first + CHUNK : counts[kind];
+    for (uint32_t i = first; i < last; i++) {
+        if (kind == 0) union_box(j->vertex_box, col->slot_corners + 3 * (size_t)i, 3, j->pad, col->tri_boxes + 6 * (size_t)i);
+        else if (kind == 1) union_box(j->vertex_box, col->owned_vertices + i, 1, j->pad, col->vertex_boxes + 6 * (size_t)i);
+        else union_box(j->vertex_box, col->edge_ends + 2 * (size_t)i, 2, j->pad, col->edge_boxes + 6 * (size_t)i);
+    }
+}
+
+static void all_boxes(mk_team *team, shell_collider *col, const shell_mesh *m, const double *vertex_box, double pad)
+{
+    boxes_job j = { col, m, vertex_box, pad };
+    mk_team_for(team, chunks(m->tri_count) + chunks(m->n) + chunks(m->hinge_count), boxes_item, &j);
 }
 
 static void collect_far(void *user, uint32_t s, uint32_t u)
@@ -398,13 +498,15 @@ static void collect_far(void *user, uint32_t s, uint32_t u)
 /* The far pairs again: the slots' boxes from their corners' ranges (inflated by the thickness),
  * one traversal. A slot's box this step (from x, p inside the ranges, inflated by the same
  * thickness) lies inside, the rounding of the inflation being monotonic. 0 when out of memory. */
-static int far_rebuild(shell_collider *col, const shell_mesh *m, const double *x, const double *p, double thickness,
-                       double margin)
+static int far_rebuild(collide_ctx *c, shell_collider *col, const shell_mesh *m, const double *x, const double *p,
+                       double thickness, double margin)
 {
     far_ranges(col, m->n, x, p, margin);
-    all_boxes(col, m, col->far_range, thickness);
+    all_boxes(c->team, col, m, col->far_range, thickness);
     col->live_count[0] = col->live_count[1] = 0;
-    near_pairs(NULL, col, col->near, col->near_count, col->live, col->live_count);
+    box_job j;
+    if (!box_tests(c, c->team, col, col->near, col->near_count, 0, &j)) return 0;
+    near_pairs(NULL, col, &j, col->live, col->live_count);
     shell_bvh_refit(&col->tree);
     col->far_count = 0;
     col->far_oom = 0;
@@ -418,18 +520,16 @@ static void visit_direct(void *user, uint32_t s, uint32_t u)
     visit_triangles(user, s, u);
 }
 
-/* The far pairs whose boxes overlap this step. */
-static void far_pairs(collide_ctx *c)
+/* The far pairs whose boxes overlap this step (flags from box_tests), in list order. */
+static void far_pairs(collide_ctx *c, const box_job *j)
 {
     const shell_collider *col = c->col;
-    for (size_t k = 0; k < col->far_count; k++) {
-        uint32_t s = col->far[2 * k], u = col->far[2 * k + 1];
-        if (boxes_overlap(col->tri_boxes + 6 * (size_t)s, col->tri_boxes + 6 * (size_t)u)) visit_triangles(c, s, u);
-    }
+    for (size_t k = 0; k < col->far_count; k++)
+        if (j->overlap[2][k]) visit_triangles(c, col->far[2 * k], col->far[2 * k + 1]);
 }
 
 mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *x, double *p, double thickness,
-                        mk_arena *arena, uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err)
+                        mk_team *team, mk_arena *arena, uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err)
 {
     *vt = *ee = *rounds = 0;
     mk_arena local;
@@ -447,7 +547,7 @@ mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *
     collide_ctx c;
     memset(&c, 0, sizeof c);
     c.m = m; c.col = col; c.x = x; c.p = p; c.thickness = thickness; c.tol = fmax(thickness, 1e-9 * mean);
-    c.scale = scale; c.moved = moved; c.arena = &local;
+    c.scale = scale; c.moved = moved; c.arena = &local; c.team = team;
     /* Broad phase, once: later rounds only pull vertices back along their steps, so their swept
      * boxes lie inside round 0's and round 0's candidates are all the pairs that can meet. */
     int direct = 0;
@@ -461,35 +561,35 @@ mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *
         col->direct_left = FAR_PAUSE - 1;
         direct = 1;
     } else {
-        if (!far_rebuild(col, m, x, p, thickness, FAR_MARGIN * mean)) {
+        if (!far_rebuild(&c, col, m, x, p, thickness, FAR_MARGIN * mean)) {
             mk_arena_free_all(&local);
             return mk_error_oom(err, "shell collisions (candidate pairs)");
         }
         col->far_frames = 1;
     }
     for (uint32_t v = 0; v < m->n; v++) swept_box(x, p, &v, 1, 0, col->step_box + 6 * (size_t)v, col->step_box + 6 * (size_t)v + 3);
-    all_boxes(col, m, col->step_box, thickness);
+    all_boxes(team, col, m, col->step_box, thickness);
     for (int round = 0; round < MAX_ROUNDS; round++) {
         for (uint32_t v = 0; v < m->n; v++) scale[v] = 1;
         uint32_t before = c.vt + c.ee;
         if (round == 0) {
-            if (direct) near_pairs(&c, col, col->near, col->near_count, NULL, NULL);
-            else near_pairs(&c, col, col->live, col->live_count, NULL, NULL);
-            if (direct) {
-                shell_bvh_refit(&col->tree);
-                shell_bvh_self_pairs(&col->tree, col->slot_corners, visit_direct, &c);
-            } else {
-                far_pairs(&c);
-            }
-            if (c.oom) { mk_arena_free_all(&local); return mk_error_oom(err, "shell collisions (candidate pairs)"); }
-        } else {
-            for (int kind = 0; kind < 2; kind++)
-                for (size_t i = 0; i < c.pair_count[kind]; i++) {
-                    uint32_t idx[4];
-                    pair_vertices(m, kind, c.pairs[kind][2 * i], c.pairs[kind][2 * i + 1], idx);
-                    test_pair(&c, kind, idx, round);
+            box_job j;
+            if (!box_tests(&c, team, col, direct ? col->near : col->live, direct ? col->near_count : col->live_count, !direct, &j))
+                c.oom = 1;
+            else {
+                near_pairs(&c, col, &j, NULL, NULL);
+                if (direct) {
+                    shell_bvh_refit(&col->tree);
+                    shell_bvh_self_pairs(&col->tree, col->slot_corners, visit_direct, &c);
+                } else {
+                    far_pairs(&c, &j);
                 }
+            }
+            for (int kind = 0; kind < 2 && !c.oom; kind++)
+                if (!(c.hit_time[kind] = mk_arena_array(&local, c.pair_count[kind] + 1, sizeof(double)))) c.oom = 1;
+            if (c.oom) { mk_arena_free_all(&local); return mk_error_oom(err, "shell collisions (candidate pairs)"); }
         }
+        narrow_phase(&c, round);
         *rounds = (uint32_t)round + 1;
         if (c.vt + c.ee == before) break;
         /* Response: pull the hit vertices back along their step. */

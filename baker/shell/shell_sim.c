@@ -256,7 +256,7 @@ static mk_result simulate(shell_state *sp, mk_arena *arena, void (*progress)(voi
         }
         double tc = bake_now();
         if (p->thickness > 0) {
-            r = shell_collide(collider, m, x, q, p->thickness, arena, &st->vt_hits, &st->ee_hits, &st->collision_rounds, err);
+            r = shell_collide(collider, m, x, q, p->thickness, s.team, arena, &st->vt_hits, &st->ee_hits, &st->collision_rounds, err);
             if (r != MK_OK) return r;
         }
         st->ms_collision = 1000 * (bake_now() - tc);
