@@ -79,7 +79,7 @@ typedef struct mk_bake_options {
      * mk_import_load_asset (formats/import.h), tests may hand over models built in memory. NULL: `transfer`
      * ops fail with an error naming the field. */
     mk_result (*load_asset)(void *user, const char *path, mk_raw_asset *out, mk_error *err);
-    /* Threads for the parts of a bake that run in parallel (the `shell` simulation's sweeps);
+    /* Threads for the parts of a bake that run in parallel (the `shell` simulation's sweeps and collision tests);
      * 0 = one per core. The result is the same for any count. */
     uint32_t threads;
 } mk_bake_options;

@@ -76,14 +76,18 @@ void mk_parallel_for(uint32_t items, uint32_t threads, mk_parallel_fn fn, void *
     for (uint32_t i = 0; i < started; i++) thrd_join(ids[i], NULL);
 }
 
-/* The team: workers 1 .. count - 1 wait for the generation to change, drain the loop, and the
- * last one out wakes the caller. Waiting spins for a moment first (a sweep's loops come every few
- * hundred microseconds; a sleep and wake-up costs tens of them), then sleeps. */
+/* The team: the caller opens a loop (a new generation), drains it with whoever joins, closes it
+ * and waits for the workers that joined. A worker joins a loop only while it is open, so the
+ * caller never waits for a worker that is not running (another process may hold its core: then
+ * the caller does the whole loop itself). Waiting spins for a moment first (a sweep's loops
+ * come every few hundred microseconds; a sleep and wake-up costs tens of them), then sleeps. The
+ * loop's fields change only while no worker is in it. */
 struct mk_team {
     mtx_t lock;
     cnd_t start, done;
-    atomic_ulong generation;  /* loops started; changed under lock */
-    atomic_uint running;      /* workers still in the current loop */
+    atomic_ulong generation;  /* loops opened; changed under lock */
+    atomic_uint active;       /* workers in the current loop; changed under lock */
+    int closed;               /* the current loop takes no more workers; under lock */
     atomic_int stop;
     loop l;
     uint32_t count;           /* threads, the caller included */
@@ -94,8 +98,14 @@ struct mk_team {
 
 #define TEAM_SPINS 20000
 
-static void spin_pause(void)
+/* One turn of a spin: a pause, and every 64th turn the core to whoever waits for it (more
+ * threads than free cores: a spinning thread must not keep out the one it waits for). */
+static void spin_pause(int turn)
 {
+    if ((turn & 63) == 63) {
+        thrd_yield();
+        return;
+    }
 #if defined(__x86_64__) || defined(__i386__)
     __builtin_ia32_pause();
 #endif
@@ -107,18 +117,22 @@ static int team_main(void *p)
     mk_team *t = w->team;
     unsigned long seen = 0;
     for (;;) {
-        for (int i = 0; i < TEAM_SPINS && atomic_load(&t->generation) == seen && !atomic_load(&t->stop); i++) spin_pause();
+        for (int i = 0; i < TEAM_SPINS && atomic_load(&t->generation) == seen && !atomic_load(&t->stop); i++) spin_pause(i);
         mtx_lock(&t->lock);
         while (atomic_load(&t->generation) == seen && !atomic_load(&t->stop)) cnd_wait(&t->start, &t->lock);
-        mtx_unlock(&t->lock);
-        if (atomic_load(&t->stop)) return 0;
-        seen = atomic_load(&t->generation);
-        drain(&t->l, w->index);
-        if (atomic_fetch_sub(&t->running, 1u) == 1u) {
-            mtx_lock(&t->lock);
-            cnd_signal(&t->done);
+        if (atomic_load(&t->stop)) {
             mtx_unlock(&t->lock);
+            return 0;
         }
+        seen = atomic_load(&t->generation);
+        int join = !t->closed;
+        if (join) atomic_fetch_add(&t->active, 1u);
+        mtx_unlock(&t->lock);
+        if (!join) continue;  /* the loop was done without this worker */
+        drain(&t->l, w->index);
+        mtx_lock(&t->lock);
+        if (atomic_fetch_sub(&t->active, 1u) == 1u) cnd_signal(&t->done);
+        mtx_unlock(&t->lock);
     }
 }
 
@@ -130,7 +144,7 @@ mk_team *mk_team_create(uint32_t threads)
     if (!t) return NULL;
     atomic_init(&t->l.next, 0u);
     atomic_init(&t->generation, 0ul);
-    atomic_init(&t->running, 0u);
+    atomic_init(&t->active, 0u);
     atomic_init(&t->stop, 0);
     if (mtx_init(&t->lock, mtx_plain) != thrd_success) {
         free(t);
@@ -166,20 +180,24 @@ void mk_team_for(mk_team *t, uint32_t items, mk_parallel_fn fn, void *user)
         for (uint32_t i = 0; i < items; i++) fn(user, i, 0);
         return;
     }
-    /* No worker is in a loop here (the last call waited for all of them). */
+    mtx_lock(&t->lock);
+    /* No worker is in a loop here: the last call waited for those that joined it. */
     atomic_store(&t->l.next, 0u);
     t->l.items = items;
     t->l.fn = fn;
     t->l.user = user;
-    atomic_store(&t->running, t->started);
-    mtx_lock(&t->lock);
+    t->closed = 0;
     atomic_fetch_add(&t->generation, 1ul);
     cnd_broadcast(&t->start);
     mtx_unlock(&t->lock);
     drain(&t->l, 0);
-    for (int i = 0; i < TEAM_SPINS && atomic_load(&t->running) > 0; i++) spin_pause();
+    /* Every item is taken: close the loop, then wait for the workers still in it. */
     mtx_lock(&t->lock);
-    while (atomic_load(&t->running) > 0) cnd_wait(&t->done, &t->lock);
+    t->closed = 1;
+    mtx_unlock(&t->lock);
+    for (int i = 0; i < TEAM_SPINS && atomic_load(&t->active) > 0; i++) spin_pause(i);
+    mtx_lock(&t->lock);
+    while (atomic_load(&t->active) > 0) cnd_wait(&t->done, &t->lock);
     mtx_unlock(&t->lock);
 }
 

@@ -28,7 +28,8 @@ static const cli_option options[] = {
     { "--all-meshes", NULL, CLI_FLAG, offsetof(bake_args, all_meshes),
       "Also write meshes that end up without channels (by default they are left out).", NULL, NULL, 0, 0, 0, 0 },
     { "--threads", "N", CLI_UINT, offsetof(bake_args, threads),
-      "Threads for the parts of a bake that run in parallel (the shell simulation's sweeps); 0 = one per core. "
+      "Threads for the parts of a bake that run in parallel (the shell simulation's sweeps and collision tests); 0 = one per core; "
+      "where other processes keep the cores busy, 1 can be faster. "
       "The blob is the same for any count.",
       "0", NULL, 0, 64, 0, 0 },
     { "--depfile", "PATH", CLI_STRING, offsetof(bake_args, depfile),

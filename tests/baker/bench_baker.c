@@ -152,6 +152,7 @@ static int shell_bench(uint32_t segments, uint32_t rings, double thickness, uint
     memset(&p, 0, sizeof p);
     p.pressure = pressure; p.dt = 0.01; p.frames = frames; p.ramp = 1; p.iterations = 5; p.density = 1; p.damping = 0.02;
     p.material = SHELL_STVK; p.mu = 100; p.lambda = 100; p.kB = kB; p.epsilon = 0.05; p.thickness = thickness;
+    if (getenv("BENCH_SHELL_THREADS")) p.threads = (uint32_t)atoi(getenv("BENCH_SHELL_THREADS"));  /* 0: one per core */
     shell_mesh m;
     shell_run run;
     mk_error err;
