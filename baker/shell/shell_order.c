@@ -106,5 +106,11 @@ mk_result shell_sweep_order_build(const uint32_t *idx, int k, uint32_t count, ui
     }
     out->phase_part[out->phase_count] = out->part_count;
     out->part_batch[out->part_count] = out->batch_count;
+    mk_arena_release(arena, stamp);
+    mk_arena_release(arena, owner);
+    mk_arena_release(arena, next);
+    mk_arena_release(arena, part);
+    mk_arena_release(arena, list);
+    mk_arena_release(arena, group);
     return MK_OK;
 }

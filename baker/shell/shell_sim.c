@@ -2,8 +2,9 @@
 /* The frame loop of the shell simulation (shell.h): per substep (shell_steps.c) prediction under
  * pressure, Gauss-Seidel sweeps over the energy constraints (XPBD, C = sqrt(2 W), compliance 1)
  * and velocities from positions; per frame collision handling over the frame's motion and the
- * per-frame record. Single-threaded and in a fixed order, so
- * a run is reproducible bit for bit. */
+ * per-frame record. The sweeps (in the order of shell_order.c) and the collision tests run on a
+ * team of threads in a way that gives the same result for any thread count, so a run is
+ * reproducible bit for bit. */
 #include <math.h>
 #include <string.h>
 #include "shell.h"
