@@ -35,9 +35,8 @@ typedef struct loop {
 } loop;
 
 typedef struct worker {
-    loop *l;
+    mk_team *team;
     uint32_t index;
-    mk_team *team;            /* a team's worker (mk_team_create), else NULL */
 } worker;
 
 static void drain(loop *l, uint32_t index)
@@ -49,31 +48,12 @@ static void drain(loop *l, uint32_t index)
     }
 }
 
-static int worker_main(void *p)
-{
-    worker *w = p;
-    drain(w->l, w->index);
-    return 0;
-}
-
+/* One loop on a team made for it (one piece of code for both kinds of loop). */
 void mk_parallel_for(uint32_t items, uint32_t threads, mk_parallel_fn fn, void *user)
 {
-    uint32_t n = mk_parallel_threads(threads, items);
-    loop l;
-    atomic_init(&l.next, 0u);
-    l.items = items;
-    l.fn = fn;
-    l.user = user;
-    thrd_t ids[MK_PARALLEL_MAX_THREADS];
-    worker workers[MK_PARALLEL_MAX_THREADS];
-    uint32_t started = 0;
-    for (uint32_t i = 1; i < n; i++) {
-        workers[started] = (worker){ &l, started + 1, NULL };
-        if (thrd_create(&ids[started], worker_main, &workers[started]) != thrd_success) break;
-        started++;
-    }
-    drain(&l, 0);
-    for (uint32_t i = 0; i < started; i++) thrd_join(ids[i], NULL);
+    mk_team *team = mk_team_create(mk_parallel_threads(threads, items));
+    mk_team_for(team, items, fn, user);
+    mk_team_destroy(team);
 }
 
 /* The team: the caller opens a loop (a new generation), drains it with whoever joins, closes it
@@ -162,7 +142,7 @@ mk_team *mk_team_create(uint32_t threads)
         return NULL;
     }
     for (uint32_t i = 1; i < n; i++) {
-        t->workers[t->started] = (worker){ &t->l, t->started + 1, t };
+        t->workers[t->started] = (worker){ t, t->started + 1 };
         if (thrd_create(&t->ids[t->started], team_main, &t->workers[t->started]) != thrd_success) break;
         t->started++;
     }

@@ -52,7 +52,7 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
             if (mk_entry_target(en) != local) continue;
             const int q = mk_entry_quantized(en);   /* per entry: a quantized target's outliers are float */
             uint32_t m = mk_popcount64(en->mask);
-            size_t attr = (size_t)m * 3 * (q ? 2 : 4);
+            size_t attr = (size_t)mk_entry_data_size(mk_entry_flags(0, q), m);  /* one attribute's bytes */
             const uint8_t *p = a->data + bm->target_data + (size_t)en->data * MK_ALIGN;
             uint32_t j = 0;
             for (uint64_t bits = en->mask; bits; bits &= bits - 1, j++) {

@@ -125,7 +125,6 @@ typedef struct target_plan {
     /* A quantized target's entries whose largest |position component| exceeds this are
      * float32 (INFINITY: none). */
     float entry_limit;
-    uint32_t float_entries;            /* how many (counted by the plan) */
     double tolerance;                  /* the mesh's */
 } target_plan;
 
@@ -157,23 +156,22 @@ static void plan_entries(const mk_raw_target *t, target_plan *p)
 {
     const float limit = entry_limit_for(p->tolerance);
     float pm = 0, nm = 0, tm = 0;
-    uint32_t int16_entries = 0, float_entries = 0;
+    int any_int16 = 0, any_float = 0;
     for (uint32_t first = 0; first < t->count;) {
         const uint32_t start = t->indices[first] / MK_BLOCK_SIZE * MK_BLOCK_SIZE;
         const uint32_t end = block_end(t, first, start + MK_BLOCK_SIZE);
         const size_t at = 3u * (size_t)first, n = 3u * (size_t)(end - first);
         const float bm = max_abs(t->positions + at, n);
         first = end;
-        if (bm > limit) { float_entries++; continue; }
-        int16_entries++;
+        if (bm > limit) { any_float = 1; continue; }
+        any_int16 = 1;
         pm = bm > pm ? bm : pm;
         if (t->normals) { float x = max_abs(t->normals + at, n); nm = x > nm ? x : nm; }
         if (t->tangents) { float x = max_abs(t->tangents + at, n); tm = x > tm ? x : tm; }
     }
-    if (!int16_entries) return;
+    if (!any_int16) return;
     p->flags |= MK_TARGET_QUANTIZED;
-    p->entry_limit = limit;
-    p->float_entries = float_entries;
+    p->entry_limit = any_float ? limit : INFINITY;  /* no block above it: the later passes need not look */
     p->position_scale = quant_scale(pm);
     if (t->normals) p->normal_scale = quant_scale(nm);
     if (t->tangents) p->tangent_scale = quant_scale(tm);

@@ -67,10 +67,8 @@ void cli_progress_init(cli_progress *p, int quiet);
 void cli_progress_update(cli_progress *p, const char *stage, double fraction);
 double cli_now_seconds(void);
 
-/* Targets stored quantized and as float, block entries stored as float (those of float targets
- * and a quantized target's outlier blocks), and the largest position error the quantized
- * steps allow (half a step). */
-void cli_precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *floats, uint64_t *float_entries,
-                      double *max_error_bound);
+/* Targets stored quantized and as float, and the largest position error the quantized steps
+ * allow (half a step). */
+void cli_precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *floats, double *max_error_bound);
 
 #endif

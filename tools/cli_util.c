@@ -153,13 +153,10 @@ void cli_progress_update(cli_progress *p, const char *stage, double fraction)
     fprintf(stderr, "  %s: %3d%%\n", stage, tenth * 10);
 }
 
-void cli_precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *floats, uint64_t *float_entries,
-                      double *max_error_bound)
+void cli_precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *floats, double *max_error_bound)
 {
     *quantized = *floats = 0;
-    *float_entries = 0;
     *max_error_bound = 0;
-    for (uint32_t i = 0; i < a->mesh_count; i++) *float_entries += mk_mesh_float_entries(a, i);
     for (uint32_t c = 0; c < a->channel_count; c++) {
         mk_channel_info ch;
         mk_channel_get(a, c, &ch);

@@ -253,9 +253,8 @@ static int run_bench(void *p)
         mk_raw_init(&bare.raw, NULL);
         mk_error bare_err;
         uint32_t quantized, floats;
-        uint64_t float_entries;
         double step_error;
-        cli_precision_of(a, &quantized, &floats, &float_entries, &step_error);
+        cli_precision_of(a, &quantized, &floats, &step_error);
         const mk_write_options bare_write = { .precision = quantized ? MK_PRECISION_Q16 : MK_PRECISION_FLOAT };
         mk_result br = mk_read_blob(a, &bare.raw, &bare_err);
         if (br == MK_OK) {

@@ -10,13 +10,21 @@
 #include "frame_write.h"
 #include "json_write.h"
 
+/* Block entries of quantized targets stored as float32, over all meshes (mk_mesh_float_entries). */
+static uint64_t float_entries(const mk_asset *a)
+{
+    uint64_t n = 0;
+    for (uint32_t i = 0; i < a->mesh_count; i++) n += mk_mesh_float_entries(a, i);
+    return n;
+}
+
 static void print_text(FILE *f, const pb_asset *l, const char *path)
 {
     const mk_asset *a = &l->asset;
     uint32_t nq, nf;
-    uint64_t fe;
     double bound;
-    cli_precision_of(a, &nq, &nf, &fe, &bound);
+    cli_precision_of(a, &nq, &nf, &bound);
+    uint64_t fe = float_entries(a);
     fprintf(f, "%s: %zu bytes, format v%u\n", path, l->blob_size, MK_FORMAT_VERSION);
     if (l->imported) {
         fprintf(f, "source: %s%s%s\n", l->raw.source_format[0] ? l->raw.source_format : "?",
@@ -65,9 +73,9 @@ static void print_json(FILE *f, const pb_asset *l, const char *path)
 {
     const mk_asset *a = &l->asset;
     uint32_t nq, nf;
-    uint64_t fe;
     double bound;
-    cli_precision_of(a, &nq, &nf, &fe, &bound);
+    cli_precision_of(a, &nq, &nf, &bound);
+    uint64_t fe = float_entries(a);
     json_writer w;
     json_begin(&w, f, 1);
     json_object(&w, NULL);

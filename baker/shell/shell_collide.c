@@ -288,14 +288,31 @@ static uint32_t chunks(size_t count)
     return (uint32_t)((count + CHUNK - 1) / CHUNK);
 }
 
+/* The items of a loop over `lists` lists of counts[] entries, one list after the other. */
+static uint32_t chunks_of(const size_t *counts, int lists)
+{
+    uint32_t n = 0;
+    for (int l = 0; l < lists; l++) n += chunks(counts[l]);
+    return n;
+}
+
+/* Item `item` of such a loop: which list, and its entries [*first, *last). */
+static int chunk_range(uint32_t item, const size_t *counts, size_t *first, size_t *last)
+{
+    int list = 0;
+    while (item >= chunks(counts[list])) item -= chunks(counts[list++]);
+    *first = (size_t)item * CHUNK;
+    *last = *first + CHUNK < counts[list] ? *first + CHUNK : counts[list];
+    return list;
+}
+
 /* The times of impact of candidates [CHUNK item, ...) of both kinds (items of kind 0 first). */
 static void narrow_item(void *user, uint32_t item, uint32_t worker)
 {
     (void)worker;
     collide_ctx *c = user;
-    int kind = item >= chunks(c->pair_count[0]);
-    size_t first = (size_t)(item - (kind ? chunks(c->pair_count[0]) : 0)) * CHUNK;
-    size_t last = first + CHUNK < c->pair_count[kind] ? first + CHUNK : c->pair_count[kind];
+    size_t first, last;
+    int kind = chunk_range(item, c->pair_count, &first, &last);
     for (size_t i = first; i < last; i++) {
         uint32_t idx[4];
         pair_vertices(c->m, kind, c->pairs[kind][2 * i], c->pairs[kind][2 * i + 1], idx);
@@ -310,7 +327,7 @@ static void narrow_item(void *user, uint32_t item, uint32_t worker)
 static void narrow_phase(collide_ctx *c, int round)
 {
     c->round = round;
-    mk_team_for(c->team, chunks(c->pair_count[0]) + chunks(c->pair_count[1]), narrow_item, c);
+    mk_team_for(c->team, chunks_of(c->pair_count, 2), narrow_item, c);
     for (int kind = 0; kind < 2; kind++)
         for (size_t i = 0; i < c->pair_count[kind]; i++) {
             double t = c->hit_time[kind][i];
@@ -362,12 +379,11 @@ static void box_item(void *user, uint32_t item, uint32_t worker)
 {
     (void)worker;
     box_job *j = user;
-    int kind = 0;
-    while (item >= chunks(j->counts[kind])) item -= chunks(j->counts[kind++]);
+    size_t first, last;
+    int kind = chunk_range(item, j->counts, &first, &last);
     const shell_collider *col = j->col;
     const double *boxes_a = kind == 0 ? col->vertex_boxes : kind == 1 ? col->edge_boxes : col->tri_boxes;
     const double *boxes_b = kind == 0 ? col->tri_boxes : kind == 1 ? col->edge_boxes : col->tri_boxes;
-    size_t first = (size_t)item * CHUNK, last = first + CHUNK < j->counts[kind] ? first + CHUNK : j->counts[kind];
     const uint32_t *list = j->lists[kind];
     for (size_t k = first; k < last; k++)
         j->overlap[kind][k] = (unsigned char)boxes_overlap(boxes_a + 6 * (size_t)list[2 * k], boxes_b + 6 * (size_t)list[2 * k + 1]);
@@ -375,9 +391,9 @@ static void box_item(void *user, uint32_t item, uint32_t worker)
 
 /* The overlap flags of the near lists (and the far list when far is nonzero), tested on the
  * team; 0 when out of memory. */
-static int box_tests(collide_ctx *c, mk_team *team, const shell_collider *col, uint32_t *const lists[2],
-                     const size_t counts[2], int far, box_job *j)
+static int box_tests(collide_ctx *c, uint32_t *const lists[2], const size_t counts[2], int far, box_job *j)
 {
+    const shell_collider *col = c->col;
     memset(j, 0, sizeof *j);
     j->col = col;
     for (int kind = 0; kind < 3; kind++) {
@@ -386,7 +402,7 @@ static int box_tests(collide_ctx *c, mk_team *team, const shell_collider *col, u
         j->overlap[kind] = mk_arena_array(c->arena, j->counts[kind] + 1, 1);
         if (!j->overlap[kind]) return 0;
     }
-    mk_team_for(team, chunks(j->counts[0]) + chunks(j->counts[1]) + chunks(j->counts[2]), box_item, j);
+    mk_team_for(c->team, chunks_of(j->counts, 3), box_item, j);
     return 1;
 }
 
@@ -463,9 +479,9 @@ static void union_box(const double *vertex_box, const uint32_t *idx, int k, doub
  * CHUNK of them per item (slots, then vertices, then edges), on the team. */
 typedef struct boxes_job {
     shell_collider *col;
-    const shell_mesh *m;
     const double *vertex_box;
     double pad;
+    size_t counts[3];         /* slots, vertices, edges */
 } boxes_job;
 
 static void boxes_item(void *user, uint32_t item, uint32_t worker)
@@ -473,10 +489,9 @@ static void boxes_item(void *user, uint32_t item, uint32_t worker)
     (void)worker;
     boxes_job *j = user;
     shell_collider *col = j->col;
-    uint32_t counts[3] = { j->m->tri_count, j->m->n, j->m->hinge_count }, kind = 0;
-    while (item >= chunks(counts[kind])) item -= chunks(counts[kind++]);
-    uint32_t first = item * CHUNK, last = first + CHUNK < counts[kind] ? first + CHUNK : counts[kind];
-    for (uint32_t i = first; i < last; i++) {
+    size_t first, last;
+    int kind = chunk_range(item, j->counts, &first, &last);
+    for (size_t i = first; i < last; i++) {
         if (kind == 0) union_box(j->vertex_box, col->slot_corners + 3 * (size_t)i, 3, j->pad, col->tri_boxes + 6 * (size_t)i);
         else if (kind == 1) union_box(j->vertex_box, col->owned_vertices + i, 1, j->pad, col->vertex_boxes + 6 * (size_t)i);
         else union_box(j->vertex_box, col->edge_ends + 2 * (size_t)i, 2, j->pad, col->edge_boxes + 6 * (size_t)i);
@@ -485,8 +500,8 @@ static void boxes_item(void *user, uint32_t item, uint32_t worker)
 
 static void all_boxes(mk_team *team, shell_collider *col, const shell_mesh *m, const double *vertex_box, double pad)
 {
-    boxes_job j = { col, m, vertex_box, pad };
-    mk_team_for(team, chunks(m->tri_count) + chunks(m->n) + chunks(m->hinge_count), boxes_item, &j);
+    boxes_job j = { col, vertex_box, pad, { m->tri_count, m->n, m->hinge_count } };
+    mk_team_for(team, chunks_of(j.counts, 3), boxes_item, &j);
 }
 
 static void collect_far(void *user, uint32_t s, uint32_t u)
@@ -498,14 +513,15 @@ static void collect_far(void *user, uint32_t s, uint32_t u)
 /* The far pairs again: the slots' boxes from their corners' ranges (inflated by the thickness),
  * one traversal. A slot's box this step (from x, p inside the ranges, inflated by the same
  * thickness) lies inside, the rounding of the inflation being monotonic. 0 when out of memory. */
-static int far_rebuild(collide_ctx *c, shell_collider *col, const shell_mesh *m, const double *x, const double *p,
-                       double thickness, double margin)
+static int far_rebuild(collide_ctx *c, shell_collider *col, const double *x, const double *p, double thickness,
+                       double margin)
 {
+    const shell_mesh *m = c->m;
     far_ranges(col, m->n, x, p, margin);
     all_boxes(c->team, col, m, col->far_range, thickness);
     col->live_count[0] = col->live_count[1] = 0;
     box_job j;
-    if (!box_tests(c, c->team, col, col->near, col->near_count, 0, &j)) return 0;
+    if (!box_tests(c, col->near, col->near_count, 0, &j)) return 0;
     near_pairs(NULL, col, &j, col->live, col->live_count);
     shell_bvh_refit(&col->tree);
     col->far_count = 0;
@@ -561,7 +577,7 @@ mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *
         col->direct_left = FAR_PAUSE - 1;
         direct = 1;
     } else {
-        if (!far_rebuild(&c, col, m, x, p, thickness, FAR_MARGIN * mean)) {
+        if (!far_rebuild(&c, col, x, p, thickness, FAR_MARGIN * mean)) {
             mk_arena_free_all(&local);
             return mk_error_oom(err, "shell collisions (candidate pairs)");
         }
@@ -574,7 +590,7 @@ mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *
         uint32_t before = c.vt + c.ee;
         if (round == 0) {
             box_job j;
-            if (!box_tests(&c, team, col, direct ? col->near : col->live, direct ? col->near_count : col->live_count, !direct, &j))
+            if (!box_tests(&c, direct ? col->near : col->live, direct ? col->near_count : col->live_count, !direct, &j))
                 c.oom = 1;
             else {
                 near_pairs(&c, col, &j, NULL, NULL);

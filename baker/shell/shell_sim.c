@@ -66,12 +66,13 @@ static void sweep_batches(const shell_state *s, double *x, double alpha, int hin
     const shell_params *p = s->p;
     const shell_sweep_order *o = hinges ? &s->hinge_order : &s->tri_order;
     const uint32_t *idx = hinges ? m->hinges : m->tris;
+    const int k = hinges ? 4 : 3;
     double g[SHELL_BATCH][12], W[SHELL_BATCH], sum = *energy;  /* summed here: parts' sums share cache lines */
     for (uint32_t b = first; b < last; b++) {
         const uint32_t *e = o->order + o->start[b];
         uint32_t size = o->start[b + 1] - o->start[b];
         for (uint32_t j = 0; j < size; j++) {
-            const uint32_t *v = idx + (hinges ? 4 : 3) * (size_t)e[j];
+            const uint32_t *v = idx + (size_t)k * e[j];
             if (hinges) {
                 const double *xs[4] = { x + 3 * (size_t)v[0], x + 3 * (size_t)v[1], x + 3 * (size_t)v[2], x + 3 * (size_t)v[3] };
                 W[j] = shell_bending_energy(m->hinge_K + 4 * (size_t)e[j], m->hinge_scale[e[j]], m->hinge_rest[e[j]], p->kB,
@@ -83,7 +84,7 @@ static void sweep_batches(const shell_state *s, double *x, double alpha, int hin
             }
         }
         for (uint32_t j = 0; j < size; j++) sum += W[j];
-        if (alpha >= 0) project_batch(m, x, idx, hinges ? 4 : 3, e, size, W, g, alpha, s->lambda + (hinges ? m->tri_count : 0));
+        if (alpha >= 0) project_batch(m, x, idx, k, e, size, W, g, alpha, s->lambda + (hinges ? m->tri_count : 0));
     }
     *energy = sum;
 }
@@ -186,12 +187,10 @@ static void update_signs(shell_state *s, const double *x, const double *normals)
     }
 }
 
-static mk_result simulate(shell_state *sp, mk_arena *arena, void (*progress)(void *user, double fraction), void *user,
-                          shell_run *run, mk_error *err)
+static mk_result simulate(const shell_mesh *m, const shell_params *p, mk_team *team, mk_arena *arena,
+                          void (*progress)(void *user, double fraction), void *user, shell_run *run, mk_error *err)
 {
-    shell_state s = *sp;
-    const shell_mesh *m = s.m;
-    const shell_params *p = s.p;
+    shell_state s = { .m = m, .p = p, .team = team };
     size_t n3 = 3 * (size_t)m->n;
     mk_result r = setup_region(&s, arena, err);
     if (r == MK_OK) r = shell_sweep_order_build(m->tris, 3, m->tri_count, m->n, arena, &s.tri_order, err);
@@ -298,11 +297,10 @@ mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *a
 {
     memset(run, 0, sizeof *run);
     /* Threads for the sweeps: no more than a phase has parts (shell_order.c). */
-    shell_state s = { .m = m, .p = p };
     uint32_t parts = shell_sweep_parts(m->tri_count), hinge_parts = shell_sweep_parts(m->hinge_count);
-    s.team = mk_team_create(mk_parallel_threads(p->threads, parts > hinge_parts ? parts : hinge_parts));
-    mk_result r = simulate(&s, arena, progress, user, run, err);
-    mk_team_destroy(s.team);
+    mk_team *team = mk_team_create(mk_parallel_threads(p->threads, parts > hinge_parts ? parts : hinge_parts));
+    mk_result r = simulate(m, p, team, arena, progress, user, run, err);
+    mk_team_destroy(team);
     return r;
 }
 
