@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include "blob_io.h"
+#include "file_write.h"
 
 static mk_result io_error(mk_error *err, const char *path, const char *what, int e)
 {
@@ -183,19 +184,6 @@ mk_result mk_output_check(mk_output *out, const char *const *inputs, uint32_t in
     return MK_OK;
 }
 
-static int write_all(int fd, const void *data, size_t size)
-{
-    const uint8_t *p = data;
-    while (size) {
-        ssize_t k = write(fd, p, size);
-        if (k < 0 && errno == EINTR) continue;
-        if (k <= 0) return -1;
-        p += k;
-        size -= (size_t)k;
-    }
-    return 0;
-}
-
 /* A new file "<target><suffix>.<pid>.<n>" created exclusively (the umask applies). */
 static int create_beside(const char *target, const char *suffix, char *name, size_t size)
 {
@@ -236,7 +224,7 @@ mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
             o->temp[0] = 0;
             break;
         }
-        int failed = write_all(fd, o->data, o->size) != 0;
+        int failed = mk_write_fd(fd, o->data, o->size, NULL) != 0;
         int e = errno;
         if (!failed && o->kind == MK_OUTPUT_REPLACE_FILE) (void)fchmod(fd, (mode_t)o->mode);
         if (!failed && fsync(fd) != 0) {
@@ -259,7 +247,7 @@ mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
             r = io_error(err, o->path, "cannot open", errno);
             break;
         }
-        int failed = write_all(fd, o->data, o->size) != 0;
+        int failed = mk_write_fd(fd, o->data, o->size, NULL) != 0;
         int e = errno;
         if (close(fd) != 0 && !failed) {
             failed = 1;

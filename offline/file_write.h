@@ -1,0 +1,18 @@
+/* SPDX-License-Identifier: MIT */
+/* Writing a buffer to a file descriptor (file_write.c). */
+#ifndef MK_FILE_WRITE_H
+#define MK_FILE_WRITE_H
+
+#include <stddef.h>
+
+/* Outputs this large or larger go to a regular file's device around the page cache. */
+#define MK_WRITE_DIRECT_MIN ((size_t)1 << 20)
+
+/* Writes size bytes at fd's offset, retrying short and interrupted writes. When fd is a regular
+ * file at a 4096-byte aligned offset, the size is at least MK_WRITE_DIRECT_MIN and the file
+ * system allows it, the whole 4096-byte blocks are written with O_DIRECT (through an aligned 1 MB buffer; the data needs
+ * no alignment) and the rest through the page cache. *direct_bytes (may be NULL) receives how
+ * many bytes went directly. 0 on success, -1 with errno set. The caller still fsyncs. */
+int mk_write_fd(int fd, const void *data, size_t size, size_t *direct_bytes);
+
+#endif

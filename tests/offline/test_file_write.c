@@ -1,0 +1,115 @@
+/* SPDX-License-Identifier: MIT */
+/* mk_write_fd: every byte arrives, in order, for sizes around the direct-write threshold and the
+ * 4096-byte block, from unaligned memory, on the build folder's file system and on tmpfs; large
+ * outputs to a regular file go around the page cache where the file system allows it, and the
+ * descriptor's flags are left as they were; devices take the ordinary path and their errors
+ * come back with errno. */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <fcntl.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include "check.h"
+#include "file_write.h"
+
+/* Whether files in dir accept O_DIRECT writes of aligned blocks. */
+static int direct_possible(const char *dir)
+{
+#ifdef O_DIRECT
+    char path[512];
+    snprintf(path, sizeof path, "%s/mk_direct_probe.%ld", dir, (long)getpid());
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_DIRECT, 0600);
+    if (fd < 0) return 0;
+    void *block = aligned_alloc(4096, 4096);
+    int ok = block && (memset(block, 0, 4096), write(fd, block, 4096) == 4096);
+    free(block);
+    close(fd);
+    unlink(path);
+    return ok;
+#else
+    (void)dir;
+    return 0;
+#endif
+}
+
+static void write_and_compare(const char *dir)
+{
+    static const size_t sizes[] = { 0, 1, 4095, 4096, 4097, MK_WRITE_DIRECT_MIN - 1, MK_WRITE_DIRECT_MIN,
+                                    MK_WRITE_DIRECT_MIN + 1, MK_WRITE_DIRECT_MIN + 4096,
+                                    3 * MK_WRITE_DIRECT_MIN + 123 };
+    const size_t most = 3 * MK_WRITE_DIRECT_MIN + 123;
+    const int direct = direct_possible(dir);
+    uint8_t *mem = malloc(most + 1);
+    CHECK(mem != NULL);
+    if (!mem) return;
+    uint8_t *data = mem + 1;   /* never 4096-aligned: the data needs no alignment */
+    uint32_t x = 12345;
+    for (size_t i = 0; i < most; i++) data[i] = (uint8_t)((x = x * 1664525u + 1013904223u) >> 24);
+    char path[512];
+    snprintf(path, sizeof path, "%s/mk_file_write_test.%ld", dir, (long)getpid());
+    for (size_t k = 0; k < sizeof sizes / sizeof *sizes; k++)
+        for (size_t prefix = 0; prefix <= 2; prefix += 2) {
+            /* With a 2-byte prefix the offset is not aligned: everything goes the ordinary way. */
+            const size_t size = sizes[k];
+            int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+            CHECK(fd >= 0);
+            if (fd < 0) break;
+            CHECK(write(fd, "ab", prefix) == (ssize_t)prefix);
+            size_t went_direct = 99;
+            CHECK_EQ_INT(mk_write_fd(fd, data, size, &went_direct), 0);
+            CHECK_EQ_INT(lseek(fd, 0, SEEK_CUR), (long long)(size + prefix));
+            size_t expect = direct && !prefix && size >= MK_WRITE_DIRECT_MIN ? size & ~(size_t)4095 : 0;
+            CHECK_MSG(went_direct == expect, "%s, %zu bytes after %zu: %zu direct, expected %zu", dir, size, prefix,
+                      went_direct, expect);
+#ifdef O_DIRECT
+            CHECK((fcntl(fd, F_GETFL) & O_DIRECT) == 0);
+#endif
+            CHECK(fsync(fd) == 0);
+            CHECK(close(fd) == 0);
+            size_t n = 0;
+            unsigned char *got = check_read_file(path, &n);
+            CHECK_EQ_INT(n, size + prefix);
+            if (got && n == size + prefix)
+                CHECK_MSG(memcmp(got, "ab", prefix) == 0 && memcmp(got + prefix, data, size) == 0,
+                          "%s, %zu bytes after %zu: contents differ", dir, size, prefix);
+            free(got);
+        }
+    unlink(path);
+    printf("  %s: O_DIRECT %s\n", dir, direct ? "used" : "not available");
+    free(mem);
+}
+
+static void every_byte_arrives_in_order(void)
+{
+    write_and_compare(".");
+    struct stat st;
+    if (stat("/dev/shm", &st) == 0 && S_ISDIR(st.st_mode) && access("/dev/shm", W_OK) == 0) write_and_compare("/dev/shm");
+}
+
+static void errors_come_back(void)
+{
+    size_t size = 2 * MK_WRITE_DIRECT_MIN, went_direct = 99;
+    uint8_t *data = calloc(1, size);
+    CHECK(data != NULL);
+    if (!data) return;
+    int fd = open("/dev/full", O_WRONLY);
+    if (fd >= 0) {   /* a device: the ordinary path, and its error */
+        errno = 0;
+        CHECK_EQ_INT(mk_write_fd(fd, data, size, &went_direct), -1);
+        CHECK_EQ_INT(errno, ENOSPC);
+        CHECK_EQ_INT(went_direct, 0);
+        close(fd);
+    }
+    fd = open(".", O_RDONLY);   /* not open for writing */
+    CHECK(fd >= 0);
+    errno = 0;
+    CHECK_EQ_INT(mk_write_fd(fd, data, size, NULL), -1);
+    CHECK(errno != 0);
+    close(fd);
+    free(data);
+}
+
+CHECK_MAIN(CASE(every_byte_arrives_in_order), CASE(errors_come_back))
