@@ -52,6 +52,14 @@ double shell_membrane_energy(shell_material material, double mu, double lambda, 
 double shell_bending_energy(const double K[4], double scale, double rest, double kB, const double *const x[4],
                             double grad[12]);
 
+/* One XPBD projection of a hinge with the signed constraint C = root (|v| - rest), whose square
+ * is 2W of shell_bending_energy (root = sqrt(kB scale)), inverse masses w: grad_j C = root K_j v /
+ * |v|, so sum_j w_j |grad_j C|^2 = root^2 sum_j w_j K_j^2 does not depend on the positions. Adds
+ * the step to *lambda and gives u: vertex j moves by w_j K_j u. Returns the energy W before the
+ * step. */
+double shell_bending_step(const double K[4], const double w[4], double root, double rest, double alpha,
+                          const double *const x[4], double *lambda, double u[3]);
+
 /* Anisotropic energy of one triangle, area * psi_a with I5 = |F a|^2 along the unit fibre a (2D,
  * rest frame): arap (mu/2)(sqrt(I5) - s)^2 with s = sign(I4) given by the caller (+1 or -1),
  * sqrt (mu/2)(sqrt(I5) - 1)^2, stvk (mu/8)(I5 - 1)^2. Gradient: 9 doubles. */

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The frame loop of the shell simulation (shell.h): per substep (shell_steps.c) prediction under
- * pressure, Gauss-Seidel sweeps over the energy constraints (XPBD, C = sqrt(2 W), compliance 1)
+ * pressure, Gauss-Seidel sweeps over the energy constraints (XPBD, C = sqrt(2 W), compliance 1;
+ * for hinges the signed root, shell_bending_step)
  * and velocities from positions; per frame collision handling over the frame's motion and the
  * per-frame record. The sweeps (in the order of shell_order.c) and the collision tests run on a
  * team of threads in a way that gives the same result for any thread count, so a run is
@@ -22,13 +23,15 @@ typedef struct shell_state {
     double *lambda;           /* per constraint: triangles, hinges, region triangles */
     shell_sweep_order tri_order, hinge_order;  /* the sweeps' order */
     mk_team *team;            /* threads for the sweeps' parts (NULL: the caller's only) */
+    double *hinge_root;       /* per hinge: sqrt(kB scale) (shell_bending_step) */
 } shell_state;
 
-/* XPBD projections of the energy constraints C = sqrt(2 W) of a batch of elements (k vertices each,
- * sharing no vertex; element j has vertices idx[k e[j] ..], energy W[j], gradient g[j] of W and
- * multiplier lambda[e[j]]). grad C = g / C, so with C^2 = 2 W the step is
- * dl = (-C - alpha lambda) 2 W / (2 W alpha + sum_i w_i |g_i|^2) and each vertex moves by
- * w_i g_i dl / C: one division per element. All steps are computed before any vertex moves,
+/* XPBD projections of the energy constraints C = sqrt(2 W) of a batch of (triangle) elements (k
+ * vertices each, sharing no vertex; element j has vertices idx[k e[j] ..], energy W[j], gradient
+ * g[j] of W and multiplier lambda[e[j]]). grad C = g / C, so with C^2 = 2 W the step is
+ * dl = (-C - alpha lambda) C^2 / (2 W alpha + sum_i w_i |g_i|^2) and each vertex moves by
+ * w_i g_i dl / C = w_i g_i (-C - alpha lambda) C / (2 W alpha + sum): one division per element,
+ * which does not wait for the square root. All steps are computed before any vertex moves,
  * which is the same as one element after the other because the elements share no vertex, and
  * lets their square roots and divisions overlap. */
 static void project_batch(const shell_mesh *m, double *x, const uint32_t *idx, int k, const uint32_t *e, uint32_t size,
@@ -39,10 +42,10 @@ static void project_batch(const shell_mesh *m, double *x, const uint32_t *idx, i
         const uint32_t *v = idx + (size_t)k * e[j];
         double sum = 0;
         for (int i = 0; i < k; i++) sum += m->inv_mass[v[i]] * vec3_dot(g[j] + 3 * i, g[j] + 3 * i);
-        double C = sqrt(2 * W[j]), den = (2 * W[j] * alpha + sum) * C;
-        double s = 0;
+        double den = 2 * W[j] * alpha + sum, C = sqrt(2 * W[j]), s = 0;
         if (W[j] > 1e-300 && den > 0) {
-            s = (-C - alpha * lambda[e[j]]) * 2 * W[j] / den;
+            double inv = 1 / den;
+            s = (-C - alpha * lambda[e[j]]) * C * inv;
             lambda[e[j]] += s * C;
         }
         step[j] = s;
@@ -56,6 +59,36 @@ static void project_batch(const shell_mesh *m, double *x, const uint32_t *idx, i
     }
 }
 
+/* Projects the hinges of batches [first, last) of their sweep order (shell_bending_step); adds
+ * their energies to *energy in order. */
+static void project_hinge_batches(const shell_state *s, double *x, double alpha, uint32_t first, uint32_t last,
+                                  double *energy)
+{
+    const shell_mesh *m = s->m;
+    const shell_sweep_order *o = &s->hinge_order;
+    double *lambda = s->lambda + m->tri_count, u[SHELL_BATCH][3], sum = *energy;
+    for (uint32_t b = first; b < last; b++) {
+        const uint32_t *e = o->order + o->start[b];
+        uint32_t size = o->start[b + 1] - o->start[b];
+        for (uint32_t j = 0; j < size; j++) {
+            const uint32_t h = e[j], *v = m->hinges + 4 * (size_t)h;
+            const double *xs[4] = { x + 3 * (size_t)v[0], x + 3 * (size_t)v[1], x + 3 * (size_t)v[2], x + 3 * (size_t)v[3] };
+            const double w[4] = { m->inv_mass[v[0]], m->inv_mass[v[1]], m->inv_mass[v[2]], m->inv_mass[v[3]] };
+            sum += shell_bending_step(m->hinge_K + 4 * (size_t)h, w, s->hinge_root[h], m->hinge_rest[h], alpha, xs,
+                                      &lambda[h], u[j]);
+        }
+        for (uint32_t j = 0; j < size; j++) {
+            const uint32_t h = e[j], *v = m->hinges + 4 * (size_t)h;
+            const double *K = m->hinge_K + 4 * (size_t)h;
+            for (int i = 0; i < 4; i++) {
+                double w = m->inv_mass[v[i]] * K[i];
+                for (int c = 0; c < 3; c++) x[3 * (size_t)v[i] + c] += w * u[j][c];
+            }
+        }
+    }
+    *energy = sum;
+}
+
 /* Evaluates (energy W, gradient) and, with alpha >= 0, projects the triangles (hinges = 0) or
  * hinges (hinges = 1) of batches [first, last) of their sweep order; adds their energies to *energy
  * in order. */
@@ -67,6 +100,10 @@ static void sweep_batches(const shell_state *s, double *x, double alpha, int hin
     const shell_sweep_order *o = hinges ? &s->hinge_order : &s->tri_order;
     const uint32_t *idx = hinges ? m->hinges : m->tris;
     const int k = hinges ? 4 : 3;
+    if (hinges && alpha >= 0) {
+        project_hinge_batches(s, x, alpha, first, last, energy);
+        return;
+    }
     double g[SHELL_BATCH][12], W[SHELL_BATCH], sum = *energy;  /* summed here: parts' sums share cache lines */
     for (uint32_t b = first; b < last; b++) {
         const uint32_t *e = o->order + o->start[b];
@@ -171,6 +208,16 @@ static mk_result setup_region(shell_state *s, mk_arena *arena, mk_error *err)
     return MK_OK;
 }
 
+/* sqrt(kB scale) per hinge, for shell_bending_step. */
+static mk_result setup_hinges(shell_state *s, mk_arena *arena, mk_error *err)
+{
+    const shell_mesh *m = s->m;
+    s->hinge_root = mk_arena_array(arena, (size_t)m->hinge_count + 1, sizeof(double));
+    if (!s->hinge_root) return mk_error_oom(err, "shell hinges");
+    for (uint32_t h = 0; h < m->hinge_count; h++) s->hinge_root[h] = sqrt(s->p->kB * m->hinge_scale[h]);
+    return MK_OK;
+}
+
 /* sign(I4) per region triangle: its current normal against the mean of its vertex normals. */
 static void update_signs(shell_state *s, const double *x, const double *normals)
 {
@@ -193,6 +240,7 @@ static mk_result simulate(const shell_mesh *m, const shell_params *p, mk_team *t
     shell_state s = { .m = m, .p = p, .team = team };
     size_t n3 = 3 * (size_t)m->n;
     mk_result r = setup_region(&s, arena, err);
+    if (r == MK_OK) r = setup_hinges(&s, arena, err);
     if (r == MK_OK) r = shell_sweep_order_build(m->tris, 3, m->tri_count, m->n, arena, &s.tri_order, err);
     if (r == MK_OK) r = shell_sweep_order_build(m->hinges, 4, m->hinge_count, m->n, arena, &s.hinge_order, err);
     if (r != MK_OK) return r;

@@ -133,6 +133,50 @@ static void energy_gradients_match_finite_differences(void)
     printf("worst relative gradient error over all energies: %.2e\n", worst_all);
 }
 
+/* The hinges' projection (shell_bending_step, the signed C = root (|v| - rest)) moves the vertices
+ * as the generic XPBD step with C = sqrt(2W) and W's gradient does, with the multiplier's sign
+ * following d = |v| - rest: for hinges bent past their rest and short of it, with and without an
+ * accumulated multiplier. */
+static void hinge_step_is_the_xpbd_step_of_its_energy(void)
+{
+    unsigned seed = 11;
+    double worst = 0;
+    for (int trial = 0; trial < 40; trial++) {
+        bending_case b = { { frand(&seed), frand(&seed), frand(&seed), 0 }, 1 + 0.5 * frand(&seed), 0 };
+        b.K[3] = -(b.K[0] + b.K[1] + b.K[2]);
+        double x[12], w[4], v[3] = { 0, 0, 0 }, kB = 0.3, alpha = trial % 2 ? 0 : 40.0;
+        for (int i = 0; i < 12; i++) x[i] = frand(&seed);
+        for (int j = 0; j < 4; j++) w[j] = 1 + 0.5 * frand(&seed);
+        for (int j = 0; j < 4; j++)
+            for (int c = 0; c < 3; c++) v[c] += b.K[j] * x[3 * j + c];
+        double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        b.rest = len * (trial % 4 < 2 ? 0.7 : 1.3);   /* d > 0 and d < 0 */
+        const double *xs[4] = { x, x + 3, x + 6, x + 9 };
+        double g[12], W = shell_bending_energy(b.K, b.scale, b.rest, kB, xs, g);
+        double d = len - b.rest, lambda_signed = trial % 8 < 4 ? 0 : 0.01 * frand(&seed);
+        double lambda_generic = d > 0 ? lambda_signed : -lambda_signed;
+        /* generic: C = sqrt(2W), grad C = g / C */
+        double C = sqrt(2 * W), sum = 0;
+        for (int j = 0; j < 4; j++)
+            for (int c = 0; c < 3; c++) sum += w[j] * g[3 * j + c] * g[3 * j + c];
+        double dl = (-C - alpha * lambda_generic) * 2 * W / (2 * W * alpha + sum);
+        double u[3], W2 = shell_bending_step(b.K, w, sqrt(kB * b.scale), b.rest, alpha, xs, &lambda_signed, u);
+        CHECK_NEAR(W2, W, 1e-12 * fmax(W, 1));
+        double scale = 0, err = 0;
+        for (int j = 0; j < 4; j++)
+            for (int c = 0; c < 3; c++) {
+                double generic = w[j] * g[3 * j + c] * dl / C, step = w[j] * b.K[j] * u[c];
+                scale = fmax(scale, fabs(generic));
+                err = fmax(err, fabs(generic - step));
+            }
+        CHECK_MSG(scale > 0 && err <= 1e-12 * scale, "trial %d: step differs by %g of %g", trial, err, scale);
+        double lambda_after = lambda_generic + dl;  /* the generic multiplier after the step */
+        CHECK_NEAR(d > 0 ? lambda_signed : -lambda_signed, lambda_after, 1e-12 * fmax(fabs(lambda_after), 1e-3));
+        worst = fmax(worst, scale > 0 ? err / scale : 1);
+    }
+    printf("hinge step against the generic XPBD step: worst relative difference %.1e over 40 hinges\n", worst);
+}
+
 /* A closed icosphere as the shell, and the volume's gradient against finite differences. */
 static void volume_and_its_gradient(void)
 {
@@ -782,6 +826,7 @@ static void collisions_hold_at_10000_triangles(void)
 }
 
 CHECK_MAIN(CASE(energy_gradients_match_finite_differences),
+           CASE(hinge_step_is_the_xpbd_step_of_its_energy),
            CASE(volume_and_its_gradient),
            CASE(cubic_roots_match_dense_sampling),
            CASE(volume_falls_monotonically_and_bending_resists),
