@@ -3,9 +3,10 @@
  * (file_io.c), so a large output's bytes must reach the device before the command ends anyway.
  * Written through the page cache they are first copied into freshly allocated cache pages, and
  * first use of fresh memory is what such a write mostly costs on a virtual machine whose host
- * backs guest memory lazily (a 48 MB blob: 0.24-0.28 s of copying, then 0.03 s of flushing;
- * docs/performance.md). Written with O_DIRECT (Linux; whole 4096-byte blocks from an aligned
- * buffer) they go from one reused buffer to the device: 0.05-0.06 s there. Where the file
+ * backs guest memory lazily (a 48 MB blob: up to 0.26 s of copying, then 0.03 s of flushing;
+ * docs/performance.md). Written with O_DIRECT (where the system has it; whole 4096-byte blocks
+ * from an aligned buffer) they go from one reused buffer to the device: 0.04-0.09 s there. On a
+ * network file system each direct write is its own round trip (not measured). Where the file
  * system refuses O_DIRECT, or a direct write fails part way, the rest is written the ordinary
  * way; a real error (no space, I/O) then shows there. */
 #define _GNU_SOURCE
@@ -37,43 +38,45 @@ static int write_buffered(int fd, const uint8_t *p, size_t size)
     return 0;
 }
 
-/* The whole blocks of data[0 .. size) with O_DIRECT; returns how many bytes were written (0
- * when O_DIRECT is not available). fd's status flags are as they were afterwards. */
-static size_t write_direct(int fd, const uint8_t *data, size_t size)
+/* The whole blocks of data[0 .. size) with O_DIRECT; *done: how many bytes were written (0 when
+ * O_DIRECT is not available). fd's status flags are as they were afterwards: -1 (errno set)
+ * when they could not be put back, else 0. */
+static int write_direct(int fd, const uint8_t *data, size_t size, size_t *done)
 {
-    size_t done = 0;
+    *done = 0;
 #ifdef O_DIRECT
     struct stat st;
     if (size < MK_WRITE_DIRECT_MIN || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) return 0;
     off_t at = lseek(fd, 0, SEEK_CUR);
     if (at < 0 || (uint64_t)at % DIRECT_ALIGN) return 0;
-    int flags = fcntl(fd, F_GETFL);
-    if (flags < 0 || fcntl(fd, F_SETFL, flags | O_DIRECT) != 0) return 0;
+    const int flags = fcntl(fd, F_GETFL), direct = flags | O_DIRECT;
+    if (flags < 0 || (flags & O_DIRECT) || fcntl(fd, F_SETFL, direct) != 0) return 0;
     uint8_t *chunk = aligned_alloc(DIRECT_ALIGN, DIRECT_CHUNK);
     const size_t whole = size & ~(DIRECT_ALIGN - 1);
-    while (chunk && done < whole) {
-        size_t n = whole - done < DIRECT_CHUNK ? whole - done : DIRECT_CHUNK;
-        memcpy(chunk, data + done, n);
+    while (chunk && *done < whole) {
+        size_t n = whole - *done < DIRECT_CHUNK ? whole - *done : DIRECT_CHUNK;
+        memcpy(chunk, data + *done, n);
         ssize_t k = write(fd, chunk, n);
         if (k < 0 && errno == EINTR) continue;
         if (k <= 0) break;                  /* refused or failed: the rest buffered */
-        done += (size_t)k;
+        *done += (size_t)k;
         if ((size_t)k % DIRECT_ALIGN) break; /* the offset is no longer aligned */
     }
     free(chunk);
-    (void)fcntl(fd, F_SETFL, flags);
+    if (fcntl(fd, F_SETFL, flags) != 0) return -1;
 #else
     (void)fd;
     (void)data;
     (void)size;
 #endif
-    return done;
+    return 0;
 }
 
 int mk_write_fd(int fd, const void *data, size_t size, size_t *direct_bytes)
 {
     const uint8_t *p = data;
-    size_t done = write_direct(fd, p, size);
+    size_t done = 0;
+    int r = write_direct(fd, p, size, &done);
     if (direct_bytes) *direct_bytes = done;
-    return write_buffered(fd, p + done, size - done);
+    return r != 0 ? -1 : write_buffered(fd, p + done, size - done);
 }

@@ -12,7 +12,8 @@
  * file at a 4096-byte aligned offset, the size is at least MK_WRITE_DIRECT_MIN and the file
  * system allows it, the whole 4096-byte blocks are written with O_DIRECT (through an aligned 1 MB buffer; the data needs
  * no alignment) and the rest through the page cache. *direct_bytes (may be NULL) receives how
- * many bytes went directly. 0 on success, -1 with errno set. The caller still fsyncs. */
+ * many bytes went directly. 0 on success, -1 with errno set. fd must not have O_DIRECT set
+ * already. The caller still fsyncs. */
 int mk_write_fd(int fd, const void *data, size_t size, size_t *direct_bytes);
 
 #endif

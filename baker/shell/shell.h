@@ -46,19 +46,25 @@ double shell_membrane_energy(shell_material material, double mu, double lambda, 
                              const double basis[6], double area, const double *x0, const double *x1,
                              const double *x2, double grad[9]);
 
+/* shell_membrane_energy with SHELL_STVK for count <= SHELL_BATCH triangles (corners x[j][0..2],
+ * their Dm_inv and area), bit for bit the same, written to overlap the triangles' work. */
+void shell_stvk_batch(double mu, double lambda, uint32_t count, const double *x[][3], const double *const Dm_inv[],
+                      const double area[], double W[], double grad[][12]);
+
 /* Bending energy of one hinge: (kB / 2) * scale * (|v| - rest)^2 with v = sum_j K_j x_j
  * (x0, x1 the hinge edge, x2, x3 the opposite vertices), scale = 3 / (A0 + A1). Gradient:
  * 12 doubles. */
 double shell_bending_energy(const double K[4], double scale, double rest, double kB, const double *const x[4],
                             double grad[12]);
 
-/* One XPBD projection of a hinge with the signed constraint C = root (|v| - rest), whose square
- * is 2W of shell_bending_energy (root = sqrt(kB scale)), inverse masses w: grad_j C = root K_j v /
- * |v|, so sum_j w_j |grad_j C|^2 = root^2 sum_j w_j K_j^2 does not depend on the positions. Adds
- * the step to *lambda and gives u: vertex j moves by w_j K_j u. Returns the energy W before the
- * step. */
-double shell_bending_step(const double K[4], const double w[4], double root, double rest, double alpha,
-                          const double *const x[4], double *lambda, double u[3]);
+/* XPBD projections of count <= SHELL_BATCH hinges that share no vertex, each with the signed
+ * constraint C = root (|v| - rest), whose square is 2W of shell_bending_energy (root =
+ * sqrt(kB scale)), inverse masses w (4 per hinge): grad_j C = root K_j v / |v|, so sum_j w_j |grad_j C|^2 =
+ * root^2 sum_j w_j K_j^2 does not depend on the positions. Adds each step to *lambda[i] and gives
+ * u[i]: vertex j of hinge i moves by w_j K_j u[i]. W[i]: the energy before the step. */
+void shell_bending_steps(uint32_t count, const double *const K[], const double w[], const double root[],
+                         const double rest[], double alpha, const double *x[][4], double *const lambda[], double W[],
+                         double u[][3]);
 
 /* Anisotropic energy of one triangle, area * psi_a with I5 = |F a|^2 along the unit fibre a (2D,
  * rest frame): arap (mu/2)(sqrt(I5) - s)^2 with s = sign(I4) given by the caller (+1 or -1),

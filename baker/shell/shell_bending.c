@@ -34,22 +34,33 @@ double shell_bending_energy(const double K[4], double scale, double rest, double
 /* The projection of the sweeps (shell_sim.c) for hinges. The generic one uses C = sqrt(2W) = root
  * |d|, whose gradient flips where d = |v| - rest changes sign; the signed C = root d gives the
  * same step wherever d keeps its sign (the multiplier then only changes sign with it) and is
- * smooth through d = 0. It also needs one square root and one division instead of two of
- * each: the hinges were most of a sweep's time, waiting on those. */
-double shell_bending_step(const double K[4], const double w[4], double root, double rest, double alpha,
-                          const double *const x[4], double *lambda, double u[3])
+ * smooth through d = 0. It also needs one square root instead of two, and its two divisions do
+ * not wait for each other: the hinges were most of a sweep's time, waiting on those. */
+void shell_bending_steps(uint32_t count, const double *const K[], const double w[], const double root[],
+                         const double rest[], double alpha, const double *x[][4], double *const lambda[], double W[],
+                         double u[][3])
 {
-    /* Written so that neither division waits for the other: 1 / (sum w |grad C|^2 + alpha) needs
-     * no position, and root / |v| starts as soon as the square root is done. */
-    double wk = w[0] * K[0] * K[0] + w[1] * K[1] * K[1] + w[2] * K[2] * K[2] + w[3] * K[3] * K[3];
-    double inv_den = 1 / (root * root * wk + alpha), v[3];
-    double len = hinge_vector(K, x, v);
-    double C = root * (len - rest), f = 0;
-    if (len > 1e-300) {   /* as above: no direction, no step */
-        double along = root / len, dl = (-C - alpha * *lambda) * inv_den;
-        *lambda += dl;
-        f = along * dl;
+    /* Stage by stage for all the hinges, so that their square roots and divisions overlap, and
+     * written so that neither division waits for the other: 1 / (sum w |grad C|^2 + alpha)
+     * needs no position, and root / |v| starts as soon as the square root is done. */
+    enum { B = SHELL_BATCH };
+    double inv_den[B], v[B][3], len[B];
+    for (uint32_t j = 0; j < count; j++) {
+        const double *k = K[j];
+        const double *wj = w + 4 * (size_t)j;
+        double wk = wj[0] * k[0] * k[0] + wj[1] * k[1] * k[1] + wj[2] * k[2] * k[2] + wj[3] * k[3] * k[3];
+        double den = root[j] * root[j] * wk + alpha;
+        inv_den[j] = den > 0 ? 1 / den : 0;   /* nothing to move (alpha 0 and no mass or stiffness): no step */
     }
-    for (int c = 0; c < 3; c++) u[c] = f * v[c];
-    return 0.5 * C * C;
+    for (uint32_t j = 0; j < count; j++) len[j] = hinge_vector(K[j], x[j], v[j]);
+    for (uint32_t j = 0; j < count; j++) {
+        double C = root[j] * (len[j] - rest[j]), f = 0;
+        W[j] = 0.5 * C * C;
+        if (len[j] > 1e-300) {   /* as above: no direction, no step */
+            double along = root[j] / len[j], dl = (-C - alpha * *lambda[j]) * inv_den[j];
+            *lambda[j] += dl;
+            f = along * dl;
+        }
+        for (int c = 0; c < 3; c++) u[j][c] = f * v[j][c];
+    }
 }

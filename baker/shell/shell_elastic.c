@@ -122,3 +122,51 @@ double shell_membrane_energy(shell_material material, double mu, double lambda, 
     shell_gradient_from_stress(P, Dm_inv, area, grad);
     return area * psi;
 }
+
+/* The StVK membrane of up to SHELL_BATCH triangles at once, each stage for all of them before the
+ * next: the same arithmetic as shell_membrane_energy (the results are bit-identical), laid out so
+ * that the triangles' independent chains interleave instead of one triangle's multiplications
+ * waiting for the one before. */
+void shell_stvk_batch(double mu, double lambda, uint32_t count, const double *x[][3], const double *const Dm_inv[],
+                      const double area[], double W[], double grad[][12])
+{
+    enum { B = SHELL_BATCH };
+    double F[6][B], E0[B], E1[B], E3[B], tr[B], S0[B], S1[B], S3[B], P[6][B];
+    for (uint32_t j = 0; j < count; j++)
+        for (int c = 0; c < 3; c++) {
+            const double *Dm = Dm_inv[j];
+            double d1 = x[j][1][c] - x[j][0][c], d2 = x[j][2][c] - x[j][0][c];
+            F[c][j] = d1 * Dm[0] + d2 * Dm[2];
+            F[3 + c][j] = d1 * Dm[1] + d2 * Dm[3];
+        }
+    for (uint32_t j = 0; j < count; j++) {
+        double C0 = F[0][j] * F[0][j] + F[1][j] * F[1][j] + F[2][j] * F[2][j];
+        double C1 = F[0][j] * F[3][j] + F[1][j] * F[4][j] + F[2][j] * F[5][j];
+        double C3 = F[3][j] * F[3][j] + F[4][j] * F[4][j] + F[5][j] * F[5][j];
+        E0[j] = 0.5 * (C0 - 1);
+        E1[j] = 0.5 * C1;
+        E3[j] = 0.5 * (C3 - 1);
+        tr[j] = E0[j] + E3[j];
+        S0[j] = 2 * mu * E0[j] + lambda * tr[j];
+        S1[j] = 2 * mu * E1[j];
+        S3[j] = 2 * mu * E3[j] + lambda * tr[j];
+    }
+    for (uint32_t j = 0; j < count; j++)
+        for (int c = 0; c < 3; c++) {
+            double a = F[c][j], b = F[3 + c][j];
+            P[c][j] = a * S0[j] + b * S1[j];   /* S is symmetric: S[2] = S[1] */
+            P[3 + c][j] = a * S1[j] + b * S3[j];
+        }
+    for (uint32_t j = 0; j < count; j++) {
+        double psi = mu * (E0[j] * E0[j] + 2 * E1[j] * E1[j] + E3[j] * E3[j]) + 0.5 * lambda * tr[j] * tr[j];
+        W[j] = area[j] * psi;
+        const double *Dm = Dm_inv[j];
+        for (int c = 0; c < 3; c++) {
+            double g1 = area[j] * (P[c][j] * Dm[0] + P[3 + c][j] * Dm[1]);
+            double g2 = area[j] * (P[c][j] * Dm[2] + P[3 + c][j] * Dm[3]);
+            grad[j][3 + c] = g1;
+            grad[j][6 + c] = g2;
+            grad[j][c] = -(g1 + g2);
+        }
+    }
+}

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The frame loop of the shell simulation (shell.h): per substep (shell_steps.c) prediction under
  * pressure, Gauss-Seidel sweeps over the energy constraints (XPBD, C = sqrt(2 W), compliance 1;
- * for hinges the signed root, shell_bending_step)
+ * for hinges the signed root, shell_bending_steps)
  * and velocities from positions; per frame collision handling over the frame's motion and the
  * per-frame record. The sweeps (in the order of shell_order.c) and the collision tests run on a
  * team of threads in a way that gives the same result for any thread count, so a run is
@@ -23,7 +23,7 @@ typedef struct shell_state {
     double *lambda;           /* per constraint: triangles, hinges, region triangles */
     shell_sweep_order tri_order, hinge_order;  /* the sweeps' order */
     mk_team *team;            /* threads for the sweeps' parts (NULL: the caller's only) */
-    double *hinge_root;       /* per hinge: sqrt(kB scale) (shell_bending_step) */
+    double *hinge_root;       /* per hinge: sqrt(kB scale) (shell_bending_steps) */
 } shell_state;
 
 /* XPBD projections of the energy constraints C = sqrt(2 W) of a batch of (triangle) elements (k
@@ -59,30 +59,37 @@ static void project_batch(const shell_mesh *m, double *x, const uint32_t *idx, i
     }
 }
 
-/* Projects the hinges of batches [first, last) of their sweep order (shell_bending_step); adds
+/* Projects the hinges of batches [first, last) of their sweep order (shell_bending_steps); adds
  * their energies to *energy in order. */
 static void project_hinge_batches(const shell_state *s, double *x, double alpha, uint32_t first, uint32_t last,
                                   double *energy)
 {
     const shell_mesh *m = s->m;
     const shell_sweep_order *o = &s->hinge_order;
-    double *lambda = s->lambda + m->tri_count, u[SHELL_BATCH][3], sum = *energy;
+    double *lambda = s->lambda + m->tri_count, sum = *energy;
     for (uint32_t b = first; b < last; b++) {
         const uint32_t *e = o->order + o->start[b];
         uint32_t size = o->start[b + 1] - o->start[b];
+        const double *K[SHELL_BATCH], *xs[SHELL_BATCH][4];
+        double w[SHELL_BATCH][4], root[SHELL_BATCH], rest[SHELL_BATCH], *lam[SHELL_BATCH], W[SHELL_BATCH], u[SHELL_BATCH][3];
         for (uint32_t j = 0; j < size; j++) {
             const uint32_t h = e[j], *v = m->hinges + 4 * (size_t)h;
-            const double *xs[4] = { x + 3 * (size_t)v[0], x + 3 * (size_t)v[1], x + 3 * (size_t)v[2], x + 3 * (size_t)v[3] };
-            const double w[4] = { m->inv_mass[v[0]], m->inv_mass[v[1]], m->inv_mass[v[2]], m->inv_mass[v[3]] };
-            sum += shell_bending_step(m->hinge_K + 4 * (size_t)h, w, s->hinge_root[h], m->hinge_rest[h], alpha, xs,
-                                      &lambda[h], u[j]);
-        }
-        for (uint32_t j = 0; j < size; j++) {
-            const uint32_t h = e[j], *v = m->hinges + 4 * (size_t)h;
-            const double *K = m->hinge_K + 4 * (size_t)h;
             for (int i = 0; i < 4; i++) {
-                double w = m->inv_mass[v[i]] * K[i];
-                for (int c = 0; c < 3; c++) x[3 * (size_t)v[i] + c] += w * u[j][c];
+                xs[j][i] = x + 3 * (size_t)v[i];
+                w[j][i] = m->inv_mass[v[i]];
+            }
+            K[j] = m->hinge_K + 4 * (size_t)h;
+            root[j] = s->hinge_root[h];
+            rest[j] = m->hinge_rest[h];
+            lam[j] = &lambda[h];
+        }
+        shell_bending_steps(size, K, w[0], root, rest, alpha, xs, lam, W, u);
+        for (uint32_t j = 0; j < size; j++) {
+            sum += W[j];
+            const uint32_t *v = m->hinges + 4 * (size_t)e[j];
+            for (int i = 0; i < 4; i++) {
+                double f = w[j][i] * K[j][i];
+                for (int c = 0; c < 3; c++) x[3 * (size_t)v[i] + c] += f * u[j][c];
             }
         }
     }
@@ -108,6 +115,17 @@ static void sweep_batches(const shell_state *s, double *x, double alpha, int hin
     for (uint32_t b = first; b < last; b++) {
         const uint32_t *e = o->order + o->start[b];
         uint32_t size = o->start[b + 1] - o->start[b];
+        if (!hinges && p->material == SHELL_STVK) {
+            const double *xs[SHELL_BATCH][3], *Dm[SHELL_BATCH];
+            double area[SHELL_BATCH];
+            for (uint32_t j = 0; j < size; j++) {
+                const uint32_t t = e[j], *v = idx + 3 * (size_t)t;
+                for (int i = 0; i < 3; i++) xs[j][i] = x + 3 * (size_t)v[i];
+                Dm[j] = m->Dm_inv + 4 * (size_t)t;
+                area[j] = m->area[t];
+            }
+            shell_stvk_batch(p->mu, p->lambda, size, xs, Dm, area, W, g);
+        } else
         for (uint32_t j = 0; j < size; j++) {
             const uint32_t *v = idx + (size_t)k * e[j];
             if (hinges) {
@@ -121,7 +139,7 @@ static void sweep_batches(const shell_state *s, double *x, double alpha, int hin
             }
         }
         for (uint32_t j = 0; j < size; j++) sum += W[j];
-        if (alpha >= 0) project_batch(m, x, idx, k, e, size, W, g, alpha, s->lambda + (hinges ? m->tri_count : 0));
+        if (alpha >= 0) project_batch(m, x, idx, k, e, size, W, g, alpha, s->lambda);   /* triangles: hinges return above */
     }
     *energy = sum;
 }
@@ -208,7 +226,7 @@ static mk_result setup_region(shell_state *s, mk_arena *arena, mk_error *err)
     return MK_OK;
 }
 
-/* sqrt(kB scale) per hinge, for shell_bending_step. */
+/* sqrt(kB scale) per hinge, for shell_bending_steps. */
 static mk_result setup_hinges(shell_state *s, mk_arena *arena, mk_error *err)
 {
     const shell_mesh *m = s->m;

@@ -10,7 +10,9 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
+#include <sys/vfs.h>
 #include <unistd.h>
 #include "check.h"
 #include "file_write.h"
@@ -35,6 +37,30 @@ static int direct_possible(const char *dir)
 #endif
 }
 
+/* How many of the file's first `bytes` bytes (whole pages) are in the page cache; -1 if unknown. */
+static long cached_pages(const char *path, size_t bytes)
+{
+    long page = sysconf(_SC_PAGESIZE);
+    size_t pages = page > 0 ? bytes / (size_t)page : 0;
+    int fd = open(path, O_RDONLY);
+    if (fd < 0 || pages == 0) {
+        if (fd >= 0) close(fd);
+        return -1;
+    }
+    void *map = mmap(NULL, pages * (size_t)page, PROT_READ, MAP_SHARED, fd, 0);
+    close(fd);
+    if (map == MAP_FAILED) return -1;
+    unsigned char *vec = malloc(pages);
+    long n = -1;
+    if (vec && mincore(map, pages * (size_t)page, vec) == 0) {
+        n = 0;
+        for (size_t i = 0; i < pages; i++) n += vec[i] & 1;
+    }
+    free(vec);
+    munmap(map, pages * (size_t)page);
+    return n;
+}
+
 static void write_and_compare(const char *dir)
 {
     static const size_t sizes[] = { 0, 1, 4095, 4096, 4097, MK_WRITE_DIRECT_MIN - 1, MK_WRITE_DIRECT_MIN,
@@ -42,6 +68,10 @@ static void write_and_compare(const char *dir)
                                     3 * MK_WRITE_DIRECT_MIN + 123 };
     const size_t most = 3 * MK_WRITE_DIRECT_MIN + 123;
     const int direct = direct_possible(dir);
+    struct statfs fs;
+    /* tmpfs keeps every file in the page cache: there a direct write is not visible as such */
+    const int cache_visible = statfs(dir, &fs) == 0 && fs.f_type != 0x01021994 /* TMPFS_MAGIC */;
+    long direct_cases = 0;
     uint8_t *mem = malloc(most + 1);
     CHECK(mem != NULL);
     if (!mem) return;
@@ -59,16 +89,22 @@ static void write_and_compare(const char *dir)
             if (fd < 0) break;
             CHECK(write(fd, "ab", prefix) == (ssize_t)prefix);
             size_t went_direct = 99;
+            const int flags_before = fcntl(fd, F_GETFL);
             CHECK_EQ_INT(mk_write_fd(fd, data, size, &went_direct), 0);
+            CHECK_EQ_INT(fcntl(fd, F_GETFL), flags_before);
             CHECK_EQ_INT(lseek(fd, 0, SEEK_CUR), (long long)(size + prefix));
             size_t expect = direct && !prefix && size >= MK_WRITE_DIRECT_MIN ? size & ~(size_t)4095 : 0;
             CHECK_MSG(went_direct == expect, "%s, %zu bytes after %zu: %zu direct, expected %zu", dir, size, prefix,
                       went_direct, expect);
-#ifdef O_DIRECT
-            CHECK((fcntl(fd, F_GETFL) & O_DIRECT) == 0);
-#endif
             CHECK(fsync(fd) == 0);
             CHECK(close(fd) == 0);
+            if (expect && cache_visible) {
+                /* written around the page cache: none of the direct part is cached (a buffered
+                 * write leaves all of it there) */
+                long cached = cached_pages(path, expect);
+                CHECK_MSG(cached == 0, "%s, %zu bytes: %ld pages of the direct part in the page cache", dir, size, cached);
+                direct_cases++;
+            }
             size_t n = 0;
             unsigned char *got = check_read_file(path, &n);
             CHECK_EQ_INT(n, size + prefix);
@@ -78,7 +114,8 @@ static void write_and_compare(const char *dir)
             free(got);
         }
     unlink(path);
-    printf("  %s: O_DIRECT %s\n", dir, direct ? "used" : "not available");
+    printf("  %s: O_DIRECT %s; %ld writes checked to have left the page cache alone\n", dir,
+           direct ? "used" : "not available on this file system", direct_cases);
     free(mem);
 }
 
