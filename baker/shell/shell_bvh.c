@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The shell's box hierarchy (shell_bvh.h): top-down median splits, iterative traversal. */
 #include <math.h>
+#include <string.h>
 #include "shell_bvh.h"
 #include "alloc.h"
 
@@ -182,10 +183,69 @@ static void node_pairs(const pair_walk *w, uint32_t na, uint32_t nb)
     }
 }
 
-void shell_bvh_self_pairs(const shell_bvh *bvh, const uint32_t *corners, void (*visit)(void *user, uint32_t a, uint32_t b),
-                          void *user)
+void shell_bvh_task_pairs(const shell_bvh *bvh, const uint32_t *corners, uint32_t a, uint32_t b,
+                          void (*visit)(void *user, uint32_t a, uint32_t b), void *user)
 {
     if (bvh->node_count == 0) return;
     pair_walk w = { bvh, corners, visit, user };
-    node_pairs(&w, 0, 0);
+    node_pairs(&w, a, b);
+}
+
+void shell_bvh_self_pairs(const shell_bvh *bvh, const uint32_t *corners, void (*visit)(void *user, uint32_t a, uint32_t b),
+                          void *user)
+{
+    shell_bvh_task_pairs(bvh, corners, 0, 0, visit, user);
+}
+
+/* Task (a, b)'s sub-tasks as node_pairs would recurse into them, in its order, at out (at most
+ * 3); returns their number, 0 for a pair of boxes that do not overlap, or UINT32_MAX for a task
+ * that does not split (a leaf with itself or two leaves). */
+static uint32_t split_task(const shell_bvh *bvh, uint32_t na, uint32_t nb, uint32_t *out)
+{
+    const shell_bvh_node *a = &bvh->nodes[na], *b = &bvh->nodes[nb];
+    if (na == nb) {
+        if (a->count) return UINT32_MAX;
+        const uint32_t l = a->start, r = a->start + 1, t[6] = { l, l, r, r, l, r };
+        memcpy(out, t, sizeof t);
+        return 3;
+    }
+    if (!shell_boxes_overlap(a->lo, a->hi, b->lo, b->hi)) return 0;
+    if (a->count && b->count) return UINT32_MAX;
+    double va = 0, vb = 0;
+    for (int c = 0; c < 3; c++) { va += a->hi[c] - a->lo[c]; vb += b->hi[c] - b->lo[c]; }
+    if (b->count || (!a->count && va >= vb)) {
+        const uint32_t t[4] = { a->start, nb, a->start + 1, nb };
+        memcpy(out, t, sizeof t);
+    } else {
+        const uint32_t t[4] = { na, b->start, na, b->start + 1 };
+        memcpy(out, t, sizeof t);
+    }
+    return 2;
+}
+
+uint32_t shell_bvh_self_split(const shell_bvh *bvh, uint32_t max, uint32_t *tasks)
+{
+    if (bvh->node_count == 0 || max == 0) return 0;
+    if (max > SHELL_BVH_TASKS_MAX) max = SHELL_BVH_TASKS_MAX;
+    uint32_t next[2 * SHELL_BVH_TASKS_MAX], n = 1;
+    tasks[0] = tasks[1] = 0;
+    for (int split = 1; split;) {   /* one level per pass, while the tasks fit */
+        split = 0;
+        uint32_t m = 0;
+        for (uint32_t i = 0; i < n; i++) {
+            uint32_t sub[6], k = m + 3 + (n - i - 1) <= max ? split_task(bvh, tasks[2 * i], tasks[2 * i + 1], sub) : UINT32_MAX;
+            if (k == UINT32_MAX) {   /* kept as it is */
+                next[2 * m] = tasks[2 * i];
+                next[2 * m + 1] = tasks[2 * i + 1];
+                m++;
+                continue;
+            }
+            memcpy(next + 2 * m, sub, 2 * k * sizeof *sub);
+            m += k;
+            split = 1;
+        }
+        memcpy(tasks, next, 2 * (size_t)m * sizeof *tasks);
+        n = m;
+    }
+    return n;
 }

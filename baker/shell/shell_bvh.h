@@ -48,4 +48,14 @@ void shell_bvh_refit(shell_bvh *bvh);
 void shell_bvh_self_pairs(const shell_bvh *bvh, const uint32_t *corners, void (*visit)(void *user, uint32_t a, uint32_t b),
                           void *user);
 
+/* The same traversal in parts: shell_bvh_self_split writes up to max (at most
+ * SHELL_BVH_TASKS_MAX) tasks, pairs of nodes (2 per task), and returns their number;
+ * shell_bvh_task_pairs(a, b) visits a task's pairs. The tasks' visits, one task after the other
+ * in their order, are exactly shell_bvh_self_pairs' visits in its order, so the tasks can run on
+ * several threads and their pairs be taken in task order afterwards. */
+#define SHELL_BVH_TASKS_MAX 256
+uint32_t shell_bvh_self_split(const shell_bvh *bvh, uint32_t max, uint32_t *tasks);
+void shell_bvh_task_pairs(const shell_bvh *bvh, const uint32_t *corners, uint32_t a, uint32_t b,
+                          void (*visit)(void *user, uint32_t a, uint32_t b), void *user);
+
 #endif

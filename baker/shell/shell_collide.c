@@ -32,6 +32,7 @@
  * broad phase. */
 #include <math.h>
 #include <string.h>
+#include <threads.h>
 #include "shell.h"
 #include "bake_util.h"
 #include "parallel.h"
@@ -504,6 +505,67 @@ static void all_boxes(mk_team *team, shell_collider *col, const shell_mesh *m, c
     mk_team_for(team, chunks_of(j.counts, 3), boxes_item, &j);
 }
 
+/* The hierarchy's self-traversal on the team: split into tasks (shell_bvh_self_split), each
+ * task's overlapping slot pairs into its own list (grown under a lock: the arena is not shared
+ * otherwise), then taken by `take` one task after the other, which is the order of the traversal
+ * on one thread: the result does not depend on the thread count. */
+#define TRAVERSAL_TASKS 64
+
+typedef struct traversal_job {
+    const shell_collider *col;
+    uint32_t tasks[2 * TRAVERSAL_TASKS];
+    uint32_t *pairs[TRAVERSAL_TASKS];
+    size_t count[TRAVERSAL_TASKS], capacity[TRAVERSAL_TASKS];
+    mk_arena *arena;
+    mtx_t lock;
+    int oom;                  /* set under the lock */
+} traversal_job;
+
+typedef struct task_sink {
+    traversal_job *job;
+    uint32_t task;
+} task_sink;
+
+static void sink_pair(void *user, uint32_t a, uint32_t b)
+{
+    task_sink *s = user;
+    traversal_job *j = s->job;
+    const uint32_t t = s->task;
+    if (j->count[t] < j->capacity[t]) {
+        put_pair(j->pairs[t], &j->count[t], a, b);
+        return;
+    }
+    mtx_lock(&j->lock);
+    if (!push_pair(j->arena, &j->pairs[t], &j->count[t], &j->capacity[t], a, b)) j->oom = 1;
+    mtx_unlock(&j->lock);
+}
+
+static void traverse_task(void *user, uint32_t task, uint32_t worker)
+{
+    (void)worker;
+    traversal_job *j = user;
+    task_sink sink = { j, task };
+    shell_bvh_task_pairs(&j->col->tree, j->col->slot_corners, j->tasks[2 * task], j->tasks[2 * task + 1], sink_pair, &sink);
+}
+
+/* 0 when out of memory. */
+static int traverse(collide_ctx *c, void (*take)(void *user, uint32_t a, uint32_t b), void *user)
+{
+    traversal_job *j = mk_arena_array(c->arena, 1, sizeof *j);
+    if (!j || mtx_init(&j->lock, mtx_plain) != thrd_success) return 0;
+    j->col = c->col;
+    j->arena = c->arena;
+    uint32_t tasks = shell_bvh_self_split(&c->col->tree, TRAVERSAL_TASKS, j->tasks);
+    mk_team_for(c->team, tasks, traverse_task, j);
+    mtx_destroy(&j->lock);
+    for (uint32_t t = 0; t < tasks && !j->oom; t++)
+        for (size_t k = 0; k < j->count[t]; k++) take(user, j->pairs[t][2 * k], j->pairs[t][2 * k + 1]);
+    for (uint32_t t = 0; t < tasks; t++) mk_arena_release(c->arena, j->pairs[t]);
+    int ok = !j->oom;
+    mk_arena_release(c->arena, j);
+    return ok;
+}
+
 static void collect_far(void *user, uint32_t s, uint32_t u)
 {
     shell_collider *col = user;
@@ -526,7 +588,7 @@ static int far_rebuild(collide_ctx *c, shell_collider *col, const double *x, con
     shell_bvh_refit(&col->tree);
     col->far_count = 0;
     col->far_oom = 0;
-    shell_bvh_self_pairs(&col->tree, col->slot_corners, collect_far, col);
+    if (!traverse(c, collect_far, col)) col->far_oom = 1;
     col->far_valid = !col->far_oom;
     return col->far_valid;
 }
@@ -596,7 +658,7 @@ mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *
                 near_pairs(&c, col, &j, NULL, NULL);
                 if (direct) {
                     shell_bvh_refit(&col->tree);
-                    shell_bvh_self_pairs(&col->tree, col->slot_corners, visit_direct, &c);
+                    if (!traverse(&c, visit_direct, &c)) c.oom = 1;
                 } else {
                     far_pairs(&c, &j);
                 }

@@ -15,6 +15,7 @@
 #include "check.h"
 #include "fixtures.h"
 #include "shell/shell.h"
+#include "shell/shell_bvh.h"
 #include "shell/shell_ccd.h"
 #include "shell/shell_channel.h"
 
@@ -459,6 +460,73 @@ static double region_inward_motion(const shell_mesh *m, const shell_run *run, co
 }
 
 /* k_A is a pressure on the region, so the same k_A moves the region alike on both meshes. */
+/* The hierarchy's traversal split into tasks (shell_bvh_self_split) visits, task after task, the
+ * same pairs in the same order as the traversal in one piece, for every task budget: jittered
+ * boxes of a 10 000-triangle sphere's triangles, with and without the shared-corner rule. */
+typedef struct pair_log { uint32_t *pairs; size_t count, capacity; } pair_log;
+static void log_pair(void *user, uint32_t a, uint32_t b)
+{
+    pair_log *l = user;
+    if (l->count == l->capacity) {
+        l->capacity = l->capacity ? 2 * l->capacity : 1024;
+        l->pairs = realloc(l->pairs, 2 * l->capacity * sizeof *l->pairs);
+        if (!l->pairs) abort();
+    }
+    l->pairs[2 * l->count] = a;
+    l->pairs[2 * l->count + 1] = b;
+    l->count++;
+}
+
+static void split_traversal_visits_the_same_pairs(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    const mk_raw_mesh *mesh = make_ball(&raw, 10000);
+    uint32_t n = mesh->triangle_count;
+    double *boxes = malloc(6 * (size_t)n * sizeof *boxes);
+    CHECK(boxes != NULL);
+    if (!boxes) { mk_raw_free(&raw); return; }
+    unsigned seed = 3;
+    for (uint32_t t = 0; t < n; t++) {
+        double *b = boxes + 6 * (size_t)t;
+        for (int c = 0; c < 3; c++) { b[c] = INFINITY; b[3 + c] = -INFINITY; }
+        for (int k = 0; k < 3; k++)
+            for (int c = 0; c < 3; c++) {
+                double v = mesh->positions[3 * (size_t)mesh->triangles[3 * (size_t)t + k] + c] + 0.01 * frand(&seed);
+                b[c] = fmin(b[c], v);
+                b[3 + c] = fmax(b[3 + c], v);
+            }
+    }
+    shell_bvh bvh;
+    CHECK(shell_bvh_build(&bvh, boxes, n, &raw.arena));
+    for (int rule = 0; rule < 2; rule++) {
+        const uint32_t *corners = rule ? mesh->triangles : NULL;
+        pair_log whole = { 0 };
+        shell_bvh_self_pairs(&bvh, corners, log_pair, &whole);
+        static const uint32_t budgets[] = { 1, 2, 3, 7, 64, SHELL_BVH_TASKS_MAX, 100000 };
+        for (size_t k = 0; k < sizeof budgets / sizeof *budgets; k++) {
+            uint32_t tasks[2 * SHELL_BVH_TASKS_MAX];
+            uint32_t count = shell_bvh_self_split(&bvh, budgets[k], tasks);
+            pair_log parts = { 0 };
+            for (uint32_t i = 0; i < count; i++)
+                shell_bvh_task_pairs(&bvh, corners, tasks[2 * i], tasks[2 * i + 1], log_pair, &parts);
+            int same = parts.count == whole.count &&
+                       (whole.count == 0 || memcmp(parts.pairs, whole.pairs, 2 * whole.count * sizeof *whole.pairs) == 0);
+            if (budgets[k] == 64 || !same)
+                printf("%s corners, budget %u: %u tasks, %zu pairs in the same order as one traversal: %s\n",
+                       rule ? "with" : "without", budgets[k], count, parts.count, same ? "yes" : "no");
+            CHECK(same);
+            CHECK(count >= 1 && count <= (budgets[k] < SHELL_BVH_TASKS_MAX ? budgets[k] : SHELL_BVH_TASKS_MAX));
+            if (budgets[k] >= 64) CHECK(count > 16);   /* the budget is used: enough tasks for the threads */
+            free(parts.pairs);
+        }
+        CHECK(whole.count > 1000);
+        free(whole.pairs);
+    }
+    free(boxes);
+    mk_raw_free(&raw);
+}
+
 /* Each material drives the simulation: 30 frames on 1 280 triangles contract the shell, and no
  * two materials give the same volume curve (the StVK triangles take their own batched path). */
 static void every_material_contracts_the_shell(void)
@@ -915,6 +983,7 @@ CHECK_MAIN(CASE(energy_gradients_match_finite_differences),
            CASE(batches_equal_one_element_at_a_time),
            CASE(volume_and_its_gradient),
            CASE(cubic_roots_match_dense_sampling),
+           CASE(split_traversal_visits_the_same_pairs),
            CASE(volume_falls_monotonically_and_bending_resists),
            CASE(every_material_contracts_the_shell),
            CASE(anisotropic_region_contracts_faster),
