@@ -90,6 +90,8 @@ typedef struct shell_mesh {
     double *hinge_rest;       /* |sum K_j X_j| at rest */
     uint32_t *hinge_tri;      /* a triangle with the edge x0 x1 and the vertex x2 */
     double *inv_mass;         /* per welded vertex */
+    uint32_t *corner_start;   /* per welded vertex (n + 1): its corners corners[corner_start[v] ..) */
+    uint32_t *corners;        /* 3 t + k for corner k of triangle t, increasing per vertex */
     double volume0;
 } shell_mesh;
 
@@ -129,6 +131,10 @@ mk_result shell_sweep_order_build(const uint32_t *idx, int k, uint32_t count, ui
 
 /* Enclosed volume (1/6) sum x_a . (x_b x_c), and optionally its gradient (3 per vertex). */
 double shell_volume(const shell_mesh *m, const double *x, double *grad);
+/* The volume's gradient at vertices [first, last) alone (grad holds 3 per vertex), the same
+ * bits as shell_volume's: each vertex sums its triangles' terms in triangle order. Vertex ranges
+ * can run on several threads. */
+void shell_volume_gradient(const shell_mesh *m, const double *x, double *grad, uint32_t first, uint32_t last);
 /* Area-weighted unit vertex normals of positions x (3 per vertex). */
 void shell_vertex_normals(const shell_mesh *m, const double *x, double *normals);
 

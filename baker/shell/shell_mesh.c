@@ -35,24 +35,31 @@ static double cot_angle(const double v[3], const double w[3])
 double shell_volume(const shell_mesh *m, const double *x, double *grad)
 {
     double v = 0;
-    if (grad) memset(grad, 0, 3 * (size_t)m->n * sizeof(double));
     for (uint32_t t = 0; t < m->tri_count; t++) {
         const uint32_t *tri = m->tris + 3 * (size_t)t;
         const double *a = x + 3 * (size_t)tri[0], *b = x + 3 * (size_t)tri[1], *c = x + 3 * (size_t)tri[2];
         double bc[3];
         vec3_cross(bc, b, c);
         v += vec3_dot(a, bc);
-        if (!grad) continue;
-        double ca[3], ab[3];
-        vec3_cross(ca, c, a);
-        vec3_cross(ab, a, b);
-        for (int k = 0; k < 3; k++) {
-            grad[3 * (size_t)tri[0] + k] += bc[k] / 6;
-            grad[3 * (size_t)tri[1] + k] += ca[k] / 6;
-            grad[3 * (size_t)tri[2] + k] += ab[k] / 6;
-        }
     }
+    if (grad) shell_volume_gradient(m, x, grad, 0, m->n);
     return v / 6;
+}
+
+void shell_volume_gradient(const shell_mesh *m, const double *x, double *grad, uint32_t first, uint32_t last)
+{
+    /* d(a . (b x c))/da = b x c, and cyclically: corner k's term is the cross product of the
+     * next corner and the one after. */
+    for (uint32_t v = first; v < last; v++) {
+        double g[3] = { 0, 0, 0 };
+        for (uint32_t i = m->corner_start[v]; i < m->corner_start[v + 1]; i++) {
+            const uint32_t t = m->corners[i] / 3, k = m->corners[i] % 3, *tri = m->tris + 3 * (size_t)t;
+            double term[3];
+            vec3_cross(term, x + 3 * (size_t)tri[(k + 1) % 3], x + 3 * (size_t)tri[(k + 2) % 3]);
+            for (int c = 0; c < 3; c++) g[c] += term[c] / 6;
+        }
+        for (int c = 0; c < 3; c++) grad[3 * (size_t)v + c] = g[c];
+    }
 }
 
 void shell_vertex_normals(const shell_mesh *m, const double *x, double *normals)
@@ -122,6 +129,15 @@ mk_result shell_mesh_build(const mk_raw_mesh *mesh, double density, mk_arena *ar
                                 "vertex %u is used by no triangle (the shell must be one closed surface)", v);
         m->inv_mass[v] = 1 / m->inv_mass[v];
     }
+    /* Every vertex's corners, in triangle order (a counting sort). */
+    m->corner_start = mk_arena_array(arena, (size_t)m->n + 1, sizeof(uint32_t));
+    m->corners = mk_arena_array(arena, 3 * (size_t)nt, sizeof(uint32_t));
+    if (!m->corner_start || !m->corners) return mk_error_oom(err, "shell mesh");
+    for (size_t i = 0; i < 3 * (size_t)nt; i++) m->corner_start[m->tris[i] + 1]++;
+    for (uint32_t v = 0; v < m->n; v++) m->corner_start[v + 1] += m->corner_start[v];
+    for (size_t i = 0; i < 3 * (size_t)nt; i++) m->corners[m->corner_start[m->tris[i]]++] = (uint32_t)i;
+    for (uint32_t v = m->n; v > 0; v--) m->corner_start[v] = m->corner_start[v - 1];
+    m->corner_start[0] = 0;
     /* Closed and consistently oriented: every edge twice, once in each direction. */
     qsort(he, 3 * (size_t)nt, sizeof *he, compare_half_edges);
     size_t edges = 3 * (size_t)nt / 2;

@@ -252,6 +252,59 @@ static void update_signs(shell_state *s, const double *x, const double *normals)
     }
 }
 
+/* A substep's per-vertex work on the team: the pressure force from the volume's gradient at xs,
+ * the inward push k_A, the prediction (predict_item), and after the sweeps the velocities
+ * (velocity_item). Each vertex's arithmetic is the same on any thread. */
+#define VERTEX_CHUNK 1024u
+
+typedef struct substep_job {
+    const shell_state *s;
+    double *xs, *v, *q, *grad;
+    const double *normals;
+    double pressure, h, keep;
+} substep_job;
+
+static void vertex_range(const shell_mesh *m, uint32_t item, uint32_t *first, uint32_t *last)
+{
+    *first = item * VERTEX_CHUNK;
+    *last = m->n - *first < VERTEX_CHUNK ? m->n : *first + VERTEX_CHUNK;
+}
+
+static void predict_item(void *user, uint32_t item, uint32_t worker)
+{
+    (void)worker;
+    const substep_job *j = user;
+    const shell_mesh *m = j->s->m;
+    const shell_params *p = j->s->p;
+    const int push = j->s->aniso_count && p->aniso_kA != 0;
+    uint32_t first, last;
+    vertex_range(m, item, &first, &last);
+    shell_volume_gradient(m, j->xs, j->grad, first, last);
+    for (uint32_t i = first; i < last; i++) {
+        double w = m->inv_mass[i];
+        for (int c = 0; c < 3; c++) {
+            size_t k = 3 * (size_t)i + (size_t)c;
+            double force = -j->pressure * j->grad[k];
+            /* k_A is a pressure: times the vertex's rest area (its mass / density). */
+            if (push && p->aniso_region[i]) force -= p->aniso_kA * j->normals[k] / (p->density * w);
+            j->v[k] = j->keep * (j->v[k] + j->h * w * force);
+            j->q[k] = j->xs[k] + j->h * j->v[k];
+        }
+    }
+}
+
+static void velocity_item(void *user, uint32_t item, uint32_t worker)
+{
+    (void)worker;
+    const substep_job *j = user;
+    uint32_t first, last;
+    vertex_range(j->s->m, item, &first, &last);
+    for (size_t k = 3 * (size_t)first; k < 3 * (size_t)last; k++) {
+        j->v[k] = (j->q[k] - j->xs[k]) / j->h;
+        j->xs[k] = j->q[k];
+    }
+}
+
 static mk_result simulate(const shell_mesh *m, const shell_params *p, mk_team *team, mk_arena *arena,
                           void (*progress)(void *user, double fraction), void *user, shell_run *run, mk_error *err)
 {
@@ -283,7 +336,7 @@ static mk_result simulate(const shell_mesh *m, const shell_params *p, mk_team *t
     uint32_t substeps = run->substeps = shell_substeps(m, p);
     double h = p->dt / substeps, alpha = 1 / (h * h), keep = pow(1 - p->damping, 1.0 / substeps);
     size_t nlambda = (size_t)m->tri_count + m->hinge_count + s.aniso_count;
-    shell_volume(m, x, grad);   /* then at the end of every frame, for the next one */
+    const uint32_t vertex_items = (m->n + VERTEX_CHUNK - 1) / VERTEX_CHUNK;
     for (uint32_t f = 1; f <= p->frames; f++) {
         double t0 = bake_now();
         shell_frame_stats *st = &run->stats[f];
@@ -295,30 +348,17 @@ static mk_result simulate(const shell_mesh *m, const shell_params *p, mk_team *t
         for (uint32_t sub = 1; sub <= substeps; sub++) {
             double time = (f - 1) * p->dt + sub * h;
             double pressure = p->ramp > 0 && time < p->ramp ? p->pressure * time / p->ramp : p->pressure;
-            if (sub > 1) shell_volume(m, xs, grad);
             if (s.aniso_count && p->aniso_kA != 0) shell_vertex_normals(m, xs, normals);
-            for (uint32_t i = 0; i < m->n; i++) {
-                double w = m->inv_mass[i];
-                for (int c = 0; c < 3; c++) {
-                    size_t k = 3 * (size_t)i + (size_t)c;
-                    double force = -pressure * grad[k];
-                    /* k_A is a pressure: times the vertex's rest area (its mass / density). */
-                    if (s.aniso_count && p->aniso_kA != 0 && p->aniso_region[i])
-                        force -= p->aniso_kA * normals[k] / (p->density * w);
-                    v[k] = keep * (v[k] + h * w * force);
-                    q[k] = xs[k] + h * v[k];
-                }
-            }
+            substep_job job = { .s = &s, .xs = xs, .v = v, .q = q, .grad = grad, .normals = normals,
+                                .pressure = pressure, .h = h, .keep = keep };
+            mk_team_for(s.team, vertex_items, predict_item, &job);
             if (s.aniso_count) {
                 shell_vertex_normals(m, q, normals);
                 update_signs(&s, q, normals);
             }
             memset(s.lambda, 0, nlambda * sizeof(double));
             for (uint32_t it = 0; it < p->iterations; it++) sweep(&s, q, alpha, energy);
-            for (size_t k = 0; k < n3; k++) {
-                v[k] = (q[k] - xs[k]) / h;
-                xs[k] = q[k];
-            }
+            mk_team_for(s.team, vertex_items, velocity_item, &job);
         }
         double tc = bake_now();
         if (p->thickness > 0) {
@@ -342,7 +382,7 @@ static mk_result simulate(const shell_mesh *m, const shell_params *p, mk_team *t
         }
         sweep(&s, x, -1, energy);
         st->time = f * p->dt;
-        st->volume_ratio = shell_volume(m, x, grad) / m->volume0;
+        st->volume_ratio = shell_volume(m, x, NULL) / m->volume0;
         st->membrane = energy[0];
         st->bending = energy[1];
         st->aniso = energy[2];
