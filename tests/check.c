@@ -6,8 +6,9 @@ check_state check_global;
 int check_run(const check_case *cases, int count, int argc, char **argv)
 {
     const char *filter = argc > 1 ? argv[1] : NULL;
+    const int exclude = filter && filter[0] == '-';   /* "-text": every case but those */
     for (int i = 0; i < count; i++) {
-        if (filter && !strstr(cases[i].name, filter)) continue;
+        if (filter && (exclude ? strstr(cases[i].name, filter + 1) != NULL : !strstr(cases[i].name, filter))) continue;
         check_global.current = cases[i].name;
         check_global.failures = 0;
         cases[i].fn();

@@ -38,7 +38,8 @@ extern check_state check_global;
 
 typedef struct check_case { const char *name; void (*fn)(void); } check_case;
 
-/* Runs the cases (argv[1], if given, keeps only names containing it) and prints the summary.
+/* Runs the cases (argv[1], if given, keeps only names containing it; "-text" keeps the names
+ * that do not contain text) and prints the summary.
  * Exit: 0 if none failed (77, meson's "skipped", if all were skipped), else 1. */
 int check_run(const check_case *cases, int count, int argc, char **argv);
 

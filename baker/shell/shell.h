@@ -59,10 +59,10 @@ double shell_bending_energy(const double K[4], double scale, double rest, double
 
 /* XPBD projections of count <= SHELL_BATCH hinges that share no vertex, each with the signed
  * constraint C = root (|v| - rest), whose square is 2W of shell_bending_energy (root =
- * sqrt(kB scale)), inverse masses w (4 per hinge): grad_j C = root K_j v / |v|, so sum_j w_j |grad_j C|^2 =
+ * sqrt(kB scale)), inverse masses w (read only): grad_j C = root K_j v / |v|, so sum_j w_j |grad_j C|^2 =
  * root^2 sum_j w_j K_j^2 does not depend on the positions. Adds each step to *lambda[i] and gives
  * u[i]: vertex j of hinge i moves by w_j K_j u[i]. W[i]: the energy before the step. */
-void shell_bending_steps(uint32_t count, const double *const K[], const double w[], const double root[],
+void shell_bending_steps(uint32_t count, const double *const K[], double w[][4], const double root[],
                          const double rest[], double alpha, const double *x[][4], double *const lambda[], double W[],
                          double u[][3]);
 

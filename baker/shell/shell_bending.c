@@ -36,7 +36,7 @@ double shell_bending_energy(const double K[4], double scale, double rest, double
  * same step wherever d keeps its sign (the multiplier then only changes sign with it) and is
  * smooth through d = 0. It also needs one square root instead of two, and its two divisions do
  * not wait for each other: the hinges were most of a sweep's time, waiting on those. */
-void shell_bending_steps(uint32_t count, const double *const K[], const double w[], const double root[],
+void shell_bending_steps(uint32_t count, const double *const K[], double w[][4], const double root[],
                          const double rest[], double alpha, const double *x[][4], double *const lambda[], double W[],
                          double u[][3])
 {
@@ -47,7 +47,7 @@ void shell_bending_steps(uint32_t count, const double *const K[], const double w
     double inv_den[B], v[B][3], len[B];
     for (uint32_t j = 0; j < count; j++) {
         const double *k = K[j];
-        const double *wj = w + 4 * (size_t)j;
+        const double *wj = w[j];
         double wk = wj[0] * k[0] * k[0] + wj[1] * k[1] * k[1] + wj[2] * k[2] * k[2] + wj[3] * k[3] * k[3];
         double den = root[j] * root[j] * wk + alpha;
         inv_den[j] = den > 0 ? 1 / den : 0;   /* nothing to move (alpha 0 and no mass or stiffness): no step */

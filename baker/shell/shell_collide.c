@@ -515,28 +515,32 @@ typedef struct traversal_job {
     const shell_collider *col;
     uint32_t tasks[2 * TRAVERSAL_TASKS];
     uint32_t *pairs[TRAVERSAL_TASKS];
-    size_t count[TRAVERSAL_TASKS], capacity[TRAVERSAL_TASKS];
+    size_t count[TRAVERSAL_TASKS];
     mk_arena *arena;
     mtx_t lock;
     int oom;                  /* set under the lock */
 } traversal_job;
 
+/* One task's list while it runs, on its thread's stack (the job's per-task arrays share cache
+ * lines between tasks on different threads): written back when the task ends. */
 typedef struct task_sink {
     traversal_job *job;
-    uint32_t task;
+    uint32_t *pairs;
+    size_t count, capacity;
+    int oom;
 } task_sink;
 
 static void sink_pair(void *user, uint32_t a, uint32_t b)
 {
     task_sink *s = user;
-    traversal_job *j = s->job;
-    const uint32_t t = s->task;
-    if (j->count[t] < j->capacity[t]) {
-        put_pair(j->pairs[t], &j->count[t], a, b);
+    if (s->count < s->capacity) {
+        put_pair(s->pairs, &s->count, a, b);
         return;
     }
+    if (s->oom) return;
+    traversal_job *j = s->job;
     mtx_lock(&j->lock);
-    if (!push_pair(j->arena, &j->pairs[t], &j->count[t], &j->capacity[t], a, b)) j->oom = 1;
+    if (!push_pair(j->arena, &s->pairs, &s->count, &s->capacity, a, b)) s->oom = j->oom = 1;
     mtx_unlock(&j->lock);
 }
 
@@ -544,19 +548,26 @@ static void traverse_task(void *user, uint32_t task, uint32_t worker)
 {
     (void)worker;
     traversal_job *j = user;
-    task_sink sink = { j, task };
+    task_sink sink = { j, NULL, 0, 0, 0 };
     shell_bvh_task_pairs(&j->col->tree, j->col->slot_corners, j->tasks[2 * task], j->tasks[2 * task + 1], sink_pair, &sink);
+    j->pairs[task] = sink.pairs;
+    j->count[task] = sink.count;
 }
 
 /* 0 when out of memory. */
 static int traverse(collide_ctx *c, void (*take)(void *user, uint32_t a, uint32_t b), void *user)
 {
     traversal_job *j = mk_arena_array(c->arena, 1, sizeof *j);
-    if (!j || mtx_init(&j->lock, mtx_plain) != thrd_success) return 0;
+    if (!j) return 0;
+    if (mtx_init(&j->lock, mtx_plain) != thrd_success) {
+        mk_arena_release(c->arena, j);
+        return 0;
+    }
     j->col = c->col;
     j->arena = c->arena;
     uint32_t tasks = shell_bvh_self_split(&c->col->tree, TRAVERSAL_TASKS, j->tasks);
-    mk_team_for(c->team, tasks, traverse_task, j);
+    /* Under an arena limit the growths' order must not depend on timing: one thread. */
+    mk_team_for(mk_arena_threads(c->arena, 2) > 1 ? c->team : NULL, tasks, traverse_task, j);
     mtx_destroy(&j->lock);
     for (uint32_t t = 0; t < tasks && !j->oom; t++)
         for (size_t k = 0; k < j->count[t]; k++) take(user, j->pairs[t][2 * k], j->pairs[t][2 * k + 1]);

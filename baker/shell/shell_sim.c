@@ -83,7 +83,7 @@ static void project_hinge_batches(const shell_state *s, double *x, double alpha,
             rest[j] = m->hinge_rest[h];
             lam[j] = &lambda[h];
         }
-        shell_bending_steps(size, K, w[0], root, rest, alpha, xs, lam, W, u);
+        shell_bending_steps(size, K, w, root, rest, alpha, xs, lam, W, u);
         for (uint32_t j = 0; j < size; j++) {
             sum += W[j];
             const uint32_t *v = m->hinges + 4 * (size_t)e[j];

@@ -161,9 +161,10 @@ static void hinge_step_is_the_xpbd_step_of_its_energy(void)
         for (int j = 0; j < 4; j++)
             for (int c = 0; c < 3; c++) sum += w[j] * g[3 * j + c] * g[3 * j + c];
         double dl = (-C - alpha * lambda_generic) * 2 * W / (2 * W * alpha + sum);
-        const double *K[1] = { b.K }, *xb[1][4] = { { xs[0], xs[1], xs[2], xs[3] } }, ww[1][4] = { { w[0], w[1], w[2], w[3] } };
+        const double *K[1] = { b.K }, *xb[1][4] = { { xs[0], xs[1], xs[2], xs[3] } };
+        double ww[1][4] = { { w[0], w[1], w[2], w[3] } };
         double root = sqrt(kB * b.scale), *lam[1] = { &lambda_signed }, u[1][3], W2;
-        shell_bending_steps(1, K, ww[0], &root, &b.rest, alpha, xb, lam, &W2, u);
+        shell_bending_steps(1, K, ww, &root, &b.rest, alpha, xb, lam, &W2, u);
         CHECK_NEAR(W2, W, 1e-12 * fmax(W, 1));
         double scale = 0, err = 0;
         for (int j = 0; j < 4; j++)
@@ -223,11 +224,11 @@ static void batches_equal_one_element_at_a_time(void)
                 lam_a[j] = lam_b[j] = 0.01 * frand(&seed);
                 lp[j] = &lam_a[j];
             }
-            shell_bending_steps(count, Kp, w[0], root, rest, 40.0, hx, lp, Wa, ua);
+            shell_bending_steps(count, Kp, w, root, rest, 40.0, hx, lp, Wa, ua);
             for (uint32_t j = 0; j < count; j++) {
                 double Wb, ub[1][3], *lb[1] = { &lam_b[j] };
                 const double *Kb[1] = { K[j] }, *xb[1][4] = { { hx[j][0], hx[j][1], hx[j][2], hx[j][3] } };
-                shell_bending_steps(1, Kb, w[j], &root[j], &rest[j], 40.0, xb, lb, &Wb, ub);
+                shell_bending_steps(1, Kb, &w[j], &root[j], &rest[j], 40.0, xb, lb, &Wb, ub);
                 differ += memcmp(&Wb, &Wa[j], sizeof Wb) != 0 || memcmp(ub[0], ua[j], sizeof ub[0]) != 0 ||
                           memcmp(&lam_b[j], &lam_a[j], sizeof lam_b[j]) != 0;
             }
@@ -272,6 +273,26 @@ static void volume_and_its_gradient(void)
     CHECK_NEAR(V, exact, 1e-12);
     CHECK(V < 4 * 3.14159265358979 / 3 && V > 0.9 * 4 * 3.14159265358979 / 3);
     CHECK(worst < 1e-8);
+    /* The gradient, gathered per vertex (shell_volume_gradient, on threads by vertex range), has
+     * the bits of the plain scatter over triangles in triangle order, on a jittered shape, whole
+     * and in ranges. */
+    double *scatter = calloc(3 * m.n, sizeof(double)), *ranged = malloc(3 * m.n * sizeof(double));
+    unsigned seed = 9;
+    for (uint32_t i = 0; i < 3 * m.n; i++) x[i] = m.rest[i] * (1 + 0.2 * frand(&seed));
+    for (uint32_t t = 0; t < m.tri_count; t++) {
+        const uint32_t *tri = m.tris + 3 * t;
+        for (int k = 0; k < 3; k++) {
+            const double *p = x + 3 * tri[(k + 1) % 3], *q = x + 3 * tri[(k + 2) % 3];
+            double cr[3] = { p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0] };
+            for (int c = 0; c < 3; c++) scatter[3 * tri[k] + c] += cr[c] / 6;
+        }
+    }
+    shell_volume(&m, x, grad);
+    for (uint32_t first = 0; first < m.n; first += 37) shell_volume_gradient(&m, x, ranged, first, first + 37 < m.n ? first + 37 : m.n);
+    CHECK(memcmp(grad, scatter, 3 * m.n * sizeof(double)) == 0);
+    CHECK(memcmp(ranged, scatter, 3 * m.n * sizeof(double)) == 0);
+    free(scatter);
+    free(ranged);
     /* A reversed triangle makes the mesh inconsistent: rejected. */
     uint32_t keep = mesh->triangles[1];
     mesh->triangles[1] = mesh->triangles[2];
@@ -459,7 +480,6 @@ static double region_inward_motion(const shell_mesh *m, const shell_run *run, co
     return count ? sum / count : 0;
 }
 
-/* k_A is a pressure on the region, so the same k_A moves the region alike on both meshes. */
 /* The hierarchy's traversal split into tasks (shell_bvh_self_split) visits, task after task, the
  * same pairs in the same order as the traversal in one piece, for every task budget: jittered
  * boxes of a 10 000-triangle sphere's triangles, with and without the shared-corner rule. */
@@ -554,6 +574,7 @@ static void every_material_contracts_the_shell(void)
         for (int b = a + 1; b < 4; b++) CHECK_MSG(end[a] != end[b], "%s and %s give the same run", names[a], names[b]);
 }
 
+/* k_A is a pressure on the region, so the same k_A moves the region alike on both meshes. */
 static void anisotropic_region_contracts_faster(void)
 {
     double with_end[2] = { 0, 0 };
