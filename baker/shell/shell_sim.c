@@ -125,17 +125,20 @@ static void sweep_batches(const shell_state *s, double *x, double alpha, int hin
                 area[j] = m->area[t];
             }
             shell_stvk_batch(p->mu, p->lambda, size, xs, Dm, area, W, g);
-        } else
-        for (uint32_t j = 0; j < size; j++) {
-            const uint32_t *v = idx + (size_t)k * e[j];
-            if (hinges) {
-                const double *xs[4] = { x + 3 * (size_t)v[0], x + 3 * (size_t)v[1], x + 3 * (size_t)v[2], x + 3 * (size_t)v[3] };
-                W[j] = shell_bending_energy(m->hinge_K + 4 * (size_t)e[j], m->hinge_scale[e[j]], m->hinge_rest[e[j]], p->kB,
-                                            xs, g[j]);
-            } else {
-                uint32_t t = e[j];
-                W[j] = shell_membrane_energy(p->material, p->mu, p->lambda, m->Dm_inv + 4 * (size_t)t, m->basis + 6 * (size_t)t,
-                                             m->area[t], x + 3 * (size_t)v[0], x + 3 * (size_t)v[1], x + 3 * (size_t)v[2], g[j]);
+        } else {
+            for (uint32_t j = 0; j < size; j++) {
+                const uint32_t *v = idx + (size_t)k * e[j];
+                if (hinges) {   /* energies only: the projecting sweeps took project_hinge_batches */
+                    const double *xs[4] = { x + 3 * (size_t)v[0], x + 3 * (size_t)v[1], x + 3 * (size_t)v[2],
+                                            x + 3 * (size_t)v[3] };
+                    W[j] = shell_bending_energy(m->hinge_K + 4 * (size_t)e[j], m->hinge_scale[e[j]], m->hinge_rest[e[j]],
+                                                p->kB, xs, g[j]);
+                } else {
+                    uint32_t t = e[j];
+                    W[j] = shell_membrane_energy(p->material, p->mu, p->lambda, m->Dm_inv + 4 * (size_t)t,
+                                                 m->basis + 6 * (size_t)t, m->area[t], x + 3 * (size_t)v[0],
+                                                 x + 3 * (size_t)v[1], x + 3 * (size_t)v[2], g[j]);
+                }
             }
         }
         for (uint32_t j = 0; j < size; j++) sum += W[j];
