@@ -54,8 +54,7 @@ uint32_t *mk_mesh_weld(const mk_raw_mesh *mesh, mk_arena *arena, uint32_t *welde
     return weld;
 }
 
-/* CSR from a key per item: first[key..key+1) lists the items with that key, in item order. */
-static int build_csr(mk_arena *arena, const uint32_t *key, uint32_t items, uint32_t keys, uint32_t **first_out,
+int mk_csr_build(mk_arena *arena, const uint32_t *key, uint32_t items, uint32_t keys, uint32_t **first_out,
                      uint32_t **list_out)
 {
     uint32_t *first = mk_arena_array(arena, (size_t)keys + 1, sizeof *first);
@@ -93,7 +92,7 @@ mk_result mk_normal_groups_build(const mk_raw_mesh *m, mk_grouping grouping, mk_
     g->group_count = mk_smoothing_groups(key, key_count, m->normals, n, g->group_of, scratch);
     mk_arena_release(arena, scratch);
     if (welded) mk_arena_release(arena, welded);
-    if (!build_csr(arena, g->group_of, n, g->group_count, &g->group_vert_first, &g->group_verts))
+    if (!mk_csr_build(arena, g->group_of, n, g->group_count, &g->group_vert_first, &g->group_verts))
         return mk_error_oom(err, "smoothing groups");
     /* group -> triangles: each triangle once per distinct corner group. */
     uint32_t *tri_group = mk_arena_array(arena, 3 * (size_t)m->triangle_count + 1, sizeof(uint32_t));
@@ -115,7 +114,7 @@ mk_result mk_normal_groups_build(const mk_raw_mesh *m, mk_grouping grouping, mk_
         }
     }
     uint32_t *slots;
-    if (!build_csr(arena, tri_group, pairs, g->group_count, &g->group_tri_first, &slots))
+    if (!mk_csr_build(arena, tri_group, pairs, g->group_count, &g->group_tri_first, &slots))
         return mk_error_oom(err, "smoothing groups");
     for (uint32_t k = 0; k < pairs; k++) slots[k] = tri_index[slots[k]];
     g->group_tris = slots;

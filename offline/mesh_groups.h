@@ -26,6 +26,11 @@ typedef struct mk_normal_groups {
     uint32_t *group_tri_first, *group_tris;   /* CSR: group -> triangles with a corner in it (once each) */
 } mk_normal_groups;
 
+/* Lists items by key (a counting sort): with key[i] < keys for each of the items, first[k] ..
+ * first[k + 1] of list are the items with key k, in item order (first: keys + 1 entries, list:
+ * items). Memory from arena; 0 when out of memory. */
+int mk_csr_build(mk_arena *arena, const uint32_t *key, uint32_t items, uint32_t keys, uint32_t **first, uint32_t **list);
+
 /* Welds render vertices with bit-identical base positions: weld[v] = welded index, numbered in
  * order of first render vertex; returns NULL on OOM. */
 uint32_t *mk_mesh_weld(const mk_raw_mesh *mesh, mk_arena *arena, uint32_t *welded_count);

@@ -27,12 +27,6 @@ typedef enum shell_aniso_energy {
     SHELL_ANISO_ARAP, SHELL_ANISO_SQRT, SHELL_ANISO_STVK
 } shell_aniso_kind;
 
-/* Membrane energy density psi(F) and its first Piola-Kirchhoff stress P = dpsi/dF. F and P are
- * 3x2, column-major (F[0..2] = first column, F[3..5] = second). basis (6 doubles: the rest
- * triangle's in-plane unit axes e1, e2) is used by the linear material only. */
-double shell_material_psi(shell_material material, double mu, double lambda, const double F[6],
-                          const double basis[6], double P[6]);
-
 /* Deformation gradient F = [x1 - x0, x2 - x0] Dm^-1 (3x2, column-major); Dm_inv is 2x2
  * row-major. */
 void shell_deformation_gradient(const double *x0, const double *x1, const double *x2,

@@ -35,6 +35,7 @@
 #include <threads.h>
 #include "shell.h"
 #include "bake_util.h"
+#include "mesh_groups.h"
 #include "parallel.h"
 #include "shell_bvh.h"
 #include "shell_ccd.h"
@@ -117,8 +118,8 @@ static void put_pair(uint32_t *list, size_t *count, uint32_t a, uint32_t b)
     (*count)++;
 }
 
-/* The pairs of slots s < u sharing a vertex (through the slots around each vertex, ring), each
- * once: the vertices one owns that are not the other's corners against the other, and their
+/* The pairs of slots s < u sharing a vertex (through the slots around each vertex: ring holds
+ * their corners 3 u + k), each once: the vertices one owns that are not the other's corners against the other, and their
  * owned edges that share no vertex. With near[k] NULL only counts. mark: one per slot. */
 static void list_near_pairs(shell_collider *c, uint32_t slots, const uint32_t *ring_start, const uint32_t *ring,
                             uint32_t *mark)
@@ -129,7 +130,7 @@ static void list_near_pairs(shell_collider *c, uint32_t slots, const uint32_t *r
         const uint32_t *ks = c->slot_corners + 3 * (size_t)s;
         for (int k = 0; k < 3; k++)
             for (uint32_t r = ring_start[ks[k]]; r < ring_start[ks[k] + 1]; r++) {
-                uint32_t u = ring[r];
+                uint32_t u = ring[r] / 3;
                 if (u <= s || mark[u] == s) continue;
                 mark[u] = s;
                 const uint32_t *ku = c->slot_corners + 3 * (size_t)u;
@@ -149,17 +150,6 @@ static void list_near_pairs(shell_collider *c, uint32_t slots, const uint32_t *r
     }
 }
 
-/* Lists items[0..n) by owner (counting sort): start[owner .. owner + 1) in list. */
-static void group_by_owner(const uint32_t *owner, uint32_t n, uint32_t owners, uint32_t *start, uint32_t *list)
-{
-    memset(start, 0, ((size_t)owners + 1) * sizeof(uint32_t));
-    for (uint32_t i = 0; i < n; i++) start[owner[i] + 1]++;
-    for (uint32_t t = 0; t < owners; t++) start[t + 1] += start[t];
-    for (uint32_t i = 0; i < n; i++) list[start[owner[i]]++] = i;
-    for (uint32_t t = owners; t > 0; t--) start[t] = start[t - 1];
-    start[0] = 0;
-}
-
 shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena)
 {
     shell_collider *c = mk_arena_array(arena, 1, sizeof *c);
@@ -168,10 +158,6 @@ shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena)
     c->slot_tri = mk_arena_array(arena, nt + 1, sizeof(uint32_t));
     c->slot_corners = mk_arena_array(arena, 3 * nt + 3, sizeof(uint32_t));
     c->tri_boxes = mk_arena_array(arena, 6 * nt, sizeof(double));
-    c->vertex_start = mk_arena_array(arena, nt + 1, sizeof(uint32_t));
-    c->edge_start = mk_arena_array(arena, nt + 1, sizeof(uint32_t));
-    c->owned_vertices = mk_arena_array(arena, m->n, sizeof(uint32_t));
-    c->owned_edges = mk_arena_array(arena, nh + 1, sizeof(uint32_t));
     c->vertex_boxes = mk_arena_array(arena, 6 * (size_t)m->n, sizeof(double));
     c->edge_boxes = mk_arena_array(arena, 6 * nh + 6, sizeof(double));
     c->edge_ends = mk_arena_array(arena, 2 * nh + 2, sizeof(uint32_t));
@@ -180,9 +166,8 @@ shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena)
     c->arena = arena;
     uint32_t *slot_of = mk_arena_array(arena, nt + 1, sizeof(uint32_t));
     uint32_t *owner = mk_arena_array(arena, (size_t)(m->n > nh ? m->n : nh) + 1, sizeof(uint32_t));
-    if (!c->slot_tri || !c->slot_corners || !c->tri_boxes || !c->vertex_start || !c->edge_start || !c->owned_vertices ||
-        !c->owned_edges || !c->vertex_boxes || !c->edge_boxes || !c->edge_ends || !c->far_range || !c->step_box || !slot_of ||
-        !owner)
+    if (!c->slot_tri || !c->slot_corners || !c->tri_boxes || !c->vertex_boxes || !c->edge_boxes || !c->edge_ends ||
+        !c->far_range || !c->step_box || !slot_of || !owner)
         return NULL;
     /* The hierarchy's shape from the rest mesh (neighbours on the surface stay neighbours), then
      * the slots in its leaf order. */
@@ -198,21 +183,15 @@ shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena)
     for (uint32_t v = 0; v < m->n; v++) owner[v] = UINT32_MAX;
     for (uint32_t t = m->tri_count; t-- > 0;)
         for (int k = 0; k < 3; k++) owner[m->tris[3 * (size_t)t + k]] = slot_of[t];
-    group_by_owner(owner, m->n, m->tri_count, c->vertex_start, c->owned_vertices);
+    if (!mk_csr_build(arena, owner, m->n, m->tri_count, &c->vertex_start, &c->owned_vertices)) return NULL;
     for (uint32_t h = 0; h < m->hinge_count; h++) owner[h] = slot_of[m->hinge_tri[h]];
-    group_by_owner(owner, m->hinge_count, m->tri_count, c->edge_start, c->owned_edges);
+    if (!mk_csr_build(arena, owner, m->hinge_count, m->tri_count, &c->edge_start, &c->owned_edges)) return NULL;
     for (uint32_t i = 0; i < m->hinge_count; i++)
         memcpy(c->edge_ends + 2 * (size_t)i, m->hinges + 4 * (size_t)c->owned_edges[i], 2 * sizeof(uint32_t));
-    /* The slots around each vertex, then the pairs of slots that share a vertex. */
-    uint32_t *ring_start = owner, *ring = mk_arena_array(arena, 3 * nt + 1, sizeof(uint32_t));
-    if (!ring) return NULL;
-    memset(ring_start, 0, ((size_t)m->n + 1) * sizeof(uint32_t));
-    for (size_t i = 0; i < 3 * nt; i++) ring_start[c->slot_corners[i] + 1]++;
-    for (uint32_t v = 0; v < m->n; v++) ring_start[v + 1] += ring_start[v];
-    for (uint32_t s = 0; s < m->tri_count; s++)
-        for (int k = 0; k < 3; k++) ring[ring_start[c->slot_corners[3 * (size_t)s + k]]++] = s;
-    for (uint32_t v = m->n; v > 0; v--) ring_start[v] = ring_start[v - 1];
-    ring_start[0] = 0;
+    /* The slots around each vertex (as their corners 3 s + k, in slot order; shell_mesh_build
+     * keeps 3 x triangles within 32 bits), then the pairs of slots that share a vertex. */
+    uint32_t *ring_start, *ring;
+    if (!mk_csr_build(arena, c->slot_corners, (uint32_t)(3 * nt), m->n, &ring_start, &ring)) return NULL;
     list_near_pairs(c, m->tri_count, ring_start, ring, slot_of);
     c->near[0] = mk_arena_array(arena, 2 * c->near_count[0] + 2, sizeof(uint32_t));
     c->near[1] = mk_arena_array(arena, 2 * c->near_count[1] + 2, sizeof(uint32_t));
@@ -221,6 +200,7 @@ shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena)
     if (!c->near[0] || !c->near[1] || !c->live[0] || !c->live[1]) return NULL;
     list_near_pairs(c, m->tri_count, ring_start, ring, slot_of);
     mk_arena_release(arena, ring);
+    mk_arena_release(arena, ring_start);
     mk_arena_release(arena, owner);
     mk_arena_release(arena, slot_of);
     return c;

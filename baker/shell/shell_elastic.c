@@ -14,6 +14,7 @@
  *   P = 2 C10 F + 2 C01 F adj(C) + (lambda ln J - 2 (C10 + C01)) F C^-1.
  */
 #include <math.h>
+#include <string.h>
 #include "shell.h"
 #include "bake_util.h"
 
@@ -50,19 +51,18 @@ static void f_times(const double F[6], const double S[4], double P[6])
 }
 
 
-double shell_material_psi(shell_material material, double mu, double lambda, const double F[6],
-                          const double basis[6], double P[6])
+/* Membrane energy density psi(F) and its first Piola-Kirchhoff stress P = dpsi/dF of the
+ * corotated, linear and Mooney-Rivlin materials. F and P are 3x2, column-major (F[0..2] = first
+ * column, F[3..5] = second). basis (6 doubles: the rest triangle's in-plane unit axes e1, e2) is
+ * used by the linear material only. */
+static double material_psi(shell_material material, double mu, double lambda, const double F[6], const double basis[6],
+                           double P[6])
 {
     double C[4] = { vec3_dot(F, F), vec3_dot(F, F + 3), 0, vec3_dot(F + 3, F + 3) };
     C[2] = C[1];
     switch (material) {
-    case SHELL_STVK: {
-        double E[4] = { 0.5 * (C[0] - 1), 0.5 * C[1], 0.5 * C[2], 0.5 * (C[3] - 1) };
-        double tr = E[0] + E[3];
-        double S[4] = { 2 * mu * E[0] + lambda * tr, 2 * mu * E[1], 2 * mu * E[2], 2 * mu * E[3] + lambda * tr };
-        f_times(F, S, P);
-        return mu * (E[0] * E[0] + 2 * E[1] * E[1] + E[3] * E[3]) + 0.5 * lambda * tr * tr;
-    }
+    case SHELL_STVK:   /* shell_stvk_batch (shell_membrane_energy goes there) */
+        break;
     case SHELL_COROTATED: {
         double det = C[0] * C[3] - C[1] * C[2];
         double sd = sqrt(fmax(det, 0)), den = sqrt(C[0] + C[3] + 2 * sd);
@@ -116,17 +116,24 @@ double shell_membrane_energy(shell_material material, double mu, double lambda, 
                              const double basis[6], double area, const double *x0, const double *x1,
                              const double *x2, double grad[9])
 {
+    if (material == SHELL_STVK) {   /* the one StVK: the batched form, for one triangle */
+        const double *xs[1][3] = { { x0, x1, x2 } };
+        double W[1], g[1][12];
+        shell_stvk_batch(mu, lambda, 1, xs, &Dm_inv, &area, W, g);
+        memcpy(grad, g[0], 9 * sizeof(double));
+        return W[0];
+    }
     double F[6], P[6];
     shell_deformation_gradient(x0, x1, x2, Dm_inv, F);
-    double psi = shell_material_psi(material, mu, lambda, F, basis, P);
+    double psi = material_psi(material, mu, lambda, F, basis, P);
     shell_gradient_from_stress(P, Dm_inv, area, grad);
     return area * psi;
 }
 
-/* The StVK membrane of up to SHELL_BATCH triangles at once, each stage for all of them before the
- * next: the same arithmetic as shell_membrane_energy (the results are bit-identical), laid out so
- * that the triangles' independent chains interleave instead of one triangle's multiplications
- * waiting for the one before. */
+/* The StVK membrane (the formulas at the top) of up to SHELL_BATCH triangles at once, each stage
+ * for all of them before the next, so that the triangles' independent chains interleave instead
+ * of one triangle's multiplications waiting for the one before; each triangle's arithmetic does
+ * not depend on the others (a batch gives what one triangle at a time gives, bit for bit). */
 void shell_stvk_batch(double mu, double lambda, uint32_t count, const double *x[][3], const double *const Dm_inv[],
                       const double area[], double W[], double grad[][12])
 {

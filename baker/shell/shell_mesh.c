@@ -83,6 +83,9 @@ mk_result shell_mesh_build(const mk_raw_mesh *mesh, double density, mk_arena *ar
     if (mesh->triangle_count < 4)
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "the mesh is not closed (%u triangles)",
                             mesh->triangle_count);
+    if (mesh->triangle_count > UINT32_MAX / 3)   /* corners are numbered 3 t + k in 32 bits */
+        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "the mesh has too many triangles for a shell (%u)",
+                            mesh->triangle_count);
     m->weld = mk_mesh_weld(mesh, arena, &m->n);
     if (!m->weld) return mk_error_oom(err, "shell mesh");
     uint32_t nt = mesh->triangle_count;
@@ -129,15 +132,8 @@ mk_result shell_mesh_build(const mk_raw_mesh *mesh, double density, mk_arena *ar
                                 "vertex %u is used by no triangle (the shell must be one closed surface)", v);
         m->inv_mass[v] = 1 / m->inv_mass[v];
     }
-    /* Every vertex's corners, in triangle order (a counting sort). */
-    m->corner_start = mk_arena_array(arena, (size_t)m->n + 1, sizeof(uint32_t));
-    m->corners = mk_arena_array(arena, 3 * (size_t)nt, sizeof(uint32_t));
-    if (!m->corner_start || !m->corners) return mk_error_oom(err, "shell mesh");
-    for (size_t i = 0; i < 3 * (size_t)nt; i++) m->corner_start[m->tris[i] + 1]++;
-    for (uint32_t v = 0; v < m->n; v++) m->corner_start[v + 1] += m->corner_start[v];
-    for (size_t i = 0; i < 3 * (size_t)nt; i++) m->corners[m->corner_start[m->tris[i]]++] = (uint32_t)i;
-    for (uint32_t v = m->n; v > 0; v--) m->corner_start[v] = m->corner_start[v - 1];
-    m->corner_start[0] = 0;
+    /* Every vertex's corners, in triangle order. */
+    if (!mk_csr_build(arena, m->tris, 3 * nt, m->n, &m->corner_start, &m->corners)) return mk_error_oom(err, "shell mesh");
     /* Closed and consistently oriented: every edge twice, once in each direction. */
     qsort(he, 3 * (size_t)nt, sizeof *he, compare_half_edges);
     size_t edges = 3 * (size_t)nt / 2;

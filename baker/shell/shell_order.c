@@ -70,7 +70,6 @@ mk_result shell_sweep_order_build(const uint32_t *idx, int k, uint32_t count, ui
     uint32_t *stamp = mk_arena_array(arena, (size_t)n + 1, sizeof(uint32_t));
     if (!out->order || !out->start || !group || !list || !part || !next || !owner || !stamp)
         return mk_error_oom(err, "shell sweep order");
-    memset(stamp, 0, ((size_t)n + 1) * sizeof(uint32_t));
     /* list: the elements left for this phase, in mesh order (at first all of them). */
     uint32_t left = count, placed = 0;
     for (uint32_t e = 0; e < count; e++) list[e] = e;
