@@ -8,11 +8,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include "alloc.h"
+#include "page_recycle.h"
 
 struct mk_arena_block {
     mk_arena_block *prev, *next;
     size_t size;
-    size_t pad;                 /* keeps the payload 16-byte aligned */
+    size_t mapped;              /* bytes of the block's own mapping when recycled (page_recycle.h),
+                                 * else 0; also keeps the payload 16-byte aligned */
 };
 
 void mk_arena_init(mk_arena *arena, const mk_allocator *allocator)
@@ -21,25 +23,33 @@ void mk_arena_init(mk_arena *arena, const mk_allocator *allocator)
     if (allocator) arena->allocator = *allocator;
 }
 
-/* Zeroed memory. The default allocator uses calloc: large blocks then come from fresh pages
- * the kernel has zeroed, instead of being written twice (a memset here and the real data
- * after it), which profiled as a tenth of an import. */
-static void *raw_alloc(mk_arena *arena, size_t size)
+/* Zeroed memory for a block of `size` bytes (header included). The default allocator uses
+ * calloc: large blocks then come from fresh pages the kernel has zeroed, instead of being
+ * written twice (a memset here and the real data after it), which profiled as a tenth of an
+ * import; or, where page recycling is on, the kept pages of freed large blocks. */
+static mk_arena_block *raw_alloc(mk_arena *arena, size_t size)
 {
     arena->calls++;
     if (arena->allocator.fail_after && arena->calls >= arena->allocator.fail_after) return NULL;
     if (arena->allocator.alloc) {
-        void *p = arena->allocator.alloc(arena->allocator.user, size);
-        if (p) memset(p, 0, size);
-        return p;
+        mk_arena_block *b = arena->allocator.alloc(arena->allocator.user, size);
+        if (b) memset(b, 0, size);
+        return b;
+    }
+    if (size >= MK_RECYCLE_MIN && mk_recycle_enabled()) {
+        size_t mapped;
+        mk_arena_block *b = mk_recycle_take(size, &mapped);
+        if (b) b->mapped = mapped;
+        return b;
     }
     return calloc(1, size);
 }
 
-static void raw_free(mk_arena *arena, void *ptr)
+static void raw_free(mk_arena *arena, mk_arena_block *b)
 {
-    if (arena->allocator.free) arena->allocator.free(arena->allocator.user, ptr);
-    else free(ptr);
+    if (b->mapped) mk_recycle_give(b, b->mapped);
+    else if (arena->allocator.free) arena->allocator.free(arena->allocator.user, b);
+    else free(b);
 }
 
 /* Whether `more` bytes would take the arena past its limit. An arena that adopted another's
@@ -121,14 +131,27 @@ void *mk_arena_grow(mk_arena *arena, void *ptr, size_t new_size)
     arena->calls++;
     if (arena->allocator.fail_after && arena->calls >= arena->allocator.fail_after) { arena->failed = 1; return NULL; }
     mk_arena_block *prev = b->prev, *next = b->next;
-    mk_arena_block *g = realloc(b, sizeof(mk_arena_block) + new_size);
+    const size_t old_mapped = b->mapped;
+    mk_arena_block *g;
+    if (b->mapped) {
+        size_t mapped = b->mapped;
+        g = mk_recycle_grow(b, &mapped, sizeof(mk_arena_block) + new_size);
+        if (g) g->mapped = mapped;
+    } else {
+        g = realloc(b, sizeof(mk_arena_block) + new_size);
+    }
     if (!g) { arena->failed = 1; return NULL; }
     if (prev) prev->next = g; else arena->blocks = g;
     if (next) next->prev = g;
     g->size = new_size;
     arena->bytes_live += new_size - old_size;
     if (arena->bytes_live > arena->bytes_peak) arena->bytes_peak = arena->bytes_live;
-    memset((char *)(g + 1) + old_size, 0, new_size - old_size);
+    /* A recycled block's pages past its old mapping are fresh (zero); its own pages past
+     * old_size were zeroed when it was handed out and never written. Cleared anyway, without
+     * touching the fresh ones. */
+    size_t clear_end = new_size;
+    if (g->mapped && old_mapped - sizeof(mk_arena_block) < clear_end) clear_end = old_mapped - sizeof(mk_arena_block);
+    if (clear_end > old_size) memset((char *)(g + 1) + old_size, 0, clear_end - old_size);
     return g + 1;
 }
 

@@ -1,0 +1,196 @@
+/* SPDX-License-Identifier: MIT */
+/* Page recycling (offline/page_recycle.h) through the arena: off until enabled; a freed large
+ * block's pages serve the next large block (the same addresses), which is always zeroed, also
+ * where its previous owner left pages untouched (those stay untouched: not resident after the
+ * zeroing); the cap bounds what is kept; kept ranges smaller than a request are grown into it;
+ * grown blocks keep their bytes and get a zero tail; threads taking and giving at once always
+ * get zeroed blocks. The cases run in order: the first sees recycling off. */
+#define _DEFAULT_SOURCE
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <threads.h>
+#include <unistd.h>
+#include "alloc.h"
+#include "check.h"
+#include "page_recycle.h"
+
+#define MB ((size_t)1 << 20)
+#define CAP (8 * MB)
+
+static int all_zero(const unsigned char *p, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (p[i]) return 0;
+    return 1;
+}
+
+/* Resident pages among the whole pages inside [p, p + n). */
+static size_t resident_pages(const void *p, size_t n)
+{
+    const size_t page = (size_t)sysconf(_SC_PAGESIZE);
+    uintptr_t lo = ((uintptr_t)p + page - 1) / page * page, hi = ((uintptr_t)p + n) / page * page;
+    if (hi <= lo) return 0;
+    size_t pages = (hi - lo) / page, count = 0;
+    unsigned char *vec = malloc(pages);
+    if (!vec) return SIZE_MAX;
+    if (mincore((void *)lo, hi - lo, vec) != 0) { free(vec); return SIZE_MAX; }
+    for (size_t i = 0; i < pages; i++) count += vec[i] & 1;
+    free(vec);
+    return count;
+}
+
+/* Takes every kept page into blocks of `arena`. */
+static void drain(mk_arena *arena)
+{
+    for (int i = 0; i < 10000 && mk_recycle_kept(); i++) CHECK(mk_arena_alloc(arena, MK_RECYCLE_MIN) != NULL);
+    CHECK_EQ_INT(mk_recycle_kept(), 0);
+}
+
+static void test_off_until_enabled(void)
+{
+    CHECK(!mk_recycle_enabled());
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    unsigned char *p = mk_arena_alloc(&arena, 2 * MB);
+    CHECK(p != NULL);
+    if (p) memset(p, 0xAB, 2 * MB);
+    mk_arena_release(&arena, p);
+    CHECK_EQ_INT(mk_recycle_kept(), 0);
+    CHECK(mk_recycle_enable(0) == 0);   /* a zero cap leaves it off */
+    CHECK(!mk_recycle_enabled());
+}
+
+static void test_freed_pages_are_reused_zeroed(void)
+{
+    CHECK(mk_recycle_enable(CAP));
+    CHECK(mk_recycle_enabled());
+    CHECK(mk_recycle_enable(2 * CAP));   /* later calls change nothing */
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    unsigned char *p = mk_arena_alloc(&arena, 3 * MB);
+    CHECK(p != NULL);
+    if (!p) return;
+    CHECK(all_zero(p, 3 * MB));
+    memset(p, 0xCD, 3 * MB);
+    mk_arena_release(&arena, p);
+    CHECK(mk_recycle_kept() >= 3 * MB);
+    size_t kept = mk_recycle_kept();
+    /* A smaller block is split off the front of the kept range: the same pages, zeroed. */
+    unsigned char *q = mk_arena_alloc(&arena, MB);
+    CHECK(q == p);
+    CHECK(q && all_zero(q, MB));
+    CHECK(mk_recycle_kept() < kept);
+    /* Below the threshold blocks come from malloc and leave the kept pages alone. */
+    kept = mk_recycle_kept();
+    unsigned char *s = mk_arena_alloc(&arena, MK_RECYCLE_MIN / 2);
+    CHECK(s && all_zero(s, MK_RECYCLE_MIN / 2));
+    CHECK_EQ_INT(mk_recycle_kept(), kept);
+    mk_arena_free_all(&arena);
+    CHECK_EQ_INT(arena.bytes_live, 0);
+}
+
+/* A block used only in its first half: reused, it reads zero throughout, and its second half's
+ * pages are still not resident (zeroing did not touch them). */
+static void test_untouched_pages_stay_untouched(void)
+{
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    drain(&arena);   /* what earlier cases kept: the block below is a fresh mapping */
+    unsigned char *p = mk_arena_alloc(&arena, 4 * MB);
+    CHECK(p != NULL);
+    if (!p) { mk_arena_free_all(&arena); return; }
+    memset(p, 0x5A, 2 * MB);
+    CHECK(resident_pages(p + 2 * MB + 4096, 2 * MB - 8192) == 0);
+    mk_arena_release(&arena, p);
+    unsigned char *q = mk_arena_alloc(&arena, 4 * MB);
+    CHECK(q == p);
+    if (q) {
+        CHECK(resident_pages(q + 2 * MB + 4096, 2 * MB - 8192) == 0);
+        CHECK(all_zero(q, 4 * MB));
+    }
+    mk_arena_release(&arena, q);
+    mk_arena_free_all(&arena);
+}
+
+/* What is given back beyond the cap is unmapped; a request larger than every kept range grows
+ * the largest one (its pages reused, the tail fresh), zeroed. */
+static void test_cap_and_growth(void)
+{
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    drain(&arena);
+    unsigned char *big = mk_arena_alloc(&arena, 3 * CAP);
+    CHECK(big != NULL);
+    CHECK_EQ_INT(mk_recycle_kept(), 0);
+    if (big) memset(big, 0x77, 3 * CAP);
+    mk_arena_release(&arena, big);
+    CHECK_EQ_INT(mk_recycle_kept(), CAP);
+    unsigned char *p = mk_arena_alloc(&arena, 2 * CAP);
+    CHECK(p != NULL);
+    CHECK_EQ_INT(mk_recycle_kept(), 0);
+    if (p) CHECK(all_zero(p, 2 * CAP));
+    mk_arena_free_all(&arena);
+}
+
+/* mk_arena_grow of a recycled block keeps its bytes and zeroes the tail, in place or moved. */
+static void test_grow_recycled_block(void)
+{
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    unsigned char *p = mk_arena_alloc(&arena, MB + 100);
+    CHECK(p != NULL);
+    if (!p) return;
+    for (size_t i = 0; i < MB + 100; i++) p[i] = (unsigned char)(i * 13u + 1u);
+    unsigned char *g = mk_arena_grow(&arena, p, MB + 200);   /* within its pages */
+    CHECK(g == p);
+    g = mk_arena_grow(&arena, g, 5 * MB);
+    CHECK(g != NULL);
+    if (g) {
+        int same = 1;
+        for (size_t i = 0; i < MB + 100; i++) same &= g[i] == (unsigned char)(i * 13u + 1u);
+        CHECK(same);
+        CHECK(all_zero(g + MB + 100, 4 * MB - 100));
+        CHECK_EQ_INT(arena.bytes_live, 5 * MB);
+    }
+    mk_arena_free_all(&arena);
+}
+
+static int churn(void *arg)
+{
+    unsigned seed = (unsigned)(uintptr_t)arg;
+    int bad = 0;
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    for (int round = 0; round < 200; round++) {
+        seed = seed * 1103515245u + 12345u;
+        size_t n = MK_RECYCLE_MIN + (seed >> 8) % (3 * MB);
+        unsigned char *p = mk_arena_alloc(&arena, n);
+        if (!p) { bad++; continue; }
+        bad += !all_zero(p, n);
+        memset(p, (int)(seed & 0xFF) | 1, n);
+        mk_arena_release(&arena, p);
+    }
+    mk_arena_free_all(&arena);
+    return bad;
+}
+
+static void test_threads_get_zeroed_blocks(void)
+{
+    thrd_t t[4];
+    int started[4];
+    for (int i = 0; i < 4; i++) started[i] = thrd_create(&t[i], churn, (void *)(uintptr_t)(i + 1)) == thrd_success;
+    int bad = 0;
+    for (int i = 0; i < 4; i++) {
+        int r = 1;
+        if (started[i]) thrd_join(t[i], &r);
+        bad += r;
+    }
+    CHECK_EQ_INT(bad, 0);
+    CHECK(mk_recycle_kept() <= CAP);
+}
+
+CHECK_MAIN(CASE(test_off_until_enabled), CASE(test_freed_pages_are_reused_zeroed),
+           CASE(test_untouched_pages_stay_untouched), CASE(test_cap_and_growth), CASE(test_grow_recycled_block),
+           CASE(test_threads_get_zeroed_blocks))
