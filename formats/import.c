@@ -70,7 +70,8 @@ mk_result mk_import_file(const char *path, const mk_import_options *options, mk_
     void *data;
     size_t size;
     mk_result r =
-        mk_read_file(&tmp, path, o.max_input_size ? o.max_input_size : MK_IMPORT_DEFAULT_MAX_INPUT, &data, &size, err);
+        mk_read_file_threads(&tmp, path, o.max_input_size ? o.max_input_size : MK_IMPORT_DEFAULT_MAX_INPUT,
+                             mk_arena_threads(&tmp, o.threads), &data, &size, err);
     if (r != MK_OK) {  /* the message names the file */
         mk_arena_free_all(&tmp);
         return r;

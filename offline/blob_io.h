@@ -63,6 +63,10 @@ mk_result mk_read_blob(const mk_asset *asset, mk_raw_asset *out, mk_error *err);
  * are read to their end. A directory or an empty file is an error saying so. */
 mk_result mk_read_file(mk_arena *arena, const char *path, size_t max_size, void **data,
                        size_t *size, mk_error *err);
+/* The same, a regular file of 8 MB or more read in parts by up to `threads` threads (0: one per
+ * core; mk_parallel_threads). */
+mk_result mk_read_file_threads(mk_arena *arena, const char *path, size_t max_size, uint32_t threads, void **data,
+                               size_t *size, mk_error *err);
 /* Does path end with extension (lower case, with the dot), ignoring the path's case? */
 int mk_path_has_extension(const char *path, const char *extension);
 

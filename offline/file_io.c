@@ -15,6 +15,7 @@
 #include <unistd.h>
 #include "blob_io.h"
 #include "file_write.h"
+#include "parallel.h"
 
 static mk_result io_error(mk_error *err, const char *path, const char *what, int e)
 {
@@ -53,7 +54,63 @@ static mk_result read_stream(mk_arena *arena, int fd, const char *path, size_t m
     return MK_OK;
 }
 
+/* A regular file of at least READ_SPLIT_MIN bytes is read by several threads at once, in at
+ * most READ_PARTS parts of at least READ_PART_MIN bytes (pread). Most of such a read's time is
+ * the first touch of the fresh destination pages, which the threads then take in parallel. */
+#define READ_SPLIT_MIN ((size_t)8 << 20)
+#define READ_PART_MIN ((size_t)4 << 20)
+#define READ_PARTS 64u
+
+typedef struct read_parts {
+    int fd;
+    uint8_t *p;
+    size_t n, part;
+    int error[READ_PARTS];     /* errno of a part's failed read, else 0 */
+    size_t end[READ_PARTS];    /* where a part's reading stopped (its end unless the file shrank) */
+} read_parts;
+
+static void read_part(void *user, uint32_t item, uint32_t worker)
+{
+    (void)worker;
+    read_parts *rp = user;
+    size_t at = (size_t)item * rp->part, end = rp->n - at < rp->part ? rp->n : at + rp->part;
+    rp->error[item] = 0;
+    while (at < end) {
+        ssize_t k = pread(rp->fd, rp->p + at, end - at, (off_t)at);
+        if (k < 0 && errno == EINTR) continue;
+        if (k < 0) { rp->error[item] = errno; break; }
+        if (k == 0) break;
+        at += (size_t)k;
+    }
+    rp->end[item] = at;
+}
+
+/* Reads n bytes of fd into p on up to `threads` threads; errors as the serial read gives them
+ * (the first part in file order that failed or came up short). */
+static mk_result read_split(int fd, const char *path, uint8_t *p, size_t n, uint32_t threads, mk_error *err)
+{
+    read_parts rp = { .fd = fd, .p = p, .n = n };
+    rp.part = (n + READ_PARTS - 1) / READ_PARTS;
+    if (rp.part < READ_PART_MIN) rp.part = READ_PART_MIN;
+    const uint32_t parts = (uint32_t)((n + rp.part - 1) / rp.part);
+    mk_parallel_for(parts, threads, read_part, &rp);
+    for (uint32_t i = 0; i < parts; i++) {
+        if (rp.error[i]) return io_error(err, path, "read failed", rp.error[i]);
+        const size_t end = n - (size_t)i * rp.part < rp.part ? n : (size_t)(i + 1) * rp.part;
+        if (rp.end[i] != end)
+            return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: read %zu of %zu bytes (file shrank?)", path,
+                                rp.end[i], n);
+    }
+    return MK_OK;
+}
+
 mk_result mk_read_file(mk_arena *arena, const char *path, size_t max_size, void **data, size_t *size, mk_error *err)
+{
+    return mk_read_file_threads(arena, path, max_size, 1, data, size, err);
+}
+
+mk_result mk_read_file_threads(mk_arena *arena, const char *path, size_t max_size, uint32_t threads, void **data,
+                               size_t *size, mk_error *err)
 {
     int fd = open(path, O_RDONLY | O_NOCTTY);
     if (fd < 0) return io_error(err, path, "cannot open", errno);
@@ -77,6 +134,10 @@ mk_result mk_read_file(mk_arena *arena, const char *path, size_t max_size, void 
         p = mk_arena_alloc(arena, n + 1);
         if (!p) r = mk_error_oom(err, "reading a file");
         size_t got = 0;
+        if (r == MK_OK && n >= READ_SPLIT_MIN && mk_parallel_threads(threads, 2) > 1) {
+            r = read_split(fd, path, p, n, threads, err);
+            got = n;
+        }
         while (r == MK_OK && got < n) {
             ssize_t k = read(fd, p + got, n - got);
             if (k < 0 && errno == EINTR) continue;

@@ -88,8 +88,9 @@ static void zero_pages(uint8_t *p, size_t len)
 
 void *mk_recycle_take(size_t bytes, size_t *mapped)
 {
-    const size_t len = page_round(bytes);
-    if (!enabled || len == 0) return NULL;
+    if (!enabled) return NULL;
+    size_t len = page_round(bytes);
+    if (len == 0) return NULL;
     /* The smallest kept range that holds the block (split off its front), else the largest,
      * grown: either way every kept page is reused before fresh ones are mapped. */
     mtx_lock(&lock);
@@ -100,6 +101,9 @@ void *mk_recycle_take(size_t bytes, size_t *mapped)
     }
     kept_range r = { NULL, 0 };
     if (best != SIZE_MAX) {
+        /* A remainder too small for any later block is handed out with the block (its length
+         * is the mapping's), instead of taking a slot it could never leave. */
+        if (kept[best].len - len < MK_RECYCLE_MIN) len = kept[best].len;
         r = (kept_range){ kept[best].p, len };
         if (kept[best].len > len) {
             kept[best].p += len;
@@ -137,8 +141,19 @@ void *mk_recycle_take(size_t bytes, size_t *mapped)
 
 void mk_recycle_give(void *p, size_t len)
 {
-    if (!p) return;
+    if (!p || !enabled) return;
+    len = len / page_size * page_size;   /* mappings from take and grow are whole pages */
+    kept_range drop = { NULL, 0 };
     mtx_lock(&lock);
+    if (kept_count == RANGE_SLOTS) {   /* full: the smallest range makes room for a larger one */
+        size_t smallest = 0;
+        for (size_t i = 1; i < kept_count; i++)
+            if (kept[i].len < kept[smallest].len) smallest = i;
+        if (kept[smallest].len < len) {
+            drop = kept[smallest];
+            remove_kept(smallest);
+        }
+    }
     size_t keep = kept_bytes < cap_bytes ? (cap_bytes - kept_bytes) / page_size * page_size : 0;
     if (keep > len) keep = len;
     if (kept_count == RANGE_SLOTS) keep = 0;
@@ -147,11 +162,13 @@ void mk_recycle_give(void *p, size_t len)
         kept_bytes += keep;
     }
     mtx_unlock(&lock);
+    if (drop.p) munmap(drop.p, drop.len);
     if (keep < len) munmap((uint8_t *)p + keep, len - keep);
 }
 
 void *mk_recycle_grow(void *p, size_t *mapped, size_t bytes)
 {
+    if (!enabled) return NULL;
     const size_t len = page_round(bytes);
     if (len == 0) return NULL;
     if (len <= *mapped) return p;

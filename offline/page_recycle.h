@@ -2,7 +2,7 @@
 /* Pages of freed large blocks kept for the next large blocks (the offline allocator's, alloc.c).
  *
  * On the virtual machines the tools run on, the first touch of a fresh page costs a fault in
- * the guest and often one in the host: an import of a 47 MB FBX touched ~300 MB of fresh pages
+ * the guest and often one in the host: an import of a 47 MB FBX touched ~310 MB of fresh pages
  * (79k faults, half a second of system time) to peak at 130 MB, because its big transient
  * arrays were unmapped when freed and the next arrays were mapped anew. With recycling enabled,
  * blocks of MK_RECYCLE_MIN bytes or more are mappings of their own; a freed one is kept (up to a
@@ -12,9 +12,11 @@
  * block sized for the worst case but used in part costs no more than a fresh one.
  *
  * Off until mk_recycle_enable: a process that keeps running after an import (an editor) may not
- * want up to `cap` bytes of freed memory held. The cap is also what recycling may add to a
- * process's peak memory (kept pages count as resident until reused). Linux only; elsewhere
- * mk_recycle_enable does nothing.
+ * want up to `cap` bytes of freed memory held. Kept pages count as resident until reused, and a
+ * reused page stays resident even where its new block leaves it unused, so recycling can raise
+ * a process's peak memory by the cap and more; measure it (docs/performance.md has blob8's
+ * figures). Linux only; elsewhere mk_recycle_enable does nothing and the other functions
+ * return NULL.
  */
 #ifndef MK_PAGE_RECYCLE_H
 #define MK_PAGE_RECYCLE_H

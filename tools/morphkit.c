@@ -6,6 +6,16 @@
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
+#if defined(__SANITIZE_ADDRESS__)
+#define MK_ADDRESS_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define MK_ADDRESS_SANITIZER 1
+#endif
+#endif
+#ifndef MK_ADDRESS_SANITIZER
+#define MK_ADDRESS_SANITIZER 0
+#endif
 
 static const cli_verb *const verbs[] = {
     &cli_verb_import, &cli_verb_info, &cli_verb_play, &cli_verb_bake,
@@ -37,12 +47,13 @@ int main(int argc, char **argv)
      * back to the system and lowers the peak (blob8: 245 MB -> 167 MB). */
     mallopt(M_TRIM_THRESHOLD, 1 << 20);
 #endif
-#if !defined(__SANITIZE_ADDRESS__)
+#if !MK_ADDRESS_SANITIZER
     /* Freed large blocks' pages go to the next large blocks instead of back to the system
-     * (page_recycle.h): blob8's import touched 79k fresh pages for a 130 MB peak, 56k with this
-     * (docs/performance.md). The cap is what it may add to the peak: 32 MB kept it within 3x
-     * the input file there; larger caps saved a few thousand faults more and went past it. Off
-     * under AddressSanitizer, which cannot see a use after free inside reused pages. */
+     * (page_recycle.h): blob8's import touched 79k fresh pages for a 129 MB peak, 55k for a
+     * 133 MB peak with this (docs/performance.md). The cap bounds the pages kept: 32 MB kept the
+     * peak within 3x the input file there; larger caps saved a few thousand faults more and
+     * reached it. Off under AddressSanitizer, which cannot see a use after free inside reused
+     * pages. */
     mk_recycle_enable((size_t)32 << 20);
 #endif
     if (argc < 2) {

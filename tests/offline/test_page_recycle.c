@@ -17,7 +17,7 @@
 #include "page_recycle.h"
 
 #define MB ((size_t)1 << 20)
-#define CAP (8 * MB)
+#define CAP (16 * MB)
 
 static int all_zero(const unsigned char *p, size_t n)
 {
@@ -101,6 +101,10 @@ static void test_untouched_pages_stay_untouched(void)
     unsigned char *p = mk_arena_alloc(&arena, 4 * MB);
     CHECK(p != NULL);
     if (!p) { mk_arena_free_all(&arena); return; }
+    /* Where transparent huge pages are always on, the memset below would fault in a whole
+     * 2 MB page reaching past the first half. */
+    const uintptr_t page = (uintptr_t)sysconf(_SC_PAGESIZE);
+    madvise((void *)((uintptr_t)p / page * page), 4 * MB + page, MADV_NOHUGEPAGE);
     memset(p, 0x5A, 2 * MB);
     CHECK(resident_pages(p + 2 * MB + 4096, 2 * MB - 8192) == 0);
     mk_arena_release(&arena, p);
@@ -157,6 +161,41 @@ static void test_grow_recycled_block(void)
     mk_arena_free_all(&arena);
 }
 
+/* A split that would leave less than a recycled block's minimum hands the whole range out. */
+static void test_no_unusable_remainders(void)
+{
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    drain(&arena);
+    void *a = mk_arena_alloc(&arena, MB);
+    CHECK(a != NULL);
+    mk_arena_release(&arena, a);
+    const size_t kept = mk_recycle_kept();
+    CHECK(kept >= MB);
+    void *b = mk_arena_alloc(&arena, kept - MK_RECYCLE_MIN / 2);
+    CHECK(b == a);
+    CHECK_EQ_INT(mk_recycle_kept(), 0);
+    mk_arena_free_all(&arena);
+}
+
+/* With every slot taken, a larger range given back replaces the smallest kept one. */
+static void test_full_table_keeps_the_larger(void)
+{
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    drain(&arena);
+    void *small[64];
+    for (int i = 0; i < 64; i++) small[i] = mk_arena_alloc(&arena, MK_RECYCLE_MIN);
+    void *big = mk_arena_alloc(&arena, 2 * MB);
+    CHECK(big != NULL);
+    for (int i = 0; i < 64; i++) mk_arena_release(&arena, small[i]);
+    const size_t kept = mk_recycle_kept(), one = kept / 64;
+    CHECK(kept == 64 * one && one >= MK_RECYCLE_MIN);
+    mk_arena_release(&arena, big);
+    CHECK(mk_recycle_kept() >= kept - one + 2 * MB);
+    mk_arena_free_all(&arena);
+}
+
 static int churn(void *arg)
 {
     unsigned seed = (unsigned)(uintptr_t)arg;
@@ -193,4 +232,5 @@ static void test_threads_get_zeroed_blocks(void)
 
 CHECK_MAIN(CASE(test_off_until_enabled), CASE(test_freed_pages_are_reused_zeroed),
            CASE(test_untouched_pages_stay_untouched), CASE(test_cap_and_growth), CASE(test_grow_recycled_block),
+           CASE(test_no_unusable_remainders), CASE(test_full_table_keeps_the_larger),
            CASE(test_threads_get_zeroed_blocks))
