@@ -38,6 +38,7 @@ typedef struct mk_write_report {
     double tolerance_used;      /* the largest per-mesh tolerance that was applied */
     uint32_t quantized_targets, float_targets;
     uint64_t float_entries;     /* entries of quantized targets stored as float32 (outliers) */
+    uint64_t offset_entries;    /* int16 entries around a position offset (outliers that fit) */
     uint64_t entry_count;       /* all block entries */
     uint64_t target_bytes;      /* bytes of block data (entries + deltas) */
     uint64_t total_bytes;

@@ -54,12 +54,17 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
             uint32_t m = mk_popcount64(en->mask);
             size_t attr = (size_t)mk_entry_data_size(mk_entry_flags(0, q), m);  /* one attribute's bytes */
             const uint8_t *p = a->data + bm->target_data + (size_t)en->data * MK_ALIGN;
+            float offset[3] = { 0, 0, 0 };   /* MK_ENTRY_OFFSET: the positions' common part */
+            if (mk_entry_has_offset(en)) {
+                memcpy(offset, p, sizeof offset);
+                p += MK_ENTRY_OFFSET_BYTES;
+            }
             uint32_t j = 0;
             for (uint64_t bits = en->mask; bits; bits &= bits - 1, j++) {
                 float pv[3], nv[3] = { 0, 0, 0 }, tv[3] = { 0, 0, 0 };
                 int nonzero = 0;
                 for (int c = 0; c < 3; c++) {
-                    pv[c] = decode(p, q, c, j, bt->position_scale);
+                    pv[c] = offset[c] + decode(p, q, c, j, bt->position_scale);
                     if (hn) nv[c] = decode(p + attr, q, c, j, bt->normal_scale);
                     if (ht) tv[c] = decode(p + attr * (hn ? 2 : 1), q, c, j, bt->tangent_scale);
                     nonzero |= pv[c] != 0 || nv[c] != 0 || tv[c] != 0;

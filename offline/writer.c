@@ -149,29 +149,58 @@ static float entry_limit_for(double tolerance)
     return limit;
 }
 
+/* Whether a block's positions fit int16 around a common offset (the middle of each component's
+ * range, written to offset[]): every |value - offset| within the entry limit, with a hundredth
+ * of it to spare for the rounding of the subtraction. Returns the largest |value - offset|, or
+ * -1 when they do not fit. */
+static float offset_fits(const float *positions, uint32_t count, float limit, float offset[3])
+{
+    float spread = 0;
+    for (int c = 0; c < 3; c++) {
+        float lo = INFINITY, hi = -INFINITY;
+        for (uint32_t k = 0; k < count; k++) {
+            const float v = positions[3u * k + (uint32_t)c];
+            lo = v < lo ? v : lo;
+            hi = v > hi ? v : hi;
+        }
+        offset[c] = lo + (hi - lo) * 0.5f;
+        const float d = fmaxf(fabsf(hi - offset[c]), fabsf(lo - offset[c]));
+        if (!(d <= 0.99f * limit)) return -1;
+        spread = d > spread ? d : spread;
+    }
+    return spread;
+}
+
 /* Per-entry precision of a target the tolerance does not fit whole: the blocks whose
- * positions exceed entry_limit_for(tolerance) are float32, the scales come from the rest. A
- * target without such a rest stays float32. */
+ * positions exceed entry_limit_for(tolerance) are int16 around an offset where their spread
+ * allows it (offset_fits), else float32; the scales come from the int16 blocks and the offset
+ * blocks' spreads. A target without such a rest stays float32. */
 static void plan_entries(const mk_raw_target *t, target_plan *p)
 {
     const float limit = entry_limit_for(p->tolerance);
     float pm = 0, nm = 0, tm = 0;
-    int any_int16 = 0, any_float = 0;
+    int any_int16 = 0, any_outlier = 0;
     for (uint32_t first = 0; first < t->count;) {
         const uint32_t start = t->indices[first] / MK_BLOCK_SIZE * MK_BLOCK_SIZE;
-        const uint32_t end = block_end(t, first, start + MK_BLOCK_SIZE);
-        const size_t at = 3u * (size_t)first, n = 3u * (size_t)(end - first);
+        const uint32_t end = block_end(t, first, start + MK_BLOCK_SIZE), count = end - first;
+        const size_t at = 3u * (size_t)first, n = 3u * (size_t)count;
         const float bm = max_abs(t->positions + at, n);
         first = end;
-        if (bm > limit) { any_float = 1; continue; }
-        any_int16 = 1;
-        pm = bm > pm ? bm : pm;
+        /* Normals and tangents of every block: the blocks offset_fits holds are int16 too. */
         if (t->normals) { float x = max_abs(t->normals + at, n); nm = x > nm ? x : nm; }
         if (t->tangents) { float x = max_abs(t->tangents + at, n); tm = x > tm ? x : tm; }
+        float offset[3], spread = bm;
+        if (bm > limit) {
+            any_outlier = 1;
+            spread = offset_fits(t->positions + at, count, limit, offset);
+        }
+        if (spread < 0) continue;   /* float32 */
+        any_int16 = 1;   /* int16, or int16 around an offset (its spread then sets the scale too) */
+        pm = spread > pm ? spread : pm;
     }
     if (!any_int16) return;
     p->flags |= MK_TARGET_QUANTIZED;
-    p->entry_limit = any_float ? limit : INFINITY;  /* no block above it: the later passes need not look */
+    p->entry_limit = any_outlier ? limit : INFINITY;  /* no block above it: the later passes need not look */
     p->position_scale = quant_scale(pm);
     if (t->normals) p->normal_scale = quant_scale(nm);
     if (t->tangents) p->tangent_scale = quant_scale(tm);
@@ -198,12 +227,17 @@ static void plan_target(const mk_raw_target *t, mk_precision precision, target_p
     if (t->tangents) p->tangent_scale = quant_scale(max_abs(t->tangents, n));
 }
 
-/* Whether the target's moved vertices [first, end) of one block are stored as float32. */
-static int entry_is_float(const mk_raw_target *t, const target_plan *p, uint32_t first, uint32_t end)
+/* How a target's moved vertices [first, end) of one block are stored. */
+typedef enum entry_kind { ENTRY_INT16, ENTRY_FLOAT, ENTRY_OFFSET } entry_kind;
+
+static entry_kind entry_kind_of(const mk_raw_target *t, const target_plan *p, uint32_t first, uint32_t end,
+                                float offset[3])
 {
-    if (!(p->flags & MK_TARGET_QUANTIZED)) return 1;
-    if (p->entry_limit == INFINITY) return 0;
-    return max_abs(t->positions + 3u * (size_t)first, 3u * (size_t)(end - first)) > p->entry_limit;
+    if (!(p->flags & MK_TARGET_QUANTIZED)) return ENTRY_FLOAT;
+    if (p->entry_limit == INFINITY) return ENTRY_INT16;
+    const float *positions = t->positions + 3u * (size_t)first;
+    if (max_abs(positions, 3u * (size_t)(end - first)) <= p->entry_limit) return ENTRY_INT16;
+    return offset_fits(positions, end - first, p->entry_limit, offset) >= 0 ? ENTRY_OFFSET : ENTRY_FLOAT;
 }
 
 typedef struct plan_loop {
@@ -226,8 +260,9 @@ static void plan_item(void *user, uint32_t item, uint32_t worker)
  * cursor is the target's first index in the block; each vertex is looked up once for all
  * attributes. The largest int16 error per attribute is kept in error[] (every value is
  * written once, so this is the error over the whole target). */
-static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p, int quantized, uint32_t cursor,
-                      uint64_t mask, uint32_t block, size_t attr, double error[3])
+static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p, int quantized,
+                      const float *offset, uint32_t cursor, uint64_t mask, uint32_t block, size_t attr,
+                      double error[3])
 {
     const float *src[3] = { t->positions, t->normals, t->tangents };
     const float scale[3] = { p->position_scale, p->normal_scale, p->tangent_scale };
@@ -242,10 +277,14 @@ static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p
             if (!src[a]) continue;
             const float *value = &src[a][3u * k];
             if (quantized) {
-                int16_t q[3] = { quantize(value[0], scale[a]), quantize(value[1], scale[a]), quantize(value[2], scale[a]) };
+                /* An offset entry's positions are stored relative to its offset. */
+                const float o[3] = { a == 0 && offset ? offset[0] : 0.0f, a == 0 && offset ? offset[1] : 0.0f,
+                                     a == 0 && offset ? offset[2] : 0.0f };
+                int16_t q[3] = { quantize(value[0] - o[0], scale[a]), quantize(value[1] - o[1], scale[a]),
+                                 quantize(value[2] - o[2], scale[a]) };
                 memcpy(out[a] + 6 * j, q, 6);
                 for (int c = 0; c < 3; c++) {
-                    double e = quant_error_of(value[c], q[c], scale[a]);
+                    double e = fabs((double)o[c] + (double)q[c] * scale[a] - (double)value[c]);
                     error[a] = e > error[a] ? e : error[a];
                 }
             } else {
@@ -271,17 +310,21 @@ typedef struct layout_loop {
     uint32_t gap;                      /* mk_block_mask's */
     target_layout *targets;
     uint32_t *entry_block;             /* per entry, target-major */
-    uint8_t *entry_float;              /* per entry: its data is float32 */
+    uint8_t *entry_kind;               /* per entry: its entry_kind */
     uint64_t *entry_mask, *entry_data; /* the entry's vertices; its data's offset in the target data */
     uint8_t *data;                     /* the mesh's target data */
     mk_arena *owner;                   /* consuming: the raw arena the written targets go back to */
     mtx_t *owner_lock;
 } layout_loop;
 
-/* Calls fn(user, block, first, end, mask) for each block a target touches, in block order:
- * the target's moved vertices in it are indices [first, end), the mask is mk_block_mask's. */
-static void target_blocks(const layout_loop *l, const mk_raw_target *tg,
-                          void (*fn)(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask),
+/* Calls fn(user, block, first, end, mask, kind, offset) for each block a target touches, in
+ * block order: the target's moved vertices in it are indices [first, end); kind and offset are
+ * entry_kind_of's; the mask is mk_block_mask's, or exactly the moved vertices for an offset entry
+ * (a covered vertex the target does not move would read as the offset). */
+typedef void (*block_fn)(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask, entry_kind kind,
+                         const float offset[3]);
+
+static void target_blocks(const layout_loop *l, const mk_raw_target *tg, const target_plan *plan, block_fn fn,
                           void *user)
 {
     const uint32_t vertex_count = l->m->vertex_count;
@@ -291,9 +334,18 @@ static void target_blocks(const layout_loop *l, const mk_raw_target *tg,
         uint32_t end = block_end(tg, first, start + in_block);
         uint64_t moved = 0;
         for (uint32_t k = first; k < end; k++) moved |= 1ull << (tg->indices[k] - start);
-        fn(user, block, first, end, mk_block_mask(moved, in_block, l->gap));
+        float offset[3] = { 0, 0, 0 };
+        const entry_kind kind = entry_kind_of(tg, plan, first, end, offset);
+        fn(user, block, first, end, kind == ENTRY_OFFSET ? moved : mk_block_mask(moved, in_block, l->gap), kind, offset);
         first = end;
     }
+}
+
+/* Bytes of an entry's data: the offset, then the attributes. */
+static uint64_t entry_bytes(const target_plan *p, entry_kind kind, uint64_t mask)
+{
+    return (kind == ENTRY_OFFSET ? MK_ENTRY_OFFSET_BYTES : 0u) +
+           mk_entry_data_size(mk_entry_flags(p->flags, kind != ENTRY_FLOAT), mk_popcount64(mask));
 }
 
 typedef struct layout_item {
@@ -302,13 +354,15 @@ typedef struct layout_item {
     uint32_t index;
 } layout_item;
 
-static void count_block(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask)
+static void count_block(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask, entry_kind kind,
+                        const float offset[3])
 {
     layout_item *it = user;
     (void)block;
-    const target_plan *p = &it->l->plans[it->index];
-    const int quantized = !entry_is_float(it->tl->t, p, first, end);
-    uint64_t size = mk_entry_data_size(mk_entry_flags(p->flags, quantized), mk_popcount64(mask));
+    (void)first;
+    (void)end;
+    (void)offset;
+    uint64_t size = entry_bytes(&it->l->plans[it->index], kind, mask);
     it->tl->data_size = pad16((size_t)it->tl->data_size) + size;
     it->tl->entry_count++;
 }
@@ -318,27 +372,35 @@ static void layout_count(void *user, uint32_t item, uint32_t worker)
     layout_loop *l = user;
     (void)worker;
     layout_item it = { l, &l->targets[item], item };
-    target_blocks(l, it.tl->t, count_block, &it);
+    target_blocks(l, it.tl->t, &l->plans[item], count_block, &it);
 }
 
-static void write_block(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask)
+static void write_block(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask, entry_kind kind,
+                        const float offset[3])
 {
     layout_item *it = user;
     const layout_loop *l = it->l;
     target_layout *tl = it->tl;
     const mk_raw_target *tg = tl->t;
     const target_plan *p = &l->plans[it->index];
+    (void)end;
     uint64_t e = tl->cursor++;
-    const int is_float = entry_is_float(tg, p, first, end);
     uint64_t at = pad16((size_t)tl->data_size);
-    uint64_t size = mk_entry_data_size(mk_entry_flags(p->flags, !is_float), mk_popcount64(mask));
+    uint64_t size = entry_bytes(p, kind, mask);
     tl->data_size = at + size;
     l->entry_block[e] = block;
-    l->entry_float[e] = (uint8_t)is_float;
+    l->entry_kind[e] = (uint8_t)kind;
     l->entry_mask[e] = mask;
     l->entry_data[e] = tl->base + at;
+    uint8_t *dst = l->data + tl->base + at;
+    if (kind == ENTRY_OFFSET) {   /* x, y, z, then the 4 zero bytes the blob already holds */
+        memcpy(dst, offset, 3 * sizeof(float));
+        dst += MK_ENTRY_OFFSET_BYTES;
+        size -= MK_ENTRY_OFFSET_BYTES;
+    }
     size_t attr = (size_t)size / (1u + (tg->normals ? 1u : 0u) + (tg->tangents ? 1u : 0u));
-    put_entry(l->data + tl->base + at, tg, p, !is_float, first, mask, block, attr, tl->error);
+    put_entry(dst, tg, p, kind != ENTRY_FLOAT, kind == ENTRY_OFFSET ? offset : NULL, first, mask, block, attr,
+              tl->error);
 }
 
 static void layout_write(void *user, uint32_t item, uint32_t worker)
@@ -348,7 +410,7 @@ static void layout_write(void *user, uint32_t item, uint32_t worker)
     layout_item it = { l, &l->targets[item], item };
     it.tl->cursor = it.tl->first_entry;
     it.tl->data_size = 0;
-    target_blocks(l, it.tl->t, write_block, &it);
+    target_blocks(l, it.tl->t, &l->plans[item], write_block, &it);
     mk_raw_target *own = it.tl->own;
     if (!own) return;
     void *arrays[] = { own->indices, own->positions, own->normals, own->tangents };
@@ -450,8 +512,8 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, uint32_t threads, mk_aren
     l->entry_block = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_block);
     l->entry_mask = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_mask);
     l->entry_data = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_data);
-    l->entry_float = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_float);
-    if (!l->entry_block || !l->entry_mask || !l->entry_data || !l->entry_float)
+    l->entry_kind = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_kind);
+    if (!l->entry_block || !l->entry_mask || !l->entry_data || !l->entry_kind)
         return mk_error_oom(err, "planning blocks");
     l->data = data + out->target_data;
     mtx_t lock;
@@ -470,9 +532,12 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, uint32_t threads, mk_aren
         for (uint32_t t = 0; t < target_count; t++) {
             target_layout *tl = &l->targets[t];
             if (tl->cursor == tl->first_entry + tl->entry_count || l->entry_block[tl->cursor] != b) continue;
-            const uint32_t flags = l->entry_float[tl->cursor] ? (uint32_t)MK_ENTRY_FLOAT : 0u;
+            const entry_kind kind = (entry_kind)l->entry_kind[tl->cursor];
+            const uint32_t flags = kind == ENTRY_FLOAT ? (uint32_t)MK_ENTRY_FLOAT
+                                 : kind == ENTRY_OFFSET ? (uint32_t)MK_ENTRY_OFFSET : 0u;
             mk_blob_entry be = { t | flags, (uint32_t)(l->entry_data[tl->cursor] / MK_ALIGN), l->entry_mask[tl->cursor] };
-            report->float_entries += flags && (l->plans[t].flags & MK_TARGET_QUANTIZED);
+            report->float_entries += kind == ENTRY_FLOAT && (l->plans[t].flags & MK_TARGET_QUANTIZED);
+            report->offset_entries += kind == ENTRY_OFFSET;
             entries[e++] = be;
             tl->cursor++;
         }
@@ -486,7 +551,7 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, uint32_t threads, mk_aren
         if (te[1] > report->max_normal_error) report->max_normal_error = te[1];
         if (te[2] > report->max_tangent_error) report->max_tangent_error = te[2];
     }
-    void *scratch[] = { l->targets, l->entry_block, l->entry_mask, l->entry_data, l->entry_float };
+    void *scratch[] = { l->targets, l->entry_block, l->entry_mask, l->entry_data, l->entry_kind };
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
     l->targets = NULL;
     return MK_OK;

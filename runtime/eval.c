@@ -242,6 +242,19 @@ MK_INLINE void add_span_f32(float *restrict acc, const float *restrict src, uint
     for (uint32_t k = 0; k < n; k++) acc[k] += factor * src[k];
 }
 
+/* Adds factor * offset (one xyz triple) to every vertex of the mask: the common part of an
+ * MK_ENTRY_OFFSET entry's position deltas. */
+MK_INLINE void add_offset(float *restrict acc, uint64_t mask, const float *restrict offset, float factor)
+{
+    const float o[3] = { factor * offset[0], factor * offset[1], factor * offset[2] };
+    for (; mask; mask &= mask - 1) {
+        float *v = acc + 3 * mk_ctz64(mask);
+        v[0] += o[0];
+        v[1] += o[1];
+        v[2] += o[2];
+    }
+}
+
 /* Adds one attribute of an entry: xyz triples of the mask's vertices in bit order. A run of
  * consecutive mask bits is one contiguous span of both the data and the accumulator, so a
  * dense block is a single loop of 192 values and a sparse one a short loop per run. */
@@ -440,7 +453,12 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
             const uint32_t moved = mk_popcount64(en->mask);
             const size_t attribute_bytes = (size_t)mk_entry_data_size(q ? MK_TARGET_QUANTIZED : 0u, moved);
             const uint8_t *p = data + (size_t)en->data * MK_ALIGN;
-            prefetch_ahead(p, (size_t)mk_entry_data_size(mk_entry_flags(tg->flags, q), moved));
+            const size_t offset_bytes = mk_entry_has_offset(en) ? MK_ENTRY_OFFSET_BYTES : 0u;
+            prefetch_ahead(p, offset_bytes + (size_t)mk_entry_data_size(mk_entry_flags(tg->flags, q), moved));
+            if (offset_bytes) {
+                add_offset(acc_p, en->mask, (const float *)(const void *)p, c);
+                p += offset_bytes;
+            }
             add_attribute(acc_p, en->mask, p, q, c * (q ? tg->position_scale : 1.0f));
             if (!want_normals && !want_tangents) continue;
             p += attribute_bytes;
@@ -537,6 +555,7 @@ uint64_t mk_eval_traffic(const mk_eval_job *job)
         if (f.coef[ti] == 0.0f) continue;
         uint32_t flags = mk_entry_flags(f.targets[ti].flags, mk_entry_quantized(&entries[e])) & ~strip;
         bytes += mk_entry_data_size(flags, mk_popcount64(entries[e].mask));
+        if (mk_entry_has_offset(&entries[e])) bytes += MK_ENTRY_OFFSET_BYTES;
     }
     /* Base arrays read and outputs written. */
     bytes += (uint64_t)n * 12u * 2u * (job->normals ? 2u : 1u);

@@ -112,12 +112,17 @@ typedef struct mk_blob_target {
  * x0 y0 z0 x1 y1 z1 ..., then the normal deltas if the target has normals, then the tangent
  * deltas (xyz) if it has tangents; float32 when the entry has MK_ENTRY_FLOAT, else int16 times
  * the target's scales (only a quantized target has int16 entries; a float target's entries all
- * have the flag). A run of consecutive mask bits is one contiguous span of data and output. The
+ * have the flag), after the position offset of an MK_ENTRY_OFFSET entry. A run of consecutive mask bits is one contiguous span of data and output. The
  * mask may cover vertices the target does not move (their deltas are zeros). */
 #define MK_ENTRY_TARGET_MASK 0x00FFFFFFu   /* target_and_flags: the mesh-local target index */
 #define MK_MAX_MESH_TARGETS (MK_ENTRY_TARGET_MASK + 1u)   /* targets per mesh: 2^24 */
 #define MK_ENTRY_FLOAT 0x80000000u       /* target_and_flags: the entry's data is float32 */
-#define MK_ENTRY_FLAGS_KNOWN MK_ENTRY_FLOAT
+/* target_and_flags: an int16 entry whose position deltas are offset + int16 x scale; its data
+ * starts with the offset (MK_ENTRY_OFFSET_BYTES: f32 x, y, z, then 4 zero bytes). Lets a block
+ * of large deltas with a narrow spread stay int16 within the tolerance. */
+#define MK_ENTRY_OFFSET 0x40000000u
+#define MK_ENTRY_OFFSET_BYTES 16u
+#define MK_ENTRY_FLAGS_KNOWN (MK_ENTRY_FLOAT | MK_ENTRY_OFFSET)
 
 typedef struct mk_blob_entry {
     uint32_t target_and_flags;     /* mesh-local target index (low 24 bits) | MK_ENTRY_* */
@@ -171,6 +176,7 @@ uint64_t mk_checksum(const void *data, uint64_t size);
 
 static inline uint32_t mk_entry_target(const mk_blob_entry *e) { return e->target_and_flags & MK_ENTRY_TARGET_MASK; }
 static inline int mk_entry_quantized(const mk_blob_entry *e) { return (e->target_and_flags & MK_ENTRY_FLOAT) == 0; }
+static inline int mk_entry_has_offset(const mk_blob_entry *e) { return (e->target_and_flags & MK_ENTRY_OFFSET) != 0; }
 
 /* The flags that size an entry's data: its target's attributes, MK_TARGET_QUANTIZED when the
  * entry holds int16 (quantized: mk_entry_quantized of a stored entry, or the writer's choice). */

@@ -488,12 +488,30 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
             if (FAILS("entry.precision", mk_entry_quantized(en) && !(tg->flags & MK_TARGET_QUANTIZED)))
                 return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": int16 data for float target ", target,
                              "");
+            if (FAILS("entry.offset_precision", mk_entry_has_offset(en) && !mk_entry_quantized(en)))
+                return fail2(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e,
+                             ": a position offset on float32 data (only int16 entries have one)");
             uint32_t count = mk_popcount64(en->mask);
-            uint64_t bytes = mk_entry_data_size(mk_entry_flags(tg->flags, mk_entry_quantized(en)), count);
+            const uint64_t offset_bytes = mk_entry_has_offset(en) ? MK_ENTRY_OFFSET_BYTES : 0u;
+            uint64_t bytes = offset_bytes + mk_entry_data_size(mk_entry_flags(tg->flags, mk_entry_quantized(en)), count);
             uint64_t offset = (uint64_t)en->data * MK_ALIGN;
             if (FAILS("entry.data", offset > m->target_data_size || bytes > m->target_data_size - offset))
                 return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": its ", bytes,
                              " bytes of data run past the mesh's target data");
+            if (offset_bytes) {
+                const float *o = (const float *)(v->data + m->target_data + offset);
+                uint64_t bad_offset = first_not_finite(o, 3);
+                if (FAILS("entry.offset_finite", bad_offset < 3))
+                    return fail3(v->err, MK_ERROR_NOT_FINITE, m->target_data + offset + 4 * bad_offset, "mesh ", mi,
+                                 " entry ", e, ": position offset component ", bad_offset, " is not finite");
+                uint32_t pad;
+                memcpy(&pad, o + 3, 4);
+                if (FAILS("entry.offset_pad", pad != 0))
+                    return fail2(v->err, MK_ERROR_CORRUPT, m->target_data + offset + 12, "mesh ", mi, " entry ", e,
+                                 ": the 4 bytes after its position offset are not zero");
+                offset += offset_bytes;
+                bytes -= offset_bytes;
+            }
             uint64_t bad = mk_entry_quantized(en) ? bytes / 4
                          : first_not_finite((const float *)(v->data + m->target_data + offset), bytes / 4);
             if (FAILS("entry.data_finite", bad < bytes / 4))

@@ -35,7 +35,7 @@ extern "C" {
 #define MK_VERSION_STRING "0.2.0"
 
 /* The version of the blob format this runtime reads and the tools write. */
-#define MK_FORMAT_VERSION 3u
+#define MK_FORMAT_VERSION 4u
 
 /* Consecutive key points of a channel (its full weights and the implicit 0) are at least this
  * far apart, so span parameters stay finite (docs/semantics.md). */

@@ -117,12 +117,14 @@ static void test_quantization_tolerance(void)
     }
     CHECK_MSG(worst <= rep.max_position_error + 1e-9, "worst %g > reported %g", worst, rep.max_position_error);
     /* A tolerance below the worst int16 error: more blocks (at least the worst one's) are stored
-     * as float now, and every int16 value errs by no more than the tolerance. */
+     * as float or around an offset now, and every int16 value errs by no more than the tolerance. */
     const double before = rep.max_position_error;
     o.tolerance = (float)(0.75 * before);
     CHECK(before > 0 && mk_write_blob(&raw, &o, &raw.arena, &blob, &size, &rep, &err) == MK_OK);
-    CHECK_MSG(rep.float_entries + rep.float_targets >= 2, "tolerance %g below the worst error %g: %llu float blocks, %u float targets",
-              (double)o.tolerance, before, (unsigned long long)rep.float_entries, rep.float_targets);
+    CHECK_MSG(rep.float_entries + rep.float_targets + rep.offset_entries >= 2,
+              "tolerance %g below the worst error %g: %llu float blocks, %llu offset blocks, %u float targets",
+              (double)o.tolerance, before, (unsigned long long)rep.float_entries,
+              (unsigned long long)rep.offset_entries, rep.float_targets);
     CHECK_MSG(rep.max_position_error <= o.tolerance, "a quantized target errs by %g, over the tolerance %g",
               rep.max_position_error, (double)o.tolerance);
     mk_raw_free(&back);

@@ -115,11 +115,20 @@ static void test_outlier_block_is_float(void)
     CHECK(found);
     mk_raw_free(&back);
 
-    /* A target whose every block is an outlier stays a float target. */
+    /* Every block an outlier: those whose deltas spread narrowly are int16 around an offset,
+     * the one with the 1000 stays float32. */
     for (uint32_t j = 0; j < t3->count; j++) t3->positions[3 * j] = 500.0f;
+    write_open(&raw, &o, &arena, &a, &rep);
+    CHECK_EQ_INT(rep.float_targets, 0);
+    CHECK_EQ_INT(rep.float_entries, 1);
+    CHECK_EQ_INT(rep.offset_entries, 4);
+    CHECK(a.targets[3].flags & MK_TARGET_QUANTIZED);
+    /* With a spread too wide everywhere, the target stays float. */
+    for (uint32_t j = 0; j < t3->count; j++) t3->positions[3 * j] = j % 2 ? 500.0f : -500.0f;
     write_open(&raw, &o, &arena, &a, &rep);
     CHECK_EQ_INT(rep.float_targets, 1);
     CHECK_EQ_INT(rep.float_entries, 0);
+    CHECK_EQ_INT(rep.offset_entries, 0);
     CHECK(!(a.targets[3].flags & MK_TARGET_QUANTIZED));
     mk_arena_free_all(&arena);
     mk_raw_free(&raw);
@@ -211,6 +220,100 @@ static void test_outlier_block_every_path(void)
     mk_raw_free(&raw);
 }
 
+/* A block whose deltas are large but close together (block 1 of target 3 moved 200 units along
+ * x, beyond what int16 holds within the tolerance) is stored int16 around an offset: its entry
+ * has MK_ENTRY_OFFSET and an exact mask, the target's scale covers the spread, and evaluation,
+ * range jobs, read-back and mk_eval_traffic agree with the float model. */
+static void test_offset_entry(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_line(&raw, VERTICES, 4, 1);
+    mk_raw_mesh *m = &raw.meshes[0];   /* tangents, for eval_range */
+    m->tangents = mk_arena_array(&raw.arena, 4u * VERTICES, sizeof(float));
+    for (uint32_t v = 0; v < VERTICES; v++) { m->tangents[4 * v] = 1; m->tangents[4 * v + 3] = 1; }
+    mk_raw_target *t3 = &raw.channels[3].targets[0];
+    /* Block 1 of target 3: every third vertex left out (gaps the mask must not fill: a covered
+     * vertex would read as the offset), the others moved 200 units along x. */
+    uint32_t kept = 0;
+    for (uint32_t j = 0; j < t3->count; j++) {
+        const uint32_t v = t3->indices[j];
+        if (v / 64 == 1 && v % 3 == 0) continue;
+        t3->indices[kept] = v;
+        memmove(&t3->positions[3 * kept], &t3->positions[3 * j], 12);
+        memmove(&t3->normals[3 * kept], &t3->normals[3 * j], 12);
+        if (v / 64 == 1) t3->positions[3 * kept] += 200.0f + 0.01f * (float)(j % 7);
+        kept++;
+    }
+    t3->count = kept;
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    mk_write_options o = { .precision = MK_PRECISION_Q16, .tolerance = TOLERANCE };
+    mk_write_options fo = { .precision = MK_PRECISION_FLOAT };
+    mk_asset a, exact;
+    mk_write_report rep;
+    write_open(&raw, &fo, &arena, &exact, &rep);
+    write_open(&raw, &o, &arena, &a, &rep);
+    CHECK_EQ_INT(rep.float_entries, 0);
+    CHECK_EQ_INT(rep.offset_entries, 1);
+    CHECK_MSG(rep.max_position_error <= TOLERANCE, "error %g over the tolerance", rep.max_position_error);
+    const mk_blob_mesh *bm = &a.meshes[0];
+    const uint32_t *first = (const uint32_t *)(a.data + bm->block_entries);
+    const mk_blob_entry *entries = (const mk_blob_entry *)(a.data + bm->entries);
+    int offsets = 0;
+    for (uint32_t b = 0; b < bm->block_count; b++)
+        for (uint32_t e = first[b]; e < first[b + 1]; e++) {
+            if (!mk_entry_has_offset(&entries[e])) continue;
+            offsets++;
+            CHECK(b == 1 && mk_entry_target(&entries[e]) == 3 && mk_entry_quantized(&entries[e]));
+            uint64_t moved = 0;
+            for (uint32_t i = 0; i < 64; i++) moved |= (uint64_t)((64 + i) % 3 != 0) << i;
+            CHECK_MSG(entries[e].mask == moved, "offset entry mask %llx, moved %llx", (unsigned long long)entries[e].mask,
+                      (unsigned long long)moved);
+            const float *off = (const float *)(const void *)(a.data + bm->target_data + 16u * entries[e].data);
+            CHECK_MSG(off[0] > 199 && off[0] < 202, "offset x %g", (double)off[0]);
+        }
+    CHECK_EQ_INT(offsets, 1);
+    static const float w[4] = { 0.5f, -1, 0.25f, 0.75f };
+    float *p = malloc(12u * VERTICES), *n = malloc(12u * VERTICES), *t = malloc(16u * VERTICES);
+    float *pe = malloc(12u * VERTICES), *ne = malloc(12u * VERTICES), *te = malloc(16u * VERTICES);
+    float *ps = malloc(12u * VERTICES), *ns = malloc(12u * VERTICES), *ts = malloc(16u * VERTICES);
+    eval_range(&a, w, MK_NORMALS_NLERP, 0, VERTICES, p, n, t);
+    eval_range(&exact, w, MK_NORMALS_NLERP, 0, VERTICES, pe, ne, te);
+    double dp = 0;
+    for (uint32_t k = 0; k < 3 * VERTICES; k++) dp = fmax(dp, fabs(p[k] - pe[k]));
+    CHECK_MSG(dp <= 2.5 * TOLERANCE, "positions %g from the float blob", dp);
+    CHECK_NEAR(p[3 * 100], pe[3 * 100], 0.75 * TOLERANCE + 1e-4);
+    static const uint32_t cuts[] = { 0, 70, 128, 129, VERTICES };
+    for (size_t r = 0; r + 1 < sizeof cuts / sizeof cuts[0]; r++)
+        eval_range(&a, w, MK_NORMALS_NLERP, cuts[r], cuts[r + 1] - cuts[r], ps, ns, ts);
+    CHECK(memcmp(p, ps, 12u * VERTICES) == 0 && memcmp(n, ns, 12u * VERTICES) == 0);
+    /* Traffic: target 3 alone, positions only: the block table, 20 headers, 300 - 21 vertices
+     * of int16 positions, the offset's 16 bytes, the base read and the output written. */
+    static const float only3[4] = { 0, 0, 0, 1 };
+    size_t scratch_size = mk_eval_scratch_size(&a, 0);
+    void *scratch = aligned_alloc(16, (scratch_size + 15) & ~(size_t)15);
+    mk_eval_job tj = { .asset = &a, .vertex_count = MK_VERTICES_TO_END, .weights = only3, .weight_count = 4,
+                       .scratch = scratch, .scratch_size = scratch_size, .positions = p, .positions_size = 12u * VERTICES };
+    CHECK_EQ_INT(mk_eval_traffic(&tj), 4 * 6 + 16 * 20 + 6 * (VERTICES - 21) + 16 + 24 * VERTICES);
+    free(scratch);
+    /* Read back: every delta within the reported error of the source. */
+    mk_raw_asset back;
+    mk_raw_init(&back, NULL);
+    mk_error err;
+    CHECK(mk_read_blob(&a, &back, &err) == MK_OK);
+    const mk_raw_target *u = &back.channels[3].targets[0];
+    CHECK_EQ_INT(u->count, t3->count);
+    double worst = 0;
+    for (uint32_t j = 0; j < u->count && j < t3->count; j++)
+        for (int k = 0; k < 3; k++) worst = fmax(worst, fabs(u->positions[3 * j + (uint32_t)k] - t3->positions[3 * j + (uint32_t)k]));
+    CHECK_MSG(worst <= rep.max_position_error * 1.0001 + 1e-9, "read back %g, reported %g", worst, rep.max_position_error);
+    mk_raw_free(&back);
+    free(p); free(n); free(t); free(pe); free(ne); free(te); free(ps); free(ns); free(ts);
+    mk_arena_free_all(&arena);
+    mk_raw_free(&raw);
+}
+
 static void test_gap_rule(void)
 {
     static const unsigned moved[] = { 0, 1, 2, 5, 20 };
@@ -273,5 +376,5 @@ static void test_writer_masks(void)
     }
 }
 
-CHECK_MAIN(CASE(test_outlier_block_is_float), CASE(test_outlier_block_every_path), CASE(test_gap_rule),
+CHECK_MAIN(CASE(test_outlier_block_is_float), CASE(test_outlier_block_every_path), CASE(test_offset_entry), CASE(test_gap_rule),
            CASE(test_writer_masks))

@@ -155,6 +155,7 @@ PATCH(magic) { c->b[0] = 'X'; }
 PATCH(magic_last_byte) { c->b[7] = 'k'; }
 PATCH(version_next) { header(c)->version = MK_FORMAT_VERSION + 1; }
 PATCH(version_2) { header(c)->version = 2; }
+PATCH(version_3) { header(c)->version = 3; }
 PATCH(version_1) { header(c)->version = 1; }
 PATCH(header_size) { header(c)->header_size = 72; }
 PATCH(header_flags) { header(c)->flags = 1; }
@@ -317,7 +318,7 @@ PATCH(block_table_order_dip) { block_table(c, 2)[2] = block_table(c, 2)[1] - 1; 
 PATCH(entry_target) { entry(c, 0, 3)->target_and_flags = 4 | MK_ENTRY_FLOAT; }
 PATCH(entry_target_huge) { entry(c, 3, 0)->target_and_flags = MK_ENTRY_TARGET_MASK - 15; }
 PATCH(entry_flags) { entry(c, 0, 1)->target_and_flags |= 1u << 24; }
-PATCH(entry_flags_top) { entry(c, 2, 3)->target_and_flags |= 0x40000000u; }
+PATCH(entry_flags_top) { entry(c, 2, 3)->target_and_flags |= 0x20000000u; }
 PATCH(entry_int16_of_float_target) { entry(c, 2, 4)->target_and_flags &= ~MK_ENTRY_FLOAT; }
 PATCH(entry_duplicate) { entry(c, 0, 1)->target_and_flags = entry(c, 0, 0)->target_and_flags; }
 PATCH(entry_misordered) { entry(c, 2, 2)->target_and_flags = 0; }
@@ -339,6 +340,23 @@ PATCH(entry_float_nan)
     mk_blob_entry *e = entry(c, 2, dense_entry(c, 2));
     e->target_and_flags |= MK_ENTRY_FLOAT;
     floats_at(c, mesh(c, 2)->target_data + 16ull * e->data)[7] = NAN;
+}
+/* A float entry with a position offset (only int16 entries have one). */
+PATCH(entry_offset_on_float) { entry(c, 2, 3)->target_and_flags |= MK_ENTRY_OFFSET; }
+/* A quantized dense entry given an offset: its first 16 data bytes are read as one. */
+PATCH(entry_offset_nan)
+{
+    mk_blob_entry *e = entry(c, 2, dense_entry(c, 2));
+    e->target_and_flags |= MK_ENTRY_OFFSET;
+    float *o = floats_at(c, mesh(c, 2)->target_data + 16ull * e->data);
+    o[0] = 0.5f; o[1] = NAN; o[2] = 0; o[3] = 0;
+}
+PATCH(entry_offset_pad)
+{
+    mk_blob_entry *e = entry(c, 2, dense_entry(c, 2));
+    e->target_and_flags |= MK_ENTRY_OFFSET;
+    float *o = floats_at(c, mesh(c, 2)->target_data + 16ull * e->data);
+    o[0] = 0.5f; o[1] = -2; o[2] = 0; o[3] = 1e-30f;
 }
 PATCH(entry_normal_delta_inf)
 {
@@ -402,8 +420,9 @@ static const corruption corruptions[] = {
     { "header.truncated", size_0, "0 bytes", MK_ERROR_TRUNCATED, "blob of 0 bytes is shorter", 0 },
     { "header.magic", magic, "magic XORPHKIT", MK_ERROR_BAD_MAGIC, "magic is not MORPHKIT", 0 },
     { "header.magic", magic_last_byte, "magic MORPHKIt", MK_ERROR_BAD_MAGIC, "magic is not MORPHKIT", 0 },
-    { "header.version", version_next, "next version", MK_ERROR_BAD_VERSION, "version 4 is not supported; this runtime reads version 3 (byte offset 8)", 0 },
-    { "header.version", version_2, "version 2 (no entry flags)", MK_ERROR_BAD_VERSION, "version 2 is not supported; this runtime reads version 3 (byte offset 8)", 0 },
+    { "header.version", version_next, "next version", MK_ERROR_BAD_VERSION, "version 5 is not supported; this runtime reads version 4 (byte offset 8)", 0 },
+    { "header.version", version_2, "version 2 (no entry flags)", MK_ERROR_BAD_VERSION, "version 2 is not supported; this runtime reads version 4 (byte offset 8)", 0 },
+    { "header.version", version_3, "version 3 (no offset entries)", MK_ERROR_BAD_VERSION, "version 3 is not supported; this runtime reads version 4 (byte offset 8)", 0 },
     { "header.version", version_1, "version 1", MK_ERROR_BAD_VERSION, "blob format version 1 is not supported", 0 },
     { "header.size", header_size, "header size 72", MK_ERROR_CORRUPT, "header size 72 is not 64", 0 },
     { "header.flags", header_flags, "header flags 1", MK_ERROR_CORRUPT, "header flags (1) are not zero", 0 },
@@ -535,7 +554,7 @@ static const corruption corruptions[] = {
     { "entry.target", entry_target_huge, "target 2^24 - 16", MK_ERROR_CORRUPT, "mesh 3 entry 0: target index 16777200 is out of range", 0 },
     { "entry.target", entry_target_huge, "quantized: target 2^24 - 16", MK_ERROR_CORRUPT, "mesh 3 entry 0: target index 16777200 is out of range", Q16 },
     { "entry.flags", entry_flags, "flag bit 24", MK_ERROR_CORRUPT, "mesh 0 entry 1: unknown flag bits 16777216", 0 },
-    { "entry.flags", entry_flags_top, "quantized: flag bit 30", MK_ERROR_CORRUPT, "mesh 2 entry 3: unknown flag bits 1073741824", Q16 },
+    { "entry.flags", entry_flags_top, "quantized: flag bit 29", MK_ERROR_CORRUPT, "mesh 2 entry 3: unknown flag bits 536870912", Q16 },
     { "entry.precision", entry_int16_of_float_target, "a float target's entry without the float flag", MK_ERROR_CORRUPT, "mesh 2 entry 4: int16 data for float target", 0 },
     { "entry.order", entry_duplicate, "two entries for target 0 in block 0", MK_ERROR_CORRUPT, "mesh 0 entry 1: target 0 repeats or precedes the previous entry's", 0 },
     { "entry.order", entry_misordered, "target 0 after target 1", MK_ERROR_CORRUPT, "mesh 2 entry 2: target 0 repeats or precedes", 0 },
@@ -549,6 +568,9 @@ static const corruption corruptions[] = {
     { "entry.data", entry_float_last, "quantized: the last entry flagged float", MK_ERROR_CORRUPT, "bytes of data run past the mesh's target data", Q16 },
     { "entry.data_finite", entry_float_nan, "quantized: a float-flagged entry's delta NaN", MK_ERROR_NOT_FINITE, "mesh 2 entry 0: delta value 7 is not finite", Q16 },
     { "entry.data_finite", entry_normal_delta_inf, "a normal delta inf", MK_ERROR_NOT_FINITE, "mesh 0 entry 2: delta value 13 is not finite", 0 },
+    { "entry.offset_precision", entry_offset_on_float, "an offset on a float entry", MK_ERROR_CORRUPT, "mesh 2 entry 3: a position offset on float32 data", 0 },
+    { "entry.offset_finite", entry_offset_nan, "quantized: an offset component NaN", MK_ERROR_NOT_FINITE, "mesh 2 entry 0: position offset component 1 is not finite", Q16 },
+    { "entry.offset_pad", entry_offset_pad, "quantized: nonzero bytes after the offset", MK_ERROR_CORRUPT, "mesh 2 entry 0: the 4 bytes after its position offset are not zero", Q16 },
 
     { "clip.name", clip_name, "name = string section size", MK_ERROR_CORRUPT, "clip 1: name string offset", 0 },
     { "clip.first_track", clip_first_track, "clip 2 starts at track 2", MK_ERROR_CORRUPT, "clip 2: first track 2 does not follow the previous clip's tracks (expected 3)", 0 },
