@@ -15,8 +15,9 @@ typedef struct mk_write_options {
     mk_precision precision;
     /* Largest allowed absolute position error of quantization, in mesh units. A quantized
      * target's scales come from its entries (64-vertex blocks) that fit this with int16; the
-     * entries that do not (outlier deltas) are stored as float32. 0 = 1e-4 x the mesh's
-     * bounding-box diagonal (a relative default that works for cm and m assets alike). */
+     * entries that do not (outlier deltas) are stored as int16 around a position offset where
+     * their spread allows it, else as float32. 0 = 1e-4 x the mesh's bounding-box diagonal (a
+     * relative default that works for cm and m assets alike). */
     float tolerance;
     /* The entry mask rule (mk_block_mask, block_mask.h) with gap = gap_limit - 1: gaps of at
      * most `gap` unmoved vertices between moved ones are stored as zeros, and a block that

@@ -11,8 +11,9 @@
  * constant-trip loop) while few zeros are stored. Quantized targets store int16 per component
  * with a per-target, per-attribute scale = max|component| / 32767 over their int16 entries;
  * when the whole target's position error would exceed the tolerance, the entries whose deltas
- * do not fit it (outliers) are stored as float32 and the scales come from the others (a target
- * with no entry that fits is stored as float32).
+ * do not fit it (outliers) are stored as int16 around a position offset where their spread
+ * allows it (MK_ENTRY_OFFSET), else as float32, and the scales come from the int16 entries (a
+ * target with no entry that fits either way is stored as float32).
  *
  * Deterministic: fixed iteration order, all padding zero, nothing taken from pointers/time.
  */
@@ -102,7 +103,9 @@ static double quant_error(const float *p, size_t n, float scale)
 
 /* An upper bound of quant_error for a normal (not subnormal) scale: v / scale rounds to within
  * 2^-24 of |v / scale| <= 32767.002, i.e. within 2^-9, then to the nearest integer, so every
- * value errs by at most scale (0.5 + 2^-9) before the last double rounding. */
+ * value errs by at most scale (0.5 + 2^-9) before the last double rounding. The bound allows
+ * 2^-8: the other 2^-9 covers an offset entry's value - offset, which rounds by at most
+ * 2^-24 x 32767 scale < 2^-9 scale (offset_fits). */
 static double quant_error_bound(float scale) { return (double)scale * (0.5 + 1.0 / 256); }
 
 static float mesh_diagonal(const mk_raw_mesh *m)
@@ -150,9 +153,10 @@ static float entry_limit_for(double tolerance)
 }
 
 /* Whether a block's positions fit int16 around a common offset (the middle of each component's
- * range, written to offset[]): every |value - offset| within the entry limit, with a hundredth
- * of it to spare for the rounding of the subtraction. Returns the largest |value - offset|, or
- * -1 when they do not fit. */
+ * range, written to offset[]): every |value - offset| within 0.99 of the entry limit, so a scale
+ * these spreads set keeps quant_error_bound a hundredth below the tolerance. The rounding of
+ * value - offset (at most 2^-24 |value - offset| <= 2^-9 scale) is within that bound's own
+ * allowance. Returns the largest |value - offset|, or -1 when they do not fit. */
 static float offset_fits(const float *positions, uint32_t count, float limit, float offset[3])
 {
     float spread = 0;
@@ -186,17 +190,16 @@ static void plan_entries(const mk_raw_target *t, target_plan *p)
         const size_t at = 3u * (size_t)first, n = 3u * (size_t)count;
         const float bm = max_abs(t->positions + at, n);
         first = end;
-        /* Normals and tangents of every block: the blocks offset_fits holds are int16 too. */
-        if (t->normals) { float x = max_abs(t->normals + at, n); nm = x > nm ? x : nm; }
-        if (t->tangents) { float x = max_abs(t->tangents + at, n); tm = x > tm ? x : tm; }
         float offset[3], spread = bm;
         if (bm > limit) {
             any_outlier = 1;
             spread = offset_fits(t->positions + at, count, limit, offset);
         }
-        if (spread < 0) continue;   /* float32 */
+        if (spread < 0) continue;   /* float32: its deltas set no scale */
         any_int16 = 1;   /* int16, or int16 around an offset (its spread then sets the scale too) */
         pm = spread > pm ? spread : pm;
+        if (t->normals) { float x = max_abs(t->normals + at, n); nm = x > nm ? x : nm; }
+        if (t->tangents) { float x = max_abs(t->tangents + at, n); tm = x > tm ? x : tm; }
     }
     if (!any_int16) return;
     p->flags |= MK_TARGET_QUANTIZED;
@@ -336,7 +339,8 @@ static void target_blocks(const layout_loop *l, const mk_raw_target *tg, const t
         for (uint32_t k = first; k < end; k++) moved |= 1ull << (tg->indices[k] - start);
         float offset[3] = { 0, 0, 0 };
         const entry_kind kind = entry_kind_of(tg, plan, first, end, offset);
-        fn(user, block, first, end, kind == ENTRY_OFFSET ? moved : mk_block_mask(moved, in_block, l->gap), kind, offset);
+        const uint64_t mask = kind == ENTRY_OFFSET ? moved : mk_block_mask(moved, in_block, l->gap);
+        fn(user, block, first, end, mask, kind, offset);
         first = end;
     }
 }

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The .morph blob layout, version 3 (docs/format.md is the prose description).
+/* The .morph blob layout, version 4 (docs/format.md is the prose description).
  *
  * Little-endian. Every record and array starts at a multiple of 16 bytes from the blob start.
  * Offsets are absolute byte offsets from the blob start. Strings are offsets into the STRINGS
@@ -112,8 +112,10 @@ typedef struct mk_blob_target {
  * x0 y0 z0 x1 y1 z1 ..., then the normal deltas if the target has normals, then the tangent
  * deltas (xyz) if it has tangents; float32 when the entry has MK_ENTRY_FLOAT, else int16 times
  * the target's scales (only a quantized target has int16 entries; a float target's entries all
- * have the flag), after the position offset of an MK_ENTRY_OFFSET entry. A run of consecutive mask bits is one contiguous span of data and output. The
- * mask may cover vertices the target does not move (their deltas are zeros). */
+ * have the flag), after the position offset of an MK_ENTRY_OFFSET entry. A run of consecutive
+ * mask bits is one contiguous span of data and output. The mask may cover vertices the target
+ * does not move: their deltas are zeros, except in an MK_ENTRY_OFFSET entry, whose every
+ * covered vertex moves by offset + int16 x scale (the writer covers only moved vertices there). */
 #define MK_ENTRY_TARGET_MASK 0x00FFFFFFu   /* target_and_flags: the mesh-local target index */
 #define MK_MAX_MESH_TARGETS (MK_ENTRY_TARGET_MASK + 1u)   /* targets per mesh: 2^24 */
 #define MK_ENTRY_FLOAT 0x80000000u       /* target_and_flags: the entry's data is float32 */

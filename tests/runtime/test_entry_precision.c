@@ -186,6 +186,13 @@ static void test_outlier_block_every_path(void)
     mk_write_options q = { .precision = MK_PRECISION_Q16, .tolerance = TOLERANCE }, f = { .precision = MK_PRECISION_FLOAT };
     write_open(&raw, &q, &arena, &mixed, &rep);
     CHECK_EQ_INT(rep.float_entries, 1);
+    /* The float block's normal deltas set no scale: the int16 blocks' do. */
+    float others_n = 0;
+    for (uint32_t j = 0; j < t3->count; j++)
+        if (t3->indices[j] / 64 != OUTLIER / 64)
+            for (int k = 0; k < 3; k++) others_n = fmaxf(others_n, fabsf(t3->normals[3 * j + (uint32_t)k]));
+    CHECK_MSG(mixed.targets[3].normal_scale == others_n / 32767.0f, "normal scale %g, expected %g (the int16 blocks')",
+              (double)mixed.targets[3].normal_scale, (double)(others_n / 32767.0f));
     write_open(&raw, &f, &arena, &exact, &rep);
     static const float w[4] = { 0.5f, -1, 0.25f, 0.75f };
     float *p = malloc(12u * VERTICES), *n = malloc(12u * VERTICES), *t = malloc(16u * VERTICES);
