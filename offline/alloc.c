@@ -131,7 +131,6 @@ void *mk_arena_grow(mk_arena *arena, void *ptr, size_t new_size)
     arena->calls++;
     if (arena->allocator.fail_after && arena->calls >= arena->allocator.fail_after) { arena->failed = 1; return NULL; }
     mk_arena_block *prev = b->prev, *next = b->next;
-    const size_t old_mapped = b->mapped;
     mk_arena_block *g;
     if (b->mapped) {
         size_t mapped = b->mapped;
@@ -146,12 +145,9 @@ void *mk_arena_grow(mk_arena *arena, void *ptr, size_t new_size)
     g->size = new_size;
     arena->bytes_live += new_size - old_size;
     if (arena->bytes_live > arena->bytes_peak) arena->bytes_peak = arena->bytes_live;
-    /* A recycled block's pages past its old mapping are fresh (zero); its own pages past
-     * old_size were zeroed when it was handed out and never written. Cleared anyway, without
-     * touching the fresh ones. */
-    size_t clear_end = new_size;
-    if (g->mapped && old_mapped - sizeof(mk_arena_block) < clear_end) clear_end = old_mapped - sizeof(mk_arena_block);
-    if (clear_end > old_size) memset((char *)(g + 1) + old_size, 0, clear_end - old_size);
+    /* A recycled block is zero past old_size already: its pages were zeroed when it was handed
+     * out and only [0, size) is written, and mremap's new tail is fresh. */
+    if (!g->mapped) memset((char *)(g + 1) + old_size, 0, new_size - old_size);
     return g + 1;
 }
 

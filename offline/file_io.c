@@ -69,11 +69,18 @@ typedef struct read_parts {
     size_t end[READ_PARTS];    /* where a part's reading stopped (its end unless the file shrank) */
 } read_parts;
 
+/* Where part i ends: its size on, or the file's end. */
+static size_t part_end(const read_parts *rp, uint32_t i)
+{
+    const size_t at = (size_t)i * rp->part;
+    return rp->n - at < rp->part ? rp->n : at + rp->part;
+}
+
 static void read_part(void *user, uint32_t item, uint32_t worker)
 {
     (void)worker;
     read_parts *rp = user;
-    size_t at = (size_t)item * rp->part, end = rp->n - at < rp->part ? rp->n : at + rp->part;
+    size_t at = (size_t)item * rp->part, end = part_end(rp, item);
     rp->error[item] = 0;
     while (at < end) {
         ssize_t k = pread(rp->fd, rp->p + at, end - at, (off_t)at);
@@ -96,8 +103,7 @@ static mk_result read_split(int fd, const char *path, uint8_t *p, size_t n, uint
     mk_parallel_for(parts, threads, read_part, &rp);
     for (uint32_t i = 0; i < parts; i++) {
         if (rp.error[i]) return io_error(err, path, "read failed", rp.error[i]);
-        const size_t end = n - (size_t)i * rp.part < rp.part ? n : (size_t)(i + 1) * rp.part;
-        if (rp.end[i] != end)
+        if (rp.end[i] != part_end(&rp, i))
             return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: read %zu of %zu bytes (file shrank?)", path,
                                 rp.end[i], n);
     }

@@ -453,11 +453,10 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
             const uint32_t moved = mk_popcount64(en->mask);
             const size_t attribute_bytes = (size_t)mk_entry_data_size(q ? MK_TARGET_QUANTIZED : 0u, moved);
             const uint8_t *p = data + (size_t)en->data * MK_ALIGN;
-            const size_t offset_bytes = mk_entry_has_offset(en) ? MK_ENTRY_OFFSET_BYTES : 0u;
-            prefetch_ahead(p, offset_bytes + (size_t)mk_entry_data_size(mk_entry_flags(tg->flags, q), moved));
-            if (offset_bytes) {
+            prefetch_ahead(p, (size_t)mk_entry_bytes(en, tg->flags));
+            if (mk_entry_has_offset(en)) {
                 add_offset(acc_p, en->mask, (const float *)(const void *)p, c);
-                p += offset_bytes;
+                p += MK_ENTRY_OFFSET_BYTES;
             }
             add_attribute(acc_p, en->mask, p, q, c * (q ? tg->position_scale : 1.0f));
             if (!want_normals && !want_tangents) continue;
@@ -553,9 +552,7 @@ uint64_t mk_eval_traffic(const mk_eval_job *job)
         bytes += sizeof(mk_blob_entry);                                 /* every header is read */
         const uint32_t ti = mk_entry_target(&entries[e]);
         if (f.coef[ti] == 0.0f) continue;
-        uint32_t flags = mk_entry_flags(f.targets[ti].flags, mk_entry_quantized(&entries[e])) & ~strip;
-        bytes += mk_entry_data_size(flags, mk_popcount64(entries[e].mask));
-        if (mk_entry_has_offset(&entries[e])) bytes += MK_ENTRY_OFFSET_BYTES;
+        bytes += mk_entry_bytes(&entries[e], f.targets[ti].flags & ~strip);
     }
     /* Base arrays read and outputs written. */
     bytes += (uint64_t)n * 12u * 2u * (job->normals ? 2u : 1u);

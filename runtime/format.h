@@ -197,4 +197,11 @@ static inline uint64_t mk_entry_data_size(uint32_t flags, uint32_t m)
     return attributes * 3u * elem * m;
 }
 
+/* Bytes of a stored entry's data (its offset, then its attributes) for its target's flags. */
+static inline uint64_t mk_entry_bytes(const mk_blob_entry *e, uint32_t target_flags)
+{
+    return (mk_entry_has_offset(e) ? MK_ENTRY_OFFSET_BYTES : 0u) +
+           mk_entry_data_size(mk_entry_flags(target_flags, mk_entry_quantized(e)), mk_popcount64(e->mask));
+}
+
 #endif

@@ -491,14 +491,12 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
             if (FAILS("entry.offset_precision", mk_entry_has_offset(en) && !mk_entry_quantized(en)))
                 return fail2(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e,
                              ": a position offset on float32 data (only int16 entries have one)");
-            uint32_t count = mk_popcount64(en->mask);
-            const uint64_t offset_bytes = mk_entry_has_offset(en) ? MK_ENTRY_OFFSET_BYTES : 0u;
-            uint64_t bytes = offset_bytes + mk_entry_data_size(mk_entry_flags(tg->flags, mk_entry_quantized(en)), count);
+            uint64_t bytes = mk_entry_bytes(en, tg->flags);
             uint64_t offset = (uint64_t)en->data * MK_ALIGN;
             if (FAILS("entry.data", offset > m->target_data_size || bytes > m->target_data_size - offset))
                 return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": its ", bytes,
                              " bytes of data run past the mesh's target data");
-            if (offset_bytes) {
+            if (mk_entry_has_offset(en)) {
                 const float *o = (const float *)(v->data + m->target_data + offset);
                 uint64_t bad_offset = first_not_finite(o, 3);
                 if (FAILS("entry.offset_finite", bad_offset < 3))
@@ -509,8 +507,8 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
                 if (FAILS("entry.offset_pad", pad != 0))
                     return fail2(v->err, MK_ERROR_CORRUPT, m->target_data + offset + 12, "mesh ", mi, " entry ", e,
                                  ": the 4 bytes after its position offset are not zero");
-                offset += offset_bytes;
-                bytes -= offset_bytes;
+                offset += MK_ENTRY_OFFSET_BYTES;
+                bytes -= MK_ENTRY_OFFSET_BYTES;
             }
             uint64_t bad = mk_entry_quantized(en) ? bytes / 4
                          : first_not_finite((const float *)(v->data + m->target_data + offset), bytes / 4);

@@ -25,6 +25,19 @@ static void write_open(const mk_raw_asset *raw, const mk_write_options *o, mk_ar
     CHECK_MSG(mk_asset_open(blob, size, a, &err) == MK_OK, "open: %s", err.message);
 }
 
+/* mk_eval_traffic of a whole-mesh positions-only job at these weights. */
+static uint64_t traffic(const mk_asset *a, const float *weights, float *positions)
+{
+    size_t scratch_size = mk_eval_scratch_size(a, 0);
+    void *scratch = aligned_alloc(16, (scratch_size + 15) & ~(size_t)15);
+    mk_eval_job job = { .asset = a, .vertex_count = MK_VERTICES_TO_END, .weights = weights, .weight_count = 4,
+                        .scratch = scratch, .scratch_size = scratch_size, .positions = positions,
+                        .positions_size = 12u * VERTICES };
+    uint64_t bytes = mk_eval_traffic(&job);
+    free(scratch);
+    return bytes;
+}
+
 static void test_outlier_block_is_float(void)
 {
     mk_raw_asset raw;
@@ -96,9 +109,7 @@ static void test_outlier_block_is_float(void)
     /* mk_eval_traffic counts the float entry's bytes as float: target 3 alone, positions only:
      * the block table (6 values), 20 entry headers, 236 vertices of int16 positions and the
      * outlier block's 64 of float, the base read and the output written. */
-    mk_eval_job tj = { .asset = &a, .vertex_count = MK_VERTICES_TO_END, .weights = weights[0], .weight_count = 4,
-                       .scratch = scratch, .scratch_size = scratch_size, .positions = p, .positions_size = 12u * VERTICES };
-    CHECK_EQ_INT(mk_eval_traffic(&tj), 4 * 6 + 16 * 20 + 6 * (VERTICES - 64) + 12 * 64 + 24 * VERTICES);
+    CHECK_EQ_INT(traffic(&a, weights[0], p), 4 * 6 + 16 * 20 + 6 * (VERTICES - 64) + 12 * 64 + 24 * VERTICES);
     free(scratch);
     free(p);
     free(n);
@@ -298,12 +309,7 @@ static void test_offset_entry(void)
     /* Traffic: target 3 alone, positions only: the block table, 20 headers, 300 - 21 vertices
      * of int16 positions, the offset's 16 bytes, the base read and the output written. */
     static const float only3[4] = { 0, 0, 0, 1 };
-    size_t scratch_size = mk_eval_scratch_size(&a, 0);
-    void *scratch = aligned_alloc(16, (scratch_size + 15) & ~(size_t)15);
-    mk_eval_job tj = { .asset = &a, .vertex_count = MK_VERTICES_TO_END, .weights = only3, .weight_count = 4,
-                       .scratch = scratch, .scratch_size = scratch_size, .positions = p, .positions_size = 12u * VERTICES };
-    CHECK_EQ_INT(mk_eval_traffic(&tj), 4 * 6 + 16 * 20 + 6 * (VERTICES - 21) + 16 + 24 * VERTICES);
-    free(scratch);
+    CHECK_EQ_INT(traffic(&a, only3, p), 4 * 6 + 16 * 20 + 6 * (VERTICES - 21) + 16 + 24 * VERTICES);
     /* Read back: every delta within the reported error of the source. */
     mk_raw_asset back;
     mk_raw_init(&back, NULL);
