@@ -9,7 +9,11 @@
  * cap, the rest unmapped) and the next large block reuses its pages: moved and resized with
  * mremap, split when larger than asked, always handed out zeroed. Zeroing touches only the
  * resident pages (mincore); the others are dropped (MADV_DONTNEED) and stay untouched, so a
- * block sized for the worst case but used in part costs no more than a fresh one.
+ * reused block sized for the worst case but used in part costs no more than a fresh one.
+ * Fresh mappings are prepared for their first use: from MK_RECYCLE_HUGE on they may use
+ * transparent huge pages (one fault per 2 MB), below it they are prefaulted whole in one call
+ * (about half the cost of faulting their pages in one by one, measured; such a block is then
+ * resident whole, used or not).
  *
  * Off until mk_recycle_enable: a process that keeps running after an import (an editor) may not
  * want up to `cap` bytes of freed memory held. Kept pages count as resident until reused, and a
@@ -25,6 +29,9 @@
 
 /* Blocks from this size on are recycled (glibc maps blocks of 128 KiB and more by default too). */
 #define MK_RECYCLE_MIN ((size_t)128 << 10)
+/* Fresh mappings from this size on may use transparent huge pages (MADV_HUGEPAGE); smaller
+ * fresh ones are prefaulted in one call (MADV_POPULATE_WRITE). */
+#define MK_RECYCLE_HUGE ((size_t)2 << 20)
 
 /* Turns recycling on with at most `cap` bytes kept (0: off). Call once, before other threads
  * allocate through an arena; later calls are ignored. Returns whether recycling is on. */

@@ -7,6 +7,7 @@
  * get zeroed blocks. The cases run in order: the first sees recycling off. */
 #define _DEFAULT_SOURCE
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
@@ -39,6 +40,52 @@ static size_t resident_pages(const void *p, size_t n)
     for (size_t i = 0; i < pages; i++) count += vec[i] & 1;
     free(vec);
     return count;
+}
+
+/* Whole pages inside [p, p + n) (what resident_pages can count). */
+static size_t whole_pages(const void *p, size_t n)
+{
+    const size_t page = (size_t)sysconf(_SC_PAGESIZE);
+    uintptr_t lo = ((uintptr_t)p + page - 1) / page * page, hi = ((uintptr_t)p + n) / page * page;
+    return hi > lo ? (hi - lo) / page : 0;
+}
+
+/* Whether the kernel prefaults on request (MADV_POPULATE_WRITE, Linux 5.14 on). */
+static int populate_supported(void)
+{
+#ifdef MADV_POPULATE_WRITE
+    const size_t page = (size_t)sysconf(_SC_PAGESIZE);
+    void *q = mmap(NULL, page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (q == MAP_FAILED) return 0;
+    int ok = madvise(q, page, MADV_POPULATE_WRITE) == 0;
+    munmap(q, page);
+    return ok;
+#else
+    return 0;
+#endif
+}
+
+/* Whether the mapping holding p has the VmFlags token `flag` in /proc/self/smaps (-1: unknown). */
+static int mapping_has_flag(const void *p, const char *flag)
+{
+    FILE *f = fopen("/proc/self/smaps", "r");
+    if (!f) return -1;
+    char line[512];
+    int inside = 0, found = -1;
+    while (found < 0 && fgets(line, sizeof line, f)) {
+        unsigned long lo, hi;
+        if (sscanf(line, "%lx-%lx ", &lo, &hi) == 2 && strchr(line, '-') < strchr(line, ' '))
+            inside = (uintptr_t)p >= lo && (uintptr_t)p < hi;
+        else if (inside && strncmp(line, "VmFlags:", 8) == 0) {
+            char token[8];
+            snprintf(token, sizeof token, " %s", flag);
+            found = 0;
+            for (char *t = strstr(line, token); t && !found; t = strstr(t + 1, token))
+                found = t[strlen(token)] == ' ' || t[strlen(token)] == '\n';
+        }
+    }
+    fclose(f);
+    return found;
 }
 
 /* Takes every kept page into blocks of `arena`. */
@@ -115,6 +162,33 @@ static void test_untouched_pages_stay_untouched(void)
         CHECK(all_zero(q, 4 * MB));
     }
     mk_arena_release(&arena, q);
+    mk_arena_free_all(&arena);
+}
+
+/* A fresh block is prepared for its first use: below MK_RECYCLE_HUGE it is resident whole at
+ * once (prefaulted in one call, where the kernel can), from it on its mapping asks for
+ * transparent huge pages (the "hg" flag); either way it reads zero. */
+static void test_fresh_blocks_prepared(void)
+{
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    drain(&arena);   /* nothing kept: both blocks are fresh mappings */
+    unsigned char *small = mk_arena_alloc(&arena, MK_RECYCLE_HUGE / 2);
+    unsigned char *big = mk_arena_alloc(&arena, 2 * MK_RECYCLE_HUGE);
+    CHECK(small != NULL && big != NULL);
+    if (!small || !big) { mk_arena_free_all(&arena); return; }
+    if (populate_supported()) {
+        CHECK_EQ_INT(resident_pages(small, MK_RECYCLE_HUGE / 2), whole_pages(small, MK_RECYCLE_HUGE / 2));
+    } else {
+        fprintf(stderr, "note: this kernel cannot prefault on request; residency not checked\n");
+    }
+    CHECK(all_zero(small, MK_RECYCLE_HUGE / 2));
+    const int small_hg = mapping_has_flag(small, "hg"), big_hg = mapping_has_flag(big, "hg");
+    if (big_hg >= 0) {
+        CHECK_EQ_INT(big_hg, 1);
+        CHECK_EQ_INT(small_hg, 0);
+    }
+    CHECK(all_zero(big, 2 * MK_RECYCLE_HUGE));
     mk_arena_free_all(&arena);
 }
 
@@ -231,6 +305,6 @@ static void test_threads_get_zeroed_blocks(void)
 }
 
 CHECK_MAIN(CASE(test_off_until_enabled), CASE(test_freed_pages_are_reused_zeroed),
-           CASE(test_untouched_pages_stay_untouched), CASE(test_cap_and_growth), CASE(test_grow_recycled_block),
+           CASE(test_untouched_pages_stay_untouched), CASE(test_fresh_blocks_prepared), CASE(test_cap_and_growth), CASE(test_grow_recycled_block),
            CASE(test_no_unusable_remainders), CASE(test_full_table_keeps_the_larger),
            CASE(test_threads_get_zeroed_blocks))
