@@ -666,17 +666,24 @@ int mk_is_blob(const void *data, size_t size)
     return data && size >= 8 && memcmp(data, MK_MAGIC, 8) == 0;
 }
 
-uint64_t mk_mesh_float_entries(const mk_asset *a, uint32_t mesh)
+/* Entries of a mesh's quantized targets stored as float32 (offsets 0) or int16 around a
+ * position offset (offsets 1). */
+static uint64_t count_outlier_entries(const mk_asset *a, uint32_t mesh, int offsets)
 {
     if (!a || mesh >= a->mesh_count) return 0;
     const mk_blob_mesh *m = &a->meshes[mesh];
     const mk_blob_entry *entries = (const mk_blob_entry *)(a->data + m->entries);
     uint64_t n = 0;
-    for (uint64_t e = 0; e < m->entry_count; e++)
-        n += !mk_entry_quantized(&entries[e])
-             && (a->targets[m->first_target + mk_entry_target(&entries[e])].flags & MK_TARGET_QUANTIZED);
+    for (uint64_t e = 0; e < m->entry_count; e++) {
+        const mk_blob_entry *en = &entries[e];
+        if (offsets) n += mk_entry_has_offset(en) != 0;
+        else n += !mk_entry_quantized(en) && (a->targets[m->first_target + mk_entry_target(en)].flags & MK_TARGET_QUANTIZED);
+    }
     return n;
 }
+
+uint64_t mk_mesh_float_entries(const mk_asset *a, uint32_t mesh) { return count_outlier_entries(a, mesh, 0); }
+uint64_t mk_mesh_offset_entries(const mk_asset *a, uint32_t mesh) { return count_outlier_entries(a, mesh, 1); }
 
 int mk_mesh_get(const mk_asset *a, uint32_t mesh, mk_mesh_info *out)
 {

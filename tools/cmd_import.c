@@ -23,9 +23,9 @@ static const cli_option options[] = {
       "one (which this option replaces).",
       NULL, "additive|sequential", 0, 0, 0, offsetof(import_args, stacking_given) },
     { "--precision", "P", CLI_CHOICE, offsetof(import_args, precision),
-      "How deltas are stored: q16 (int16 with a per-target scale; the 64-vertex blocks whose deltas would exceed "
-      "--tolerance with int16 are stored as float32, and the scale comes from the others) or float (lossless "
-      "float32).",
+      "How deltas are stored: q16 (int16 with a per-target scale; a 64-vertex block whose deltas would exceed "
+      "--tolerance with int16 is stored as int16 around a position offset where its deltas spread narrowly enough, "
+      "else as float32, and the scale comes from the others) or float (lossless float32).",
       "q16", "q16|float", 0, 0, 0, 0 },
     { "--target-normals", "HOW", CLI_CHOICE, offsetof(import_args, target_normals),
       "The targets' normal deltas: auto (the file's own; FBX also computes them where the file has none) or none "
@@ -34,7 +34,8 @@ static const cli_option options[] = {
       "are kept.",
       "auto", "auto|none", 0, 0, 0, 0 },
     { "--tolerance", "D", CLI_NUMBER, offsetof(import_args, tolerance),
-      "Largest quantization error of a position, in mesh units (q16: blocks that would exceed it are float32). "
+      "Largest quantization error of a position, in mesh units (q16: blocks that would exceed it are stored around "
+      "an offset or as float32). "
       "Default: 1e-4 x each mesh's bounding-box diagonal.",
       NULL, NULL, 1e-30, 1e30, 0, 0 },
     { "--channels", "SIDECAR.json", CLI_STRING, offsetof(import_args, channels),

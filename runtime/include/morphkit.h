@@ -188,6 +188,10 @@ int mk_mesh_get(const mk_asset *asset, uint32_t mesh, mk_mesh_info *out);
  * do not fit int16 within the import tolerance); 0 for an invalid mesh. Counted by reading
  * every entry header of the mesh: for tools, not for a frame loop. */
 uint64_t mk_mesh_float_entries(const mk_asset *asset, uint32_t mesh);
+/* Block entries of the mesh stored as int16 around a position offset (outlier blocks whose
+ * deltas are too large for int16 within the tolerance but spread narrowly); 0 for an invalid
+ * mesh. Counted like mk_mesh_float_entries. */
+uint64_t mk_mesh_offset_entries(const mk_asset *asset, uint32_t mesh);
 int mk_channel_get(const mk_asset *asset, uint32_t channel, mk_channel_info *out);
 /* Targets of a channel are numbered 0..target_count-1 in increasing full weight. */
 int mk_target_get(const mk_asset *asset, uint32_t channel, uint32_t target, mk_target_info *out);

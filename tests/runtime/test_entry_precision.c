@@ -292,6 +292,10 @@ static void test_offset_entry(void)
             CHECK_MSG(off[0] > 199 && off[0] < 202, "offset x %g", (double)off[0]);
         }
     CHECK_EQ_INT(offsets, 1);
+    CHECK_EQ_INT(mk_mesh_offset_entries(&a, 0), 1);   /* what morphkit info counts */
+    CHECK_EQ_INT(mk_mesh_float_entries(&a, 0), 0);
+    CHECK_EQ_INT(mk_mesh_offset_entries(&exact, 0), 0);
+    CHECK_EQ_INT(mk_mesh_offset_entries(&a, 1), 0);   /* no such mesh */
     static const float w[4] = { 0.5f, -1, 0.25f, 0.75f };
     float *p = malloc(12u * VERTICES), *n = malloc(12u * VERTICES), *t = malloc(16u * VERTICES);
     float *pe = malloc(12u * VERTICES), *ne = malloc(12u * VERTICES), *te = malloc(16u * VERTICES);

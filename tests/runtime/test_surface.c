@@ -296,6 +296,33 @@ static void test_welded_corners(void)
     close_grid(&o);
 }
 
+/* Each vertex's range job gives the whole-mesh job's bytes, whatever the scratch held, also for a
+ * vertex that is never a triangle's first corner (the apex of a fan whose triangles all list it
+ * last). */
+static void test_range_of_a_fan_apex(void)
+{
+    static const float p0[15] = { 0, 0, 0.2f, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0 };
+    static const float n0[15] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1 };
+    static const uint32_t tris[12] = { 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 0 }, moved[2] = { 0, 1 };
+    static const float deltas[6] = { 0.1f, 0, 0.3f, 0, 0, -0.2f };
+    const small_mesh sm = { p0, n0, deltas, NULL, tris, moved, 5, 5, 4, 2 };
+    opened o;
+    if (open_small(&o, &sm)) {
+        float p[15], whole[15], range[15];
+        memcpy(p, p0, sizeof p);
+        for (int k = 0; k < 2; k++)
+            for (int d = 0; d < 3; d++) p[3 * moved[k] + (uint32_t)d] += deltas[3 * k + d];
+        mk_error err;
+        CHECK_MSG(surface(&o, p, 0, MK_VERTICES_TO_END, whole, NULL, &err) == MK_OK, "%s", err.message);
+        for (uint32_t v = 0; v < 5; v++) {
+            memset(o.scratch, 0x3f, o.scratch_size);   /* finite sums a job must not add to */
+            CHECK_MSG(surface(&o, p, v, 1, range + 3 * v, NULL, &err) == MK_OK, "%s", err.message);
+        }
+        CHECK(memcmp(whole, range, sizeof whole) == 0);
+    }
+    close_grid(&o);
+}
+
 /* A vertex in no triangle keeps its base normal in a range job as in the whole-mesh one, whatever
  * the scratch held (a finite pattern here: an infinite one would fall back to the base normal by
  * itself); outputs with their own strides get the packed outputs' bytes. */
@@ -465,6 +492,6 @@ done:
     close_grid(&o);
 }
 
-CHECK_MAIN(CASE(test_matches_brute_force), CASE(test_ranges_same_bytes), CASE(test_non_finite_positions),
+CHECK_MAIN(CASE(test_matches_brute_force), CASE(test_ranges_same_bytes), CASE(test_range_of_a_fan_apex), CASE(test_non_finite_positions),
            CASE(test_degenerate_pieces), CASE(test_welded_corners), CASE(test_isolated_vertex_and_strides),
            CASE(test_refuses_wrong_topology))
