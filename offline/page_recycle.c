@@ -86,17 +86,27 @@ static void zero_pages(uint8_t *p, size_t len)
     }
 }
 
-/* A new mapping of len bytes, about to be handed out: from MK_RECYCLE_HUGE on it may use
- * transparent huge pages (one fault per 2 MB where the system has them on request, as Debian
- * does by default), below it is prefaulted in one call (one system call instead of a fault per
- * page; the block is resident whole, used or not). Both are hints: where the kernel lacks them
- * the pages fault in one by one as before. */
-static void prepare_fresh(void *p, size_t len)
+/* A new mapping of len bytes (whole pages), prepared for its first use. From MK_RECYCLE_HUGE on
+ * it asks for transparent huge pages: one fault per 2 MB for the 2 MB-aligned stretches inside
+ * it where the system gives them on request, as Debian does by default (the hint stays with the
+ * pages when they are kept and reused). Below it, it is prefaulted in one call (one system call
+ * instead of a fault per page; the block is then resident whole, used or not). Both are hints:
+ * where the kernel lacks them the pages fault in one by one. NULL when the system refuses the
+ * mapping. */
+static void *map_fresh(size_t len)
 {
-    if (len >= MK_RECYCLE_HUGE) (void)madvise(p, len, MADV_HUGEPAGE);
-#ifdef MADV_POPULATE_WRITE
-    else (void)madvise(p, len, MADV_POPULATE_WRITE);
+    void *q = mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (q == MAP_FAILED) return NULL;
+    if (len >= MK_RECYCLE_HUGE) {
+#ifdef MADV_HUGEPAGE
+        (void)madvise(q, len, MADV_HUGEPAGE);
 #endif
+    } else {
+#ifdef MADV_POPULATE_WRITE
+        (void)madvise(q, len, MADV_POPULATE_WRITE);
+#endif
+    }
+    return q;
 }
 
 void *mk_recycle_take(size_t bytes, size_t *mapped)
@@ -146,9 +156,8 @@ void *mk_recycle_take(size_t bytes, size_t *mapped)
         *mapped = len;
         return r.p;
     }
-    void *q = mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (q == MAP_FAILED) return NULL;
-    prepare_fresh(q, len);
+    void *q = map_fresh(len);
+    if (!q) return NULL;
     *mapped = len;
     return q;
 }

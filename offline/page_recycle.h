@@ -10,10 +10,12 @@
  * mremap, split when larger than asked, always handed out zeroed. Zeroing touches only the
  * resident pages (mincore); the others are dropped (MADV_DONTNEED) and stay untouched, so a
  * reused block sized for the worst case but used in part costs no more than a fresh one.
- * Fresh mappings are prepared for their first use: from MK_RECYCLE_HUGE on they may use
- * transparent huge pages (one fault per 2 MB), below it they are prefaulted whole in one call
- * (about half the cost of faulting their pages in one by one, measured; such a block is then
- * resident whole, used or not).
+ * Fresh mappings are prepared for their first use: from MK_RECYCLE_HUGE on they ask for
+ * transparent huge pages (one fault per 2 MB for the 2 MB-aligned stretches inside them, where
+ * the system gives them on request; the hint stays with their pages when they are kept and
+ * reused, and the kernel may later merge such pages into huge ones), below it they are
+ * prefaulted whole in one call (about half the cost of faulting their pages in one by one,
+ * measured; such a block is then resident whole, used or not).
  *
  * Off until mk_recycle_enable: a process that keeps running after an import (an editor) may not
  * want up to `cap` bytes of freed memory held. Kept pages count as resident until reused, and a

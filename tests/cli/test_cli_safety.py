@@ -44,11 +44,12 @@ subprocess.run([make_example, example], check=True, capture_output=True)
 ICO = None
 
 
-def plain_gltf(p, node_names=("ico",), with_targets=False, target_names=("smile",)):
-    """A small glTF (a tetrahedron per node), plain or with one morph target per mesh."""
+def plain_gltf(p, node_names=("ico",), with_targets=False, target_names=("smile",), delta=None):
+    """A small glTF (a tetrahedron per node), plain or with one morph target per mesh (its 4
+    position deltas `delta`, 12 floats; default: each vertex 0.5 up)."""
     pos = [0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1]
     idx = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]
-    delta = [0, 0, 0.5, 0, 0, 0.5, 0, 0, 0.5, 0, 0, 0.5]
+    delta = delta or [0, 0, 0.5, 0, 0, 0.5, 0, 0, 0.5, 0, 0, 0.5]
     data = struct.pack("<12f", *pos) + struct.pack("<12H", *idx) + struct.pack("<12f", *delta)
     doc = {
         "asset": {"version": "2.0"},
@@ -57,7 +58,8 @@ def plain_gltf(p, node_names=("ico",), with_targets=False, target_names=("smile"
                         {"buffer": 0, "byteOffset": 72, "byteLength": 48}],
         "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
                       {"bufferView": 1, "componentType": 5123, "count": 12, "type": "SCALAR"},
-                      {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0.5], "max": [0, 0, 0.5]}],
+                      {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC3",
+                       "min": [min(delta[c::3]) for c in range(3)], "max": [max(delta[c::3]) for c in range(3)]}],
         "meshes": [], "nodes": [], "scenes": [{"nodes": []}], "scene": 0,
     }
     for i, name in enumerate(node_names):
@@ -211,6 +213,21 @@ expect("a recipe naming a missing mesh lists the meshes", ["bake", plain, "--rec
 rc, out, err = expect("import skips a plain mesh with a warning naming it", ["import", plain, "--all-meshes", "-o", path("p.morph")], 0)
 rc, out, err = run("import", two_nodes, "-o", path("t.morph"))
 check("import of meshes with targets prints no skipped-mesh warning", rc == 0 and "no morph targets" not in err, err)
+
+# Outlier blocks: deltas too large for int16 within a tiny tolerance but narrowly spread are
+# stored around a position offset, and info counts them (text and --json, whole and per mesh).
+offset_gltf = path("offset.gltf")
+plain_gltf(offset_gltf, with_targets=True, delta=[0, 0, 0.5, 0, 0, 0.5001, 0, 0, 0.5002, 0, 0, 0.5003])
+rc, out, err = expect("import with a tolerance the block exceeds as int16",
+                      ["import", offset_gltf, "--tolerance", "1e-7", "-o", path("offset.morph")], 0)
+check("... reports one block around an offset", "0 of 1 blocks float, 1 around an offset" in out, out)
+rc, out, err = run("info", path("offset.morph"), "--json")
+info = json.loads(out) if rc == 0 else {}
+check("info --json counts the offset entry", info.get("offset_entries") == 1 and info.get("float_entries") == 0
+      and info["meshes"][0]["offset_entries"] == 1 and info["meshes"][0]["float_entries"] == 0, out)
+rc, out, err = run("info", path("offset.morph"))
+check("info's text counts it", "(0 float blocks, 1 around an offset)" in out
+      and "(0 float in quantized targets, 1 around an offset)" in out, out)
 
 # ---- 8. Sizes ----
 for args, what in [(["--vertices", "5000000000"], "out of range"), (["--vertices", "-5"], "not a whole number"),
