@@ -51,8 +51,7 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
             const mk_blob_entry *en = &entries[e];
             if (mk_entry_target(en) != local) continue;
             const int q = mk_entry_quantized(en);   /* per entry: a quantized target's outliers are float */
-            uint32_t m = mk_popcount64(en->mask);
-            size_t attr = (size_t)mk_entry_data_size(mk_entry_flags(0, q), m);  /* one attribute's bytes */
+            const size_t attr = (size_t)mk_entry_attribute_bytes(en);
             const uint8_t *p = a->data + bm->target_data + (size_t)en->data * MK_ALIGN;
             float offset[3] = { 0, 0, 0 };   /* MK_ENTRY_OFFSET: the positions' common part */
             if (mk_entry_has_offset(en)) {

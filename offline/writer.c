@@ -87,15 +87,15 @@ static int16_t quantize(float v, float scale)
     return (int16_t)i;
 }
 
-/* |dequantized - exact| of one value stored as q. */
-static double quant_error_of(float v, int16_t q, float scale) { return fabs((double)q * scale - (double)v); }
+/* |dequantized - exact| of one value stored as q around offset o (0 but in an offset entry). */
+static double quant_error_of(float v, float o, int16_t q, float scale) { return fabs((double)o + (double)q * scale - (double)v); }
 
 /* Largest |dequantized - exact| over the array. */
 static double quant_error(const float *p, size_t n, float scale)
 {
     double e = 0;
     for (size_t i = 0; i < n; i++) {
-        double d = quant_error_of(p[i], quantize(p[i], scale), scale);
+        double d = quant_error_of(p[i], 0.0f, quantize(p[i], scale), scale);
         if (d > e) e = d;
     }
     return e;
@@ -270,6 +270,10 @@ static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p
     const float *src[3] = { t->positions, t->normals, t->tangents };
     const float scale[3] = { p->position_scale, p->normal_scale, p->tangent_scale };
     uint8_t *out[3] = { dst, dst + attr, dst + (t->normals ? 2 * attr : attr) };
+    /* Per attribute, what its values are stored relative to: an offset entry's positions to its
+     * offset, everything else to zero. */
+    static const float zero[3] = { 0, 0, 0 };
+    const float *base[3] = { offset ? offset : zero, zero, zero };
     uint32_t k = cursor;
     size_t j = 0;
     for (uint64_t bits = mask; bits; bits &= bits - 1, j++) {
@@ -280,14 +284,12 @@ static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p
             if (!src[a]) continue;
             const float *value = &src[a][3u * k];
             if (quantized) {
-                /* An offset entry's positions are stored relative to its offset. */
-                const float o[3] = { a == 0 && offset ? offset[0] : 0.0f, a == 0 && offset ? offset[1] : 0.0f,
-                                     a == 0 && offset ? offset[2] : 0.0f };
+                const float *o = base[a];
                 int16_t q[3] = { quantize(value[0] - o[0], scale[a]), quantize(value[1] - o[1], scale[a]),
                                  quantize(value[2] - o[2], scale[a]) };
                 memcpy(out[a] + 6 * j, q, 6);
                 for (int c = 0; c < 3; c++) {
-                    double e = fabs((double)o[c] + (double)q[c] * scale[a] - (double)value[c]);
+                    double e = quant_error_of(value[c], o[c], q[c], scale[a]);
                     error[a] = e > error[a] ? e : error[a];
                 }
             } else {
@@ -390,8 +392,7 @@ static void write_block(void *user, uint32_t block, uint32_t first, uint32_t end
     (void)end;
     uint64_t e = tl->cursor++;
     uint64_t at = pad16((size_t)tl->data_size);
-    uint64_t size = entry_bytes(p, kind, mask);
-    tl->data_size = at + size;
+    tl->data_size = at + entry_bytes(p, kind, mask);
     l->entry_block[e] = block;
     l->entry_kind[e] = (uint8_t)kind;
     l->entry_mask[e] = mask;
@@ -400,9 +401,8 @@ static void write_block(void *user, uint32_t block, uint32_t first, uint32_t end
     if (kind == ENTRY_OFFSET) {   /* x, y, z, then the 4 zero bytes the blob already holds */
         memcpy(dst, offset, 3 * sizeof(float));
         dst += MK_ENTRY_OFFSET_BYTES;
-        size -= MK_ENTRY_OFFSET_BYTES;
     }
-    size_t attr = (size_t)size / (1u + (tg->normals ? 1u : 0u) + (tg->tangents ? 1u : 0u));
+    const size_t attr = (size_t)mk_entry_data_size(mk_entry_flags(0u, kind != ENTRY_FLOAT), mk_popcount64(mask));
     put_entry(dst, tg, p, kind != ENTRY_FLOAT, kind == ENTRY_OFFSET ? offset : NULL, first, mask, block, attr,
               tl->error);
 }

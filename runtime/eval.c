@@ -450,8 +450,7 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
             if (c == 0.0f) continue;
             const mk_blob_target *tg = &f.targets[ti];
             const int q = mk_entry_quantized(en);   /* per entry: a quantized target's outliers are float */
-            const uint32_t moved = mk_popcount64(en->mask);
-            const size_t attribute_bytes = (size_t)mk_entry_data_size(q ? MK_TARGET_QUANTIZED : 0u, moved);
+            const size_t attribute_bytes = (size_t)mk_entry_attribute_bytes(en);
             const uint8_t *p = data + (size_t)en->data * MK_ALIGN;
             prefetch_ahead(p, (size_t)mk_entry_bytes(en, tg->flags));
             if (mk_entry_has_offset(en)) {

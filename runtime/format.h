@@ -197,6 +197,13 @@ static inline uint64_t mk_entry_data_size(uint32_t flags, uint32_t m)
     return attributes * 3u * elem * m;
 }
 
+/* Bytes of one attribute (positions, normals or tangents) of a stored entry's data: its m
+ * triples at the entry's own precision. */
+static inline uint64_t mk_entry_attribute_bytes(const mk_blob_entry *e)
+{
+    return mk_entry_data_size(mk_entry_flags(0u, mk_entry_quantized(e)), mk_popcount64(e->mask));
+}
+
 /* Bytes of a stored entry's data (its offset, then its attributes) for its target's flags. */
 static inline uint64_t mk_entry_bytes(const mk_blob_entry *e, uint32_t target_flags)
 {

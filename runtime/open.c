@@ -507,11 +507,9 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
                 if (FAILS("entry.offset_pad", pad != 0))
                     return fail2(v->err, MK_ERROR_CORRUPT, m->target_data + offset + 12, "mesh ", mi, " entry ", e,
                                  ": the 4 bytes after its position offset are not zero");
-                offset += MK_ENTRY_OFFSET_BYTES;
-                bytes -= MK_ENTRY_OFFSET_BYTES;
             }
-            uint64_t bad = mk_entry_quantized(en) ? bytes / 4
-                         : first_not_finite((const float *)(v->data + m->target_data + offset), bytes / 4);
+            if (mk_entry_quantized(en)) continue;   /* int16 values are finite; only they have an offset */
+            uint64_t bad = first_not_finite((const float *)(v->data + m->target_data + offset), bytes / 4);
             if (FAILS("entry.data_finite", bad < bytes / 4))
                 return fail3(v->err, MK_ERROR_NOT_FINITE, m->target_data + offset + 4 * bad, "mesh ", mi, " entry ", e,
                              ": delta value ", bad, " is not finite");

@@ -67,6 +67,11 @@ void cli_progress_init(cli_progress *p, int quiet);
 void cli_progress_update(cli_progress *p, const char *stage, double fraction);
 double cli_now_seconds(void);
 
+/* Prints a blob writer's precision report to stdout: int16 and float targets, the outlier
+ * blocks (float32, or int16 around a position offset), the largest quantization errors and the
+ * tolerance applied. */
+void cli_print_write_report(const mk_write_report *r);
+
 /* Targets stored quantized and as float, and the largest position error the quantized steps
  * allow (half a step). */
 void cli_precision_of(const mk_asset *a, uint32_t *quantized, uint32_t *floats, double *max_error_bound);

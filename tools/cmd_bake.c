@@ -269,10 +269,7 @@ static int run_bake(void *p)
     if (status == 0) {
         printf("%s -> %s: %u channels baked, %u targets, max playback error %.3g x diagonal, %zu bytes\n", a->input,
                a->output, report.channels_added, report.targets_added, report.max_error, size);
-        printf("precision: %u int16 targets (%llu of %llu blocks float, %llu around an offset), %u float targets; "
-               "max position quantization error %.3g\n", wr.quantized_targets, (unsigned long long)wr.float_entries,
-               (unsigned long long)wr.entry_count, (unsigned long long)wr.offset_entries, wr.float_targets,
-               wr.max_position_error);
+        cli_print_write_report(&wr);
     }
 done:
     free(dep_text);

@@ -144,14 +144,7 @@ static int run_import(void *p)
         printf("%s -> %s: %u meshes, %u channels, %u targets, %u clips, %zu bytes, %u warning%s\n", a->input, a->output,
                raw.mesh_count, raw.channel_count, targets, raw.clip_count, size, raw.warning_count,
                raw.warning_count == 1 ? "" : "s");
-        printf("precision: %u int16 targets (%llu of %llu blocks float, %llu around an offset), %u float targets; "
-               "max position quantization error %.3g (tolerance %.3g)\n",
-               report.quantized_targets, (unsigned long long)report.float_entries,
-               (unsigned long long)report.entry_count, (unsigned long long)report.offset_entries, report.float_targets,
-               report.max_position_error, report.tolerance_used);
-        if (report.max_normal_error > 0 || report.max_tangent_error > 0)
-            printf("max normal quantization error %.3g, tangent %.3g\n", report.max_normal_error,
-                   report.max_tangent_error);
+        cli_print_write_report(&report);
     }
     mk_raw_free(&raw);
     mk_phase_log_mark(io.phases, "release");
