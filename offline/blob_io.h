@@ -30,6 +30,12 @@ typedef struct mk_write_options {
     /* Threads for quantizing and laying out targets; 0 = one per core. The blob is the same
      * for any count (nothing is allocated on the worker threads). */
     uint32_t threads;
+    /* Called (when set) as parts of the blob become final, while the rest is still computed:
+     * bytes [offset, offset + size) of the blob at `blob` will not change again (each target's
+     * block data, on the worker threads, in any order; each byte at most once; the header and
+     * tables are never reported). Lets a caller write them out early (output_stream.h). */
+    void (*ready)(void *user, const void *blob, uint64_t offset, uint64_t size);
+    void *ready_user;
 } mk_write_options;
 
 typedef struct mk_write_report {
@@ -98,11 +104,26 @@ typedef struct mk_output {
     uint32_t mode;                 /* permission bits of a replaced file */
     char target[4096];             /* path with symbolic links followed: the file written */
     char temp[4200], backup[4200]; /* used while writing */
+    /* Set by mk_output_open_early: the temporary file is open (fd) before the bytes are known,
+     * and the bytes [written_from, written_to) of data are in it already (written while they
+     * were computed; output_stream.h); mk_write_outputs writes the rest. */
+    int early, fd;
+    uint64_t written_from, written_to;
+    int early_errno;               /* flushing the early bytes failed: the write fails with this */
 } mk_output;
 
 /* Decides how out->path will be written and refuses it early (see above). inputs (may be
  * NULL entries) are the files the command reads. */
 mk_result mk_output_check(mk_output *out, const char *const *inputs, uint32_t input_count, mk_error *err);
+/* For a checked output that is a file (new or replaced): creates its temporary file now, so
+ * its bytes can be written as they become final (output_stream.h). MK_OK without doing
+ * anything for a stream output (a device or FIFO is written whole at the end). Afterwards
+ * either mk_write_outputs writes the rest and renames it into place, or mk_output_discard
+ * removes it. */
+mk_result mk_output_open_early(mk_output *out, mk_error *err);
+/* Closes and removes an early output's temporary file (after a failure before
+ * mk_write_outputs); nothing for other outputs. */
+void mk_output_discard(mk_output *out);
 /* Writes checked outputs, all or none. */
 mk_result mk_write_outputs(mk_output *outputs, uint32_t count, mk_error *err);
 /* mk_output_check (no inputs) + mk_write_outputs for one file. */

@@ -276,22 +276,67 @@ static void sync_dir_of(const char *target)
     }
 }
 
+mk_result mk_output_open_early(mk_output *out, mk_error *err)
+{
+    if (out->kind == MK_OUTPUT_STREAM || out->early) return MK_OK;
+    int fd = create_beside(out->target, ".tmp", out->temp, sizeof out->temp);
+    if (fd < 0) {
+        out->temp[0] = 0;
+        return io_error(err, out->path, "cannot create a temporary file beside it", errno);
+    }
+    out->early = 1;
+    out->fd = fd;
+    out->written_from = out->written_to = 0;
+    out->early_errno = 0;
+    return MK_OK;
+}
+
+void mk_output_discard(mk_output *out)
+{
+    if (!out->early) return;
+    close(out->fd);
+    unlink(out->temp);
+    out->temp[0] = 0;
+    out->early = 0;
+}
+
+/* An early output's bytes that are not in its temporary file yet: before and after the range
+ * written while they were computed. */
+static int write_rest(const mk_output *o)
+{
+    if (o->early_errno) {
+        errno = o->early_errno;
+        return -1;
+    }
+    const uint8_t *p = o->data;
+    uint64_t from = o->written_from, to = o->written_to;
+    if (from >= to || to > o->size) from = to = 0;   /* nothing written early */
+    if (from && mk_write_fd_at(o->fd, p, (size_t)from, 0, NULL) != 0) return -1;
+    if (mk_write_fd_at(o->fd, p + to, o->size - (size_t)to, to, NULL) != 0) return -1;
+    return ftruncate(o->fd, (off_t)o->size);   /* the file is the data, nothing past it */
+}
+
 mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
 {
     mk_result r = MK_OK;
     uint32_t written = 0, renamed = 0;
-    for (uint32_t i = 0; i < count; i++) outs[i].temp[0] = outs[i].backup[0] = 0;
-    /* 1. Every file's bytes into a temporary file beside its target. */
+    for (uint32_t i = 0; i < count; i++) {
+        if (!outs[i].early) outs[i].temp[0] = 0;
+        outs[i].backup[0] = 0;
+    }
+    /* 1. Every file's bytes into a temporary file beside its target (created now, or early). */
     for (; written < count && r == MK_OK; written++) {
         mk_output *o = &outs[written];
         if (o->kind == MK_OUTPUT_STREAM) continue;
-        int fd = create_beside(o->target, ".tmp", o->temp, sizeof o->temp);
+        const int early = o->early;
+        int fd = early ? o->fd : create_beside(o->target, ".tmp", o->temp, sizeof o->temp);
+        o->early = 0;   /* its descriptor is closed below */
         if (fd < 0) {
             r = io_error(err, o->path, "cannot create a temporary file beside it", errno);
             o->temp[0] = 0;
             break;
         }
-        int failed = mk_write_fd(fd, o->data, o->size, NULL) != 0;
+        int failed = (early ? write_rest(o) : mk_write_fd(fd, o->data, o->size, NULL)) != 0;
         int e = errno;
         if (!failed && o->kind == MK_OUTPUT_REPLACE_FILE) (void)fchmod(fd, (mode_t)o->mode);
         if (!failed && fsync(fd) != 0) {
@@ -354,6 +399,8 @@ mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
         }
     }
     for (uint32_t i = 0; i < count; i++) {
+        if (outs[i].early) close(outs[i].fd);   /* not reached: an earlier output failed */
+        outs[i].early = 0;
         if (outs[i].temp[0]) unlink(outs[i].temp);
         if (outs[i].backup[0]) unlink(outs[i].backup);
         if (r == MK_OK && outs[i].kind != MK_OUTPUT_STREAM) sync_dir_of(outs[i].target);

@@ -38,17 +38,16 @@ static int write_buffered(int fd, const uint8_t *p, size_t size)
     return 0;
 }
 
-/* The whole blocks of data[0 .. size) with O_DIRECT; *done: how many bytes were written (0 when
- * O_DIRECT is not available). fd's status flags are as they were afterwards: -1 (errno set)
- * when they could not be put back, else 0. */
-static int write_direct(int fd, const uint8_t *data, size_t size, size_t *done)
+/* The whole blocks of data[0 .. size) with O_DIRECT at file offset `at` (pwrite: fd's offset is
+ * left alone); *done: how many bytes were written (0 when O_DIRECT is not available). fd's
+ * status flags are as they were afterwards: -1 (errno set) when they could not be put back,
+ * else 0. */
+static int write_direct(int fd, const uint8_t *data, size_t size, uint64_t at, size_t *done)
 {
     *done = 0;
 #ifdef O_DIRECT
     struct stat st;
-    if (size < MK_WRITE_DIRECT_MIN || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) return 0;
-    off_t at = lseek(fd, 0, SEEK_CUR);
-    if (at < 0 || (uint64_t)at % DIRECT_ALIGN) return 0;
+    if (size < MK_WRITE_DIRECT_MIN || at % DIRECT_ALIGN || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) return 0;
     const int flags = fcntl(fd, F_GETFL), direct = flags | O_DIRECT;
     if (flags < 0 || (flags & O_DIRECT) || fcntl(fd, F_SETFL, direct) != 0) return 0;
     uint8_t *chunk = aligned_alloc(DIRECT_ALIGN, DIRECT_CHUNK);
@@ -56,7 +55,7 @@ static int write_direct(int fd, const uint8_t *data, size_t size, size_t *done)
     while (chunk && *done < whole) {
         size_t n = whole - *done < DIRECT_CHUNK ? whole - *done : DIRECT_CHUNK;
         memcpy(chunk, data + *done, n);
-        ssize_t k = write(fd, chunk, n);
+        ssize_t k = pwrite(fd, chunk, n, (off_t)(at + *done));
         if (k < 0 && errno == EINTR) continue;
         if (k <= 0) break;                  /* refused or failed: the rest buffered */
         *done += (size_t)k;
@@ -68,6 +67,7 @@ static int write_direct(int fd, const uint8_t *data, size_t size, size_t *done)
     (void)fd;
     (void)data;
     (void)size;
+    (void)at;
 #endif
     return 0;
 }
@@ -76,7 +76,28 @@ int mk_write_fd(int fd, const void *data, size_t size, size_t *direct_bytes)
 {
     const uint8_t *p = data;
     size_t done = 0;
-    int r = write_direct(fd, p, size, &done);
+    const off_t at = lseek(fd, 0, SEEK_CUR);   /* fails (ESPIPE) on a pipe: no direct part */
+    int r = at < 0 ? 0 : write_direct(fd, p, size, (uint64_t)at, &done);
     if (direct_bytes) *direct_bytes = done;
+    if (r == 0 && done && lseek(fd, at + (off_t)done, SEEK_SET) < 0) r = -1;
     return r != 0 ? -1 : write_buffered(fd, p + done, size - done);
+}
+
+int mk_write_fd_at(int fd, const void *data, size_t size, uint64_t offset, size_t *direct_bytes)
+{
+    const uint8_t *p = data;
+    size_t done = 0;
+    if (write_direct(fd, p, size, offset, &done) != 0) return -1;
+    if (direct_bytes) *direct_bytes = done;
+    while (done < size) {
+        ssize_t k = pwrite(fd, p + done, size - done, (off_t)(offset + done));
+        if (k < 0 && errno == EINTR) continue;
+        if (k < 0) return -1;
+        if (k == 0) {
+            errno = EIO;
+            return -1;
+        }
+        done += (size_t)k;
+    }
+    return 0;
 }

@@ -320,6 +320,9 @@ typedef struct layout_loop {
     uint8_t *data;                     /* the mesh's target data */
     mk_arena *owner;                   /* consuming: the raw arena the written targets go back to */
     mtx_t *owner_lock;
+    const mk_write_options *options;   /* its ready callback hears of each target's finished data */
+    const uint8_t *blob;
+    uint64_t data_at;                  /* the target data's offset in the blob */
 } layout_loop;
 
 /* Calls fn(user, block, first, end, mask, kind, offset) for each block a target touches, in
@@ -415,6 +418,8 @@ static void layout_write(void *user, uint32_t item, uint32_t worker)
     it.tl->cursor = it.tl->first_entry;
     it.tl->data_size = 0;
     target_blocks(l, it.tl->t, &l->plans[item], write_block, &it);
+    if (l->options->ready && it.tl->data_size)
+        l->options->ready(l->options->ready_user, l->blob, l->data_at + it.tl->base, pad16((size_t)it.tl->data_size));
     mk_raw_target *own = it.tl->own;
     if (!own) return;
     void *arrays[] = { own->indices, own->positions, own->normals, own->tangents };
@@ -465,7 +470,7 @@ static mk_result plan_mesh_data(const mk_raw_asset *raw, mk_raw_asset *consume, 
     layout_loop *l = &out->l;
     if (target_count > MK_MAX_MESH_TARGETS)
         return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: more than 2^24 targets", mi);
-    *l = (layout_loop){ m, plans, gap, NULL, NULL, NULL, NULL, NULL, NULL, consume ? &consume->arena : NULL, NULL };
+    *l = (layout_loop){ .m = m, .plans = plans, .gap = gap, .owner = consume ? &consume->arena : NULL };
     l->targets = mk_arena_array(arena, target_count + 1, sizeof *l->targets);
     if (!l->targets) return mk_error_oom(err, "planning blocks");
     uint32_t k = 0;
@@ -498,9 +503,12 @@ static mk_result plan_mesh_data(const mk_raw_asset *raw, mk_raw_asset *consume, 
 
 /* Writes one mesh's arrays, target data and entries into the data section `data` (zeroed:
  * the padding is left as it is) at the offsets plan_mesh_data chose. */
-static mk_result write_mesh_data(const mk_raw_mesh *m, uint32_t threads, mk_arena *arena, uint8_t *data,
-                                 mesh_out *out, mk_write_report *report, mk_error *err)
+static mk_result write_mesh_data(const mk_raw_mesh *m, const mk_write_options *options, mk_arena *arena,
+                                 uint8_t *blob, uint64_t data_base, mesh_out *out, mk_write_report *report,
+                                 mk_error *err)
 {
+    uint8_t *data = blob + data_base;
+    const uint32_t threads = options->threads;
     memcpy(data + out->positions, m->positions, 12u * (size_t)m->vertex_count);
     if (m->normals) memcpy(data + out->normals, m->normals, 12u * (size_t)m->vertex_count);
     if (m->tangents) memcpy(data + out->tangents, m->tangents, 16u * (size_t)m->vertex_count);
@@ -520,6 +528,9 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, uint32_t threads, mk_aren
     if (!l->entry_block || !l->entry_mask || !l->entry_data || !l->entry_kind)
         return mk_error_oom(err, "planning blocks");
     l->data = data + out->target_data;
+    l->options = options;
+    l->blob = blob;
+    l->data_at = data_base + out->target_data;
     mtx_t lock;
     if (l->owner) {
         if (mtx_init(&lock, mtx_plain) != thrd_success) return mk_error_oom(err, "writing block data");
@@ -751,7 +762,7 @@ static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, cons
     uint8_t *blob = mk_arena_alloc(arena, (size_t)total);
     if (!blob) return mk_error_oom(err, "allocating the blob");
     for (uint32_t mi = 0; mi < raw->mesh_count; mi++) {
-        r = write_mesh_data(&raw->meshes[mi], opt.threads, arena, blob + data_base, &mesh_data[mi], &report, err);
+        r = write_mesh_data(&raw->meshes[mi], &opt, arena, blob, data_base, &mesh_data[mi], &report, err);
         if (r) return r;
     }
     mk_phase_log_mark(opt.phases, "lay out blocks");

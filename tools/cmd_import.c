@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include "output_stream.h"
 #include "cli.h"
 
 typedef struct import_args {
@@ -120,9 +121,18 @@ static int run_import(void *p)
     size_t size = 0;
     mk_write_report report;
     cli_progress_update(&progress, "writing the blob", -1);
+    /* The blob's block data goes to the output file while the rest is still computed. */
+    mk_output_stream *early = NULL;
+    if (r == MK_OK && (r = mk_output_open_early(&outs[0].file, &err)) == MK_OK) {
+        early = mk_output_stream_start(&outs[0].file);
+        wo.ready = early ? mk_output_stream_ready : NULL;
+        wo.ready_user = early;
+    }
     /* The targets are only written once: the writer gives their memory back as it goes. */
     if (r == MK_OK) r = mk_write_blob_consuming(&raw, &wo, &blob, &size, &report, &err);
+    mk_output_stream_finish(early);   /* before the blob's memory can go */
     if (r != MK_OK) {
+        mk_output_discard(&outs[0].file);
         mk_raw_free(&raw);
         cli_depfile_free(&deps);
         return cli_fail(verb->name, &err);
@@ -133,7 +143,7 @@ static int run_import(void *p)
     if (a->depfile) {
         dep_text = cli_depfile_text(&deps, a->output, &outs[1].file.size);
         outs[1].file.data = dep_text;
-        if (!dep_text) { mk_raw_free(&raw); fprintf(stderr, "morphkit import: out of memory\n"); return CLI_EXIT_FAILURE; }
+        if (!dep_text) { mk_output_discard(&outs[0].file); mk_raw_free(&raw); fprintf(stderr, "morphkit import: out of memory\n"); return CLI_EXIT_FAILURE; }
     }
     status = cli_write_outputs(verb, outs, a->depfile ? 2 : 1);
     free(dep_text);

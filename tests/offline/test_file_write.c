@@ -3,7 +3,7 @@
  * 4096-byte block, from unaligned memory, on the build folder's file system and on tmpfs; large
  * outputs to a regular file go around the page cache where the file system allows it, and the
  * descriptor's flags are left as they were; devices take the ordinary path and their errors
- * come back with errno. */
+ * come back with errno. mk_write_fd_at: parts at any offsets, in any order, make the file. */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
@@ -149,4 +149,41 @@ static void errors_come_back(void)
     free(data);
 }
 
-CHECK_MAIN(CASE(every_byte_arrives_in_order), CASE(errors_come_back))
+/* mk_write_fd_at: parts written out of order, at aligned and unaligned offsets, make the file;
+ * fd's own offset stays where it was. */
+static void parts_at_offsets(void)
+{
+    const size_t size = 3 * MK_WRITE_DIRECT_MIN + 5000;
+    uint8_t *data = malloc(size);
+    CHECK(data != NULL);
+    if (!data) return;
+    uint32_t x = 777;
+    for (size_t i = 0; i < size; i++) data[i] = (uint8_t)((x = x * 1664525u + 1013904223u) >> 24);
+    char path[512];
+    snprintf(path, sizeof path, "./mk_file_write_at.%ld", (long)getpid());
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    CHECK(fd >= 0);
+    if (fd < 0) {
+        free(data);
+        return;
+    }
+    /* the last part first (it extends the file past a hole), then an unaligned middle, then
+     * the aligned head large enough to go directly */
+    const size_t cut1 = MK_WRITE_DIRECT_MIN + 4096, cut2 = 2 * MK_WRITE_DIRECT_MIN + 777;
+    size_t went_direct = 99;
+    CHECK_EQ_INT(mk_write_fd_at(fd, data + cut2, size - cut2, cut2, &went_direct), 0);
+    CHECK_EQ_INT(went_direct, 0);   /* unaligned offset: the ordinary way */
+    CHECK_EQ_INT(mk_write_fd_at(fd, data + cut1, cut2 - cut1, cut1, NULL), 0);
+    CHECK_EQ_INT(mk_write_fd_at(fd, data, cut1, 0, &went_direct), 0);
+    CHECK_EQ_INT(lseek(fd, 0, SEEK_CUR), 0);
+    CHECK(close(fd) == 0);
+    size_t n = 0;
+    unsigned char *got = check_read_file(path, &n);
+    CHECK_EQ_INT(n, size);
+    if (got && n == size) CHECK_MSG(memcmp(got, data, size) == 0, "parts written at offsets differ");
+    free(got);
+    unlink(path);
+    free(data);
+}
+
+CHECK_MAIN(CASE(every_byte_arrives_in_order), CASE(errors_come_back), CASE(parts_at_offsets))
