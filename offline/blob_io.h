@@ -32,7 +32,7 @@ typedef struct mk_write_options {
     uint32_t threads;
     /* Called (when set) as parts of the blob become final, while the rest is still computed:
      * bytes [offset, offset + size) of the blob at `blob` will not change again (each target's
-     * block data, on the worker threads, in any order; each byte at most once; the header and
+     * block data, on the worker threads or the caller's, in any order; each byte at most once; the header and
      * tables are never reported). Lets a caller write them out early (output_stream.h). */
     void (*ready)(void *user, const void *blob, uint64_t offset, uint64_t size);
     void *ready_user;
@@ -106,7 +106,8 @@ typedef struct mk_output {
     char temp[4200], backup[4200]; /* used while writing */
     /* Set by mk_output_open_early: the temporary file is open (fd) before the bytes are known,
      * and the bytes [written_from, written_to) of data are in it already (written while they
-     * were computed; output_stream.h); mk_write_outputs writes the rest. */
+     * were computed, from the same bytes `data` then points at; output_stream.h);
+     * mk_write_outputs writes the rest and closes it. */
     int early, fd;
     uint64_t written_from, written_to;
     int early_errno;               /* flushing the early bytes failed: the write fails with this */

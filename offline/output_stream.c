@@ -5,7 +5,8 @@
  * back). The thread writes one range of the file, [from, to): it starts at the first ready
  * part with at least STREAM_MIN bytes of whole 4096-byte blocks and grows while the ready
  * bytes right after it do, in pieces of 4096-byte blocks (so they go around the page cache:
- * file_write.c) of at most STREAM_PIECE bytes, each once STREAM_MIN bytes are ready past it.
+ * file_write.c) of at most STREAM_PIECE bytes, whenever at least STREAM_MIN such bytes are
+ * ready past its end (the last, shorter stretch is left for the end).
  * Everything else is written by mk_write_outputs at the end: the header, tables and entries,
  * which are final last; parts that were ready too late; a mesh's data after the first one's. */
 #include <errno.h>

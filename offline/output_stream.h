@@ -19,9 +19,10 @@ mk_output_stream *mk_output_stream_start(mk_output *out);
 /* A mk_write_options ready callback: bytes [offset, offset + size) of the blob at `blob` are
  * final. Any thread, any order; each byte at most once. user is the stream (may be NULL). */
 void mk_output_stream_ready(void *user, const void *blob, uint64_t offset, uint64_t size);
-/* Waits for the thread's current write and stops it; out's written range then says what is in
- * the file (a part whose write failed is not in it: mk_write_outputs writes it again and
- * reports the error). Frees the stream. NULL: nothing. */
+/* Waits for the thread's current write or flush and stops it; out's written range then says
+ * what is in the file. A piece whose write failed is not in it (mk_write_outputs writes it
+ * again, and fails if that fails too); a failed flush is kept in out->early_errno and fails
+ * the output. Frees the stream. NULL: nothing. */
 void mk_output_stream_finish(mk_output_stream *stream);
 
 #endif

@@ -50,7 +50,9 @@ int cli_write_outputs(const cli_verb *verb, cli_output *outs, uint32_t count)
     for (uint32_t i = 0; i < count && n < 8; i++)
         if (!outs[i].to_stdout) files[n++] = outs[i].file;
     mk_error err;
-    if (n && mk_write_outputs(files, n, &err) != MK_OK) return cli_fail(verb->name, &err);
+    mk_result r = n ? mk_write_outputs(files, n, &err) : MK_OK;
+    for (uint32_t i = 0; i < count; i++) outs[i].file.early = 0;   /* closed by mk_write_outputs */
+    if (r != MK_OK) return cli_fail(verb->name, &err);
     for (uint32_t i = 0; i < count; i++) {
         if (!outs[i].to_stdout) continue;
         if (fwrite(outs[i].file.data, 1, outs[i].file.size, stdout) != outs[i].file.size || fflush(stdout) != 0) {

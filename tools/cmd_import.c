@@ -143,7 +143,7 @@ static int run_import(void *p)
     if (a->depfile) {
         dep_text = cli_depfile_text(&deps, a->output, &outs[1].file.size);
         outs[1].file.data = dep_text;
-        if (!dep_text) { mk_output_discard(&outs[0].file); mk_raw_free(&raw); fprintf(stderr, "morphkit import: out of memory\n"); return CLI_EXIT_FAILURE; }
+        if (!dep_text) { mk_output_discard(&outs[0].file); mk_raw_free(&raw); cli_depfile_free(&deps); fprintf(stderr, "morphkit import: out of memory\n"); return CLI_EXIT_FAILURE; }
     }
     status = cli_write_outputs(verb, outs, a->depfile ? 2 : 1);
     free(dep_text);
