@@ -125,6 +125,11 @@ mk_result mk_output_open_early(mk_output *out, mk_error *err);
 /* Closes and removes an early output's temporary file (after a failure before
  * mk_write_outputs); nothing for other outputs. */
 void mk_output_discard(mk_output *out);
+/* Installs handlers for SIGINT, SIGTERM and SIGHUP (those not ignored) that remove the
+ * temporary and backup files of outputs being written, then end the process by the signal as
+ * before: an interrupted command leaves no files beside its outputs. For programs that write
+ * outputs (the morphkit command calls it first thing). */
+void mk_output_cleanup_on_signals(void);
 /* Writes checked outputs, all or none. */
 mk_result mk_write_outputs(mk_output *outputs, uint32_t count, mk_error *err);
 /* mk_output_check (no inputs) + mk_write_outputs for one file. */

@@ -8,6 +8,8 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -251,7 +253,56 @@ mk_result mk_output_check(mk_output *out, const char *const *inputs, uint32_t in
     return MK_OK;
 }
 
-/* A new file "<target><suffix>.<pid>.<n>" created exclusively (the umask applies). */
+/* ---- the files an interrupted command leaves behind ----
+ * Every temporary and backup file beside an output is listed here from its creation until it
+ * is renamed or removed, so a signal handler can remove them (unlink is async-signal-safe). A
+ * slot's name is complete before its flag is set. More files at once than slots (a command
+ * writes at most a few outputs) are simply not listed. */
+#define PENDING_SLOTS 16
+static char pending_name[PENDING_SLOTS][4200];
+static volatile sig_atomic_t pending_used[PENDING_SLOTS];
+
+static void pending_add(const char *name)
+{
+    for (int i = 0; i < PENDING_SLOTS; i++) {
+        if (pending_used[i]) continue;
+        snprintf(pending_name[i], sizeof pending_name[i], "%s", name);
+        atomic_signal_fence(memory_order_seq_cst);
+        pending_used[i] = 1;
+        return;
+    }
+}
+
+static void pending_forget(const char *name)
+{
+    for (int i = 0; i < PENDING_SLOTS; i++)
+        if (pending_used[i] && !strcmp(pending_name[i], name)) pending_used[i] = 0;
+}
+
+static void remove_pending_and_reraise(int sig)
+{
+    for (int i = 0; i < PENDING_SLOTS; i++)
+        if (pending_used[i]) unlink(pending_name[i]);
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+void mk_output_cleanup_on_signals(void)
+{
+    static const int signals[] = { SIGINT, SIGTERM, SIGHUP };
+    for (size_t i = 0; i < sizeof signals / sizeof signals[0]; i++) {
+        struct sigaction old;
+        if (sigaction(signals[i], NULL, &old) != 0 || old.sa_handler != SIG_DFL) continue;   /* ignored: stays so */
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = remove_pending_and_reraise;
+        sigemptyset(&sa.sa_mask);
+        sigaction(signals[i], &sa, NULL);
+    }
+}
+
+/* A new file "<target><suffix>.<pid>.<n>" created exclusively (the umask applies); listed as
+ * pending until pending_forget. */
 static int create_beside(const char *target, const char *suffix, char *name, size_t size)
 {
     for (int n = 0; n < 1000; n++) {
@@ -260,9 +311,17 @@ static int create_beside(const char *target, const char *suffix, char *name, siz
             return -1;
         }
         int fd = open(name, O_WRONLY | O_CREAT | O_EXCL, 0666);
+        if (fd >= 0) pending_add(name);
         if (fd >= 0 || errno != EEXIST) return fd;
     }
     return -1;
+}
+
+/* Removes a temporary or backup file and its listing. */
+static void remove_pending(const char *name)
+{
+    unlink(name);
+    pending_forget(name);
 }
 
 static void sync_dir_of(const char *target)
@@ -295,7 +354,7 @@ void mk_output_discard(mk_output *out)
 {
     if (!out->early) return;
     close(out->fd);
-    unlink(out->temp);
+    remove_pending(out->temp);
     out->temp[0] = 0;
     out->early = 0;
 }
@@ -376,7 +435,10 @@ mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
             int fd = create_beside(o->target, ".bak", o->backup, sizeof o->backup);
             if (fd >= 0) {
                 close(fd);
-                if (unlink(o->backup) != 0 || link(o->target, o->backup) != 0) o->backup[0] = 0;
+                if (unlink(o->backup) != 0 || link(o->target, o->backup) != 0) {
+                    remove_pending(o->backup);
+                    o->backup[0] = 0;
+                }
             } else {
                 o->backup[0] = 0;
             }
@@ -385,14 +447,17 @@ mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
             r = io_error(err, o->path, "cannot rename into place", errno);
             break;
         }
+        pending_forget(o->temp);
         o->temp[0] = 0;
     }
     if (r != MK_OK) {
         for (uint32_t i = 0; i < renamed; i++) {
             mk_output *o = &outs[i];
             if (o->kind == MK_OUTPUT_STREAM) continue;
-            if (o->backup[0])
+            if (o->backup[0]) {
                 rename(o->backup, o->target);
+                pending_forget(o->backup);
+            }
             else if (o->kind == MK_OUTPUT_NEW_FILE)
                 unlink(o->target);
             o->backup[0] = 0;
@@ -401,8 +466,8 @@ mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
     for (uint32_t i = 0; i < count; i++) {
         if (outs[i].early) close(outs[i].fd);   /* not reached: an earlier output failed */
         outs[i].early = 0;
-        if (outs[i].temp[0]) unlink(outs[i].temp);
-        if (outs[i].backup[0]) unlink(outs[i].backup);
+        if (outs[i].temp[0]) remove_pending(outs[i].temp);
+        if (outs[i].backup[0]) remove_pending(outs[i].backup);
         if (r == MK_OK && outs[i].kind != MK_OUTPUT_STREAM) sync_dir_of(outs[i].target);
     }
     return r;

@@ -56,6 +56,7 @@ int main(int argc, char **argv)
      * pages. */
     mk_recycle_enable((size_t)32 << 20);
 #endif
+    mk_output_cleanup_on_signals();   /* Ctrl-C leaves no temporary files beside the outputs */
     if (argc < 2) {
         usage(stderr);
         return CLI_EXIT_USAGE;

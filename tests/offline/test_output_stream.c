@@ -2,12 +2,15 @@
 /* Early outputs (mk_output_open_early) and the thread that writes finished parts while the rest
  * is computed (output_stream.h): whatever was written early, in whatever order the parts were
  * reported, the file that lands is exactly the data; a discarded early output leaves nothing
- * and an existing file untouched; a failed early flush fails the write and keeps the old file. */
+ * and an existing file untouched; a failed early flush fails the write and keeps the old file;
+ * a signal that ends the command removes the temporary file. */
 #include <errno.h>
+#include <signal.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 #include "blob_io.h"
@@ -219,5 +222,56 @@ static void devices_are_not_early(void)
     mk_output_stream_finish(NULL);
 }
 
-CHECK_MAIN(CASE(parts_in_any_order_land_whole), CASE(nothing_early_still_lands), CASE(discard_leaves_nothing),
+/* A command interrupted while its output is being written (mk_output_cleanup_on_signals):
+ * the signal still ends the process, and the early temporary file is gone; an ignored signal
+ * stays ignored. */
+static void signals_remove_temporary_files(void)
+{
+    static const int sigs[] = { SIGTERM, SIGINT };
+    for (int k = 0; k < 2; k++) {
+        int link_fds[2];
+        CHECK(pipe(link_fds) == 0);
+        pid_t child = fork();
+        CHECK(child >= 0);
+        if (child == 0) {
+            close(link_fds[0]);
+            mk_output_cleanup_on_signals();
+            static mk_output out;
+            char path[256];
+            path_of(path, sizeof path, "signal");
+            out = (mk_output){ .path = path };
+            mk_error err;
+            if (mk_output_check(&out, NULL, 0, &err) != MK_OK || mk_output_open_early(&out, &err) != MK_OK) _exit(3);
+            if (write(link_fds[1], out.temp, strlen(out.temp) + 1) < 0) _exit(4);
+            raise(sigs[k]);
+            _exit(5);   /* not reached: the signal ends the process */
+        }
+        close(link_fds[1]);
+        char temp[4300] = "";
+        ssize_t n = read(link_fds[0], temp, sizeof temp - 1);
+        close(link_fds[0]);
+        int status = 0;
+        CHECK(waitpid(child, &status, 0) == child);
+        CHECK_MSG(WIFSIGNALED(status) && WTERMSIG(status) == sigs[k], "signal %d: the child ended by status %d",
+                  sigs[k], status);
+        CHECK(n > 0);
+        struct stat st;
+        CHECK_MSG(n > 0 && stat(temp, &st) != 0, "signal %d: the temporary file %s was left", sigs[k], temp);
+        if (n > 0) unlink(temp);
+    }
+    /* An ignored SIGHUP (nohup) stays ignored. */
+    pid_t child = fork();
+    CHECK(child >= 0);
+    if (child == 0) {
+        signal(SIGHUP, SIG_IGN);
+        mk_output_cleanup_on_signals();
+        raise(SIGHUP);
+        _exit(0);
+    }
+    int status = -1;
+    CHECK(waitpid(child, &status, 0) == child);
+    CHECK_MSG(WIFEXITED(status) && WEXITSTATUS(status) == 0, "an ignored SIGHUP ended the process (status %d)", status);
+}
+
+CHECK_MAIN(CASE(parts_in_any_order_land_whole), CASE(signals_remove_temporary_files), CASE(nothing_early_still_lands), CASE(discard_leaves_nothing),
            CASE(failed_flush_fails_the_write), CASE(devices_are_not_early))
