@@ -359,8 +359,8 @@ void mk_output_discard(mk_output *out)
     out->early = 0;
 }
 
-/* An early output's bytes that are not in its temporary file yet: before and after the range
- * written while they were computed. */
+/* An output's bytes that are not in its temporary file yet: all of them, or those before and
+ * after the range written early (while they were computed). */
 static int write_rest(const mk_output *o)
 {
     if (o->early_errno) {
@@ -383,19 +383,15 @@ mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
         if (!outs[i].early) outs[i].temp[0] = 0;
         outs[i].backup[0] = 0;
     }
-    /* 1. Every file's bytes into a temporary file beside its target (created now, or early). */
+    /* 1. Every file's bytes into a temporary file beside its target: created now unless it was
+     * opened early, and given the bytes that are not in it yet. */
     for (; written < count && r == MK_OK; written++) {
         mk_output *o = &outs[written];
         if (o->kind == MK_OUTPUT_STREAM) continue;
-        const int early = o->early;
-        int fd = early ? o->fd : create_beside(o->target, ".tmp", o->temp, sizeof o->temp);
+        if ((r = mk_output_open_early(o, err)) != MK_OK) break;
+        const int fd = o->fd;
         o->early = 0;   /* its descriptor is closed below */
-        if (fd < 0) {
-            r = io_error(err, o->path, "cannot create a temporary file beside it", errno);
-            o->temp[0] = 0;
-            break;
-        }
-        int failed = (early ? write_rest(o) : mk_write_fd(fd, o->data, o->size, NULL)) != 0;
+        int failed = write_rest(o) != 0;
         int e = errno;
         if (!failed && o->kind == MK_OUTPUT_REPLACE_FILE) (void)fchmod(fd, (mode_t)o->mode);
         if (!failed && fsync(fd) != 0) {

@@ -22,10 +22,12 @@
 #define DIRECT_ALIGN ((size_t)4096)   /* covers 512- and 4096-byte logical blocks and the page */
 #define DIRECT_CHUNK ((size_t)1 << 20)
 
-static int write_buffered(int fd, const uint8_t *p, size_t size)
+/* size bytes through the page cache, retrying short and interrupted writes: at fd's offset
+ * (write) when `at` is negative, else at file offset `at` (pwrite). */
+static int write_buffered(int fd, const uint8_t *p, size_t size, int64_t at)
 {
     while (size) {
-        ssize_t k = write(fd, p, size);
+        ssize_t k = at < 0 ? write(fd, p, size) : pwrite(fd, p, size, (off_t)at);
         if (k < 0 && errno == EINTR) continue;
         if (k < 0) return -1;
         if (k == 0) {
@@ -34,6 +36,7 @@ static int write_buffered(int fd, const uint8_t *p, size_t size)
         }
         p += k;
         size -= (size_t)k;
+        if (at >= 0) at += k;
     }
     return 0;
 }
@@ -80,7 +83,7 @@ int mk_write_fd(int fd, const void *data, size_t size, size_t *direct_bytes)
     int r = at < 0 ? 0 : write_direct(fd, p, size, (uint64_t)at, &done);
     if (direct_bytes) *direct_bytes = done;
     if (r == 0 && done && lseek(fd, at + (off_t)done, SEEK_SET) < 0) r = -1;
-    return r != 0 ? -1 : write_buffered(fd, p + done, size - done);
+    return r != 0 ? -1 : write_buffered(fd, p + done, size - done, -1);
 }
 
 int mk_write_fd_at(int fd, const void *data, size_t size, uint64_t offset, size_t *direct_bytes)
@@ -89,15 +92,5 @@ int mk_write_fd_at(int fd, const void *data, size_t size, uint64_t offset, size_
     size_t done = 0;
     if (write_direct(fd, p, size, offset, &done) != 0) return -1;
     if (direct_bytes) *direct_bytes = done;
-    while (done < size) {
-        ssize_t k = pwrite(fd, p + done, size - done, (off_t)(offset + done));
-        if (k < 0 && errno == EINTR) continue;
-        if (k < 0) return -1;
-        if (k == 0) {
-            errno = EIO;
-            return -1;
-        }
-        done += (size_t)k;
-    }
-    return 0;
+    return write_buffered(fd, p + done, size - done, (int64_t)(offset + done));
 }

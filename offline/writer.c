@@ -317,12 +317,11 @@ typedef struct layout_loop {
     uint32_t *entry_block;             /* per entry, target-major */
     uint8_t *entry_kind;               /* per entry: its entry_kind */
     uint64_t *entry_mask, *entry_data; /* the entry's vertices; its data's offset in the target data */
-    uint8_t *data;                     /* the mesh's target data */
+    uint8_t *data;                     /* the mesh's target data, in the blob */
     mk_arena *owner;                   /* consuming: the raw arena the written targets go back to */
     mtx_t *owner_lock;
     const mk_write_options *options;   /* its ready callback hears of each target's finished data */
-    const uint8_t *blob;
-    uint64_t data_at;                  /* the target data's offset in the blob */
+    const uint8_t *blob;               /* where data lies in it: its ready offsets count from here */
 } layout_loop;
 
 /* Calls fn(user, block, first, end, mask, kind, offset) for each block a target touches, in
@@ -419,7 +418,8 @@ static void layout_write(void *user, uint32_t item, uint32_t worker)
     it.tl->data_size = 0;
     target_blocks(l, it.tl->t, &l->plans[item], write_block, &it);
     if (l->options->ready && it.tl->data_size)
-        l->options->ready(l->options->ready_user, l->blob, l->data_at + it.tl->base, pad16((size_t)it.tl->data_size));
+        l->options->ready(l->options->ready_user, l->blob, (uint64_t)(l->data - l->blob) + it.tl->base,
+                          pad16((size_t)it.tl->data_size));
     mk_raw_target *own = it.tl->own;
     if (!own) return;
     void *arrays[] = { own->indices, own->positions, own->normals, own->tangents };
@@ -530,7 +530,6 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, const mk_write_options *o
     l->data = data + out->target_data;
     l->options = options;
     l->blob = blob;
-    l->data_at = data_base + out->target_data;
     mtx_t lock;
     if (l->owner) {
         if (mtx_init(&lock, mtx_plain) != thrd_success) return mk_error_oom(err, "writing block data");

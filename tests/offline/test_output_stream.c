@@ -56,6 +56,24 @@ static void sleep_ms(long ms)
     nanosleep(&t, NULL);
 }
 
+/* An early output at a fresh path named after `name`: a new file (old NULL) or one replacing
+ * an existing file holding `old`; temp (may be NULL) receives its temporary file's name. */
+static void open_early(mk_output *out, char *path, size_t path_size, const char *name, const char *old, char *temp)
+{
+    path_of(path, path_size, name);
+    if (old) write_text(path, old);
+    else unlink(path);
+    *out = (mk_output){ .path = path };
+    mk_error err;
+    CHECK_EQ_INT(mk_output_check(out, NULL, 0, &err), MK_OK);
+    CHECK_EQ_INT(out->kind, old ? MK_OUTPUT_REPLACE_FILE : MK_OUTPUT_NEW_FILE);
+    CHECK_EQ_INT(mk_output_open_early(out, &err), MK_OK);
+    CHECK(out->early);
+    struct stat st;
+    CHECK_MSG(stat(out->temp, &st) == 0, "the early temporary file %s exists", out->temp);
+    if (temp) memcpy(temp, out->temp, sizeof out->temp);
+}
+
 /* Parts of the data from `first` on, 16-byte multiples of uneven sizes (as a blob's targets),
  * reported in a shuffled order, then the early bytes waited for; the output then lands whole. */
 static void parts_in_any_order_land_whole(void)
@@ -64,14 +82,10 @@ static void parts_in_any_order_land_whole(void)
     CHECK(data != NULL);
     if (!data) return;
     char path[256];
-    path_of(path, sizeof path, "whole");
-    mk_output out = { .path = path };
+    mk_output out;
+    open_early(&out, path, sizeof path, "whole", NULL, NULL);
     mk_error err;
-    CHECK_EQ_INT(mk_output_check(&out, NULL, 0, &err), MK_OK);
-    CHECK_EQ_INT(mk_output_open_early(&out, &err), MK_OK);
-    CHECK(out.early);
     struct stat st;
-    CHECK_MSG(stat(out.temp, &st) == 0, "the early temporary file %s exists", out.temp);
     mk_output_stream *s = mk_output_stream_start(&out);
     CHECK(s != NULL);
     enum { PARTS = 40 };
@@ -129,11 +143,9 @@ static void nothing_early_still_lands(void)
     CHECK(data != NULL);
     if (!data) return;
     char path[256];
-    path_of(path, sizeof path, "none");
-    mk_output out = { .path = path };
+    mk_output out;
+    open_early(&out, path, sizeof path, "none", NULL, NULL);
     mk_error err;
-    CHECK_EQ_INT(mk_output_check(&out, NULL, 0, &err), MK_OK);
-    CHECK_EQ_INT(mk_output_open_early(&out, &err), MK_OK);
     mk_output_stream *s = mk_output_stream_start(&out);
     mk_output_stream_ready(s, data, 4096, 1000);   /* under the thread's start size */
     mk_output_stream_finish(s);
@@ -157,30 +169,13 @@ static void nothing_early_still_lands(void)
     free(data);
 }
 
-/* An early output replacing an existing file holding `old`; temp receives its temporary
- * file's name. */
-static void open_early_over(mk_output *out, char *path, size_t path_size, const char *name, const char *old,
-                            char *temp)
-{
-    path_of(path, path_size, name);
-    write_text(path, old);
-    *out = (mk_output){ .path = path };
-    mk_error err;
-    CHECK_EQ_INT(mk_output_check(out, NULL, 0, &err), MK_OK);
-    CHECK_EQ_INT(out->kind, MK_OUTPUT_REPLACE_FILE);
-    CHECK_EQ_INT(mk_output_open_early(out, &err), MK_OK);
-    memcpy(temp, out->temp, sizeof out->temp);
-    struct stat st;
-    CHECK_MSG(stat(temp, &st) == 0, "the early temporary file %s exists", temp);
-}
-
 /* A discarded early output (the command failed) leaves the existing file as it was and no
  * temporary file. */
 static void discard_leaves_nothing(void)
 {
     static mk_output out;
     char path[256], temp[sizeof out.temp];
-    open_early_over(&out, path, sizeof path, "discard", "keep me", temp);
+    open_early(&out, path, sizeof path, "discard", "keep me", temp);
     mk_output_discard(&out);
     struct stat st;
     CHECK_MSG(stat(temp, &st) != 0, "the temporary file %s is gone", temp);
@@ -194,7 +189,7 @@ static void failed_flush_fails_the_write(void)
 {
     static mk_output out;
     char path[256], temp[sizeof out.temp];
-    open_early_over(&out, path, sizeof path, "flush", "old", temp);
+    open_early(&out, path, sizeof path, "flush", "old", temp);
     out.early_errno = EIO;   /* as the stream's finish leaves it after a failed fdatasync */
     out.data = "new";
     out.size = 3;
