@@ -119,8 +119,9 @@ static void compare_mesh(frame_state *s, uint32_t mi, const pb_ref_mesh *rm)
     mk_error err;
     if (!pos || (m.has_normals && !nrm)) {
         snprintf(res->failure, sizeof res->failure, "out of memory");
-    } else if (pb_eval_mesh(a, mi, s->weights, s->o->stacking ? s->o->stacking : s->c->stacking,
-                            s->o->normal_mode_given ? s->o->normal_mode : s->c->normal_mode, pos, nrm, &err) != MK_OK) {
+    } else if (pb_eval_mesh_with(s->o->evaluator, a, mi, s->weights, s->o->stacking ? s->o->stacking : s->c->stacking,
+                                 s->o->normal_mode_given ? s->o->normal_mode : s->c->normal_mode, pos, nrm, NULL,
+                                 &err) != MK_OK) {
         snprintf(res->failure, sizeof res->failure, "mesh '%.100s': evaluation failed: %.300s", m.name, err.message);
     } else {
         if (s->c->world) pb_to_world(m.world, pos, nrm, m.vertex_count);

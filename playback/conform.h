@@ -26,6 +26,7 @@ typedef struct pb_conform_options {
     int normal_mode_given;
     double normal_tolerance_deg; /* largest normal angle; 0 means 1 degree */
     double weight_tolerance;     /* largest |weight - reference weight|; 0 means 1e-5 */
+    const struct pb_evaluator *evaluator; /* where meshes are evaluated (frame.h); NULL: the CPU runtime */
     void (*mesh_compared)(void *user, const pb_compared_mesh *mesh); /* may be NULL */
     void *user;
 } pb_conform_options;

@@ -19,13 +19,19 @@ mk_result pb_frame_weights(const mk_asset *asset, int32_t clip, double time, flo
     return mk_sample_run(&job, err);
 }
 
-mk_result pb_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
-                       mk_normal_mode normals_mode, float *positions, float *normals, mk_error *err)
+mk_result pb_eval_mesh_with(const pb_evaluator *evaluator, const mk_asset *asset, uint32_t mesh, const float *weights,
+                            mk_stacking stacking, mk_normal_mode normals_mode, float *positions, float *normals,
+                            float *tangents, mk_error *err)
 {
     mk_mesh_info m;
     if (!mk_mesh_get(asset, mesh, &m))
         return mk_error_set(err, MK_ERROR_OUT_OF_RANGE, UINT64_MAX, "mesh %u does not exist (%u meshes)", mesh,
                             asset->mesh_count);
+    if (!m.has_normals) normals = NULL;
+    if (!m.has_tangents) tangents = NULL;
+    if (evaluator && evaluator->eval)
+        return evaluator->eval(evaluator->user, asset, mesh, weights, stacking, normals_mode, positions, normals,
+                               tangents, err);
     size_t scratch_size = mk_eval_scratch_size(asset, mesh);
     void *scratch = aligned_alloc(16, (scratch_size + 31) & ~(size_t)15); /* never 0 bytes */
     if (!scratch) return mk_error_oom(err, "evaluation scratch");
@@ -41,12 +47,20 @@ mk_result pb_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weight
         .scratch_size = scratch_size,
         .positions = positions,
         .positions_size = (size_t)m.vertex_count * 12,
-        .normals = m.has_normals ? normals : NULL,
+        .normals = normals,
         .normals_size = (size_t)m.vertex_count * 12,
+        .tangents = tangents,
+        .tangents_size = (size_t)m.vertex_count * 16,
     };
     mk_result r = mk_eval_run(&job, err);
     free(scratch);
     return r;
+}
+
+mk_result pb_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
+                       mk_normal_mode normals_mode, float *positions, float *normals, mk_error *err)
+{
+    return pb_eval_mesh_with(NULL, asset, mesh, weights, stacking, normals_mode, positions, normals, NULL, err);
 }
 
 mk_result pb_surface_prepare(pb_surface *s, const mk_asset *asset, uint32_t mesh, mk_error *err)

@@ -10,8 +10,23 @@
 /* weights (asset channel count) = channel defaults, then the clip sampled at time if clip >= 0. */
 mk_result pb_frame_weights(const mk_asset *asset, int32_t clip, double time, float *weights, mk_error *err);
 
-/* Evaluates mesh positions (and normals if non-NULL and the mesh has them) for asset-wide
- * weights. stacking 0 = the blob's. Scratch is allocated here (tools may allocate). */
+/* Where a mesh is evaluated: the CPU runtime (a NULL evaluator or eval) or another path with
+ * the same meaning, such as the GPU one (tools/gpu_eval.h). eval fills positions (3 floats per
+ * vertex) and, where non-NULL, normals (3) and tangents (4) of the whole mesh for asset-wide
+ * weights. */
+typedef struct pb_evaluator {
+    mk_result (*eval)(void *user, const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
+                      mk_normal_mode normal_mode, float *positions, float *normals, float *tangents, mk_error *err);
+    void *user;
+} pb_evaluator;
+
+/* Evaluates mesh positions (and normals and tangents where non-NULL and the mesh has them) for
+ * asset-wide weights through the evaluator. stacking 0 = the blob's. Scratch is allocated here
+ * (tools may allocate). */
+mk_result pb_eval_mesh_with(const pb_evaluator *evaluator, const mk_asset *asset, uint32_t mesh, const float *weights,
+                            mk_stacking stacking, mk_normal_mode normals_mode, float *positions, float *normals,
+                            float *tangents, mk_error *err);
+/* pb_eval_mesh_with on the CPU runtime, without tangents. */
 mk_result pb_eval_mesh(const mk_asset *asset, uint32_t mesh, const float *weights, mk_stacking stacking,
                        mk_normal_mode normals_mode, float *positions, float *normals, mk_error *err);
 

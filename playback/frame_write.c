@@ -20,30 +20,6 @@ void pb_frame_free(pb_frame *f)
     f->positions = f->normals = f->tangents = NULL;
 }
 
-/* Tangents of one mesh into out (4 per vertex, mesh-local). */
-static mk_result eval_tangents(const pb_frame *f, uint32_t mesh, float *out, mk_error *err)
-{
-    mk_mesh_info m;
-    mk_mesh_get(f->asset, mesh, &m);
-    size_t scratch_size = mk_eval_scratch_size(f->asset, mesh);
-    void *scratch = aligned_alloc(16, (scratch_size + 31) & ~(size_t)15);
-    float *pos = malloc(12 * (size_t)m.vertex_count + 12);
-    if (!scratch || !pos) {
-        free(scratch);
-        free(pos);
-        return mk_error_oom(err, "tangents");
-    }
-    mk_eval_job job = { .asset = f->asset, .mesh = mesh, .vertex_count = MK_VERTICES_TO_END,
-                        .weights = f->weights + m.first_channel, .weight_count = m.channel_count,
-                        .stacking = f->stacking, .normal_mode = f->normal_mode, .scratch = scratch,
-                        .scratch_size = scratch_size, .positions = pos, .positions_size = 12 * (size_t)m.vertex_count,
-                        .tangents = out, .tangents_size = 16 * (size_t)m.vertex_count };
-    mk_result r = mk_eval_run(&job, err);
-    free(scratch);
-    free(pos);
-    return r;
-}
-
 /* Tangent directions to world space: the upper 3x3, normalized (w kept). */
 static void tangents_to_world(const float world[16], float *tangents, uint32_t count)
 {
@@ -74,10 +50,9 @@ mk_result pb_frame_evaluate(pb_frame *f, mk_error *err)
             return mk_error_oom(err, "frame");
         /* Surface normals and tangents come from the positions: nothing blended is needed. */
         int surface = f->surface_normals && f->normals[i] && mk_surface_topology_size(a, i);
-        mk_result r = pb_eval_mesh(a, i, f->weights, f->stacking, f->normal_mode, f->positions[i],
-                                   surface ? NULL : f->normals[i], err);
+        mk_result r = pb_eval_mesh_with(f->evaluator, a, i, f->weights, f->stacking, f->normal_mode, f->positions[i],
+                                        surface ? NULL : f->normals[i], surface ? NULL : f->tangents[i], err);
         if (r == MK_OK && surface) r = pb_surface_normals(a, i, f->positions[i], f->normals[i], f->tangents[i], err);
-        else if (r == MK_OK && f->tangents[i]) r = eval_tangents(f, i, f->tangents[i], err);
         if (r != MK_OK) return r;
         if (f->world) pb_to_world(m.world, f->positions[i], f->normals[i], m.vertex_count);
         if (f->world && f->tangents[i]) tangents_to_world(m.world, f->tangents[i], m.vertex_count);

@@ -19,6 +19,7 @@ typedef struct pb_frame {
                                    * (mk_surface_run) where a mesh has triangles and normals */
     int world;                    /* positions and normals in world space (else mesh-local) */
     int skip_tangents;            /* leave tangents out (pictures need none) */
+    const struct pb_evaluator *evaluator; /* where meshes are evaluated (frame.h); NULL: the CPU runtime */
     float *weights;               /* asset channel count, the weights played */
     float **positions;            /* per mesh: 3 floats per vertex */
     float **normals;              /* per mesh: 3 per vertex, or NULL where the mesh has none */

@@ -1,12 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* Morph evaluation (docs/semantics.md).
  *
- * Per frame, once per job: every target of the mesh gets one scalar coefficient from the
- * channel weights (mk_channel_span: piecewise-linear through the implicit (0,0) key and the
- * targets' full weights, extrapolated at both ends). Sequential stacking
- *     d_c = (1 - beta_c) d_{c-1} + D_c(w_c)
- * unrolls to d = sum_c D_c * prod_{c' > c} (1 - beta_c'), so it only multiplies each channel's
- * coefficients by a suffix product: it costs what additive costs.
+ * Per frame, once per job: the frame's plan (plan.h) in the job's scratch gives every target
+ * of the mesh one scalar coefficient from the channel weights, sequential stacking included.
  *
  * Per block of 64 vertices: an accumulator per attribute (float xyz triples interleaved like
  * the base arrays, the outputs and the stored deltas, 768 bytes each, in L1) starts as a copy
@@ -29,70 +25,14 @@
 #include "morphkit.h"
 #include "error.h"
 #include "span.h"
+#include "plan.h"
 #include "clones.h"
 #include "determinism.h"
 
-/* ---- channel spans ---- */
-
-/* Full weights read with a byte stride, so the evaluator can read them straight from the
- * target records and tools from a plain float array. */
-static float full_weight_at(const float *full_weights, size_t stride, uint32_t k)
-{
-    return *(const float *)(const void *)((const uint8_t *)full_weights + stride * k);
-}
-
-static void channel_span_strided(const float *full_weights, size_t stride, uint32_t count, float w,
-                                 int32_t *ia, float *ca, int32_t *ib, float *cb, float *t_out)
-{
-    /* Key points sorted by full weight with the implicit zero key inserted after the
-     * negative ones: virtual index j -> (weight, target), target -1 = the zero key. */
-    if (count == 0) {       /* no targets: D(w) = 0 */
-        *ia = *ib = -1;
-        *ca = *cb = 0.0f;
-        if (t_out) *t_out = 0.0f;
-        return;
-    }
-    uint32_t zero = 0;
-    while (zero < count && full_weight_at(full_weights, stride, zero) < 0) zero++;
-#define KEY_W(j) ((j) < zero ? full_weight_at(full_weights, stride, (j)) \
-                  : (j) == zero ? 0.0f : full_weight_at(full_weights, stride, (j) - 1))
-#define KEY_T(j) ((j) < zero ? (int32_t)(j) : (j) == zero ? -1 : (int32_t)(j) - 1)
-    /* Span j covers [key j, key j+1]; outside the range the first/last span extrapolates.
-     * Linear search: channels have few in-betweens and the search runs once per frame. */
-    uint32_t j = 0;
-    while (j + 1 < count && w > KEY_W(j + 1)) j++;
-    float wa = KEY_W(j), wb = KEY_W(j + 1);
-    float t = (w - wa) / (wb - wa);
-    *ia = KEY_T(j);
-    *ib = KEY_T(j + 1);
-    *ca = 1.0f - t;
-    *cb = t;
-    if (t_out) *t_out = t;
-#undef KEY_W
-#undef KEY_T
-}
-
-void mk_channel_span(const float *full_weights, uint32_t count, float w,
-                     int32_t *ia, float *ca, int32_t *ib, float *cb, float *t_out)
-{
-    channel_span_strided(full_weights, sizeof(float), count, w, ia, ca, ib, cb, t_out);
-}
-
 /* ---- scratch layout ---- */
 
-typedef struct channel_span {
-    int32_t target_a, target_b;  /* mesh-local targets, -1 = implicit zero key */
-    float t;                     /* position in the span (may be outside [0,1]: extrapolation) */
-    float scale;                 /* sequential suffix product (1 for additive) */
-} channel_span;
-
-static size_t align16(size_t n) { return (n + 15u) & ~(size_t)15u; }
-
-static size_t scratch_bytes(uint32_t targets, uint32_t channels)
-{
-    return align16((size_t)targets * sizeof(float)) + align16((size_t)targets * sizeof(int32_t))
-         + align16((size_t)channels * sizeof(channel_span));
-}
+/* The scratch is the frame's plan. */
+static size_t scratch_bytes(uint32_t targets, uint32_t channels) { return mk_plan_bytes(targets, channels); }
 
 size_t mk_eval_scratch_size(const mk_asset *asset, uint32_t mesh)
 {
@@ -118,16 +58,9 @@ mk_result mk_eval_validate(const mk_eval_job *job, mk_error *err)
     if (job->first_vertex > m->vertex_count
         || (job->vertex_count != MK_VERTICES_TO_END && job->vertex_count > m->vertex_count - job->first_vertex))
         return mk_error_fail(err, MK_ERROR_OUT_OF_RANGE, MK_NO_OFFSET, "eval job: vertex range exceeds the mesh");
-    if (job->weight_count != m->channel_count)
-        return mk_error_fail(err, MK_ERROR_OUT_OF_RANGE, MK_NO_OFFSET, "eval job: weight_count differs from the mesh's channel count");
-    if (m->channel_count && !job->weights)
-        return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: weights is NULL");
-    for (uint32_t c = 0; c < m->channel_count; c++)
-        if (!isfinite(job->weights[c])) return mk_error_fail(err, MK_ERROR_NOT_FINITE, MK_NO_OFFSET, "eval job: a weight is NaN or infinite");
-    if ((unsigned)job->stacking > MK_STACKING_SEQUENTIAL)
-        return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: unknown stacking mode");
-    if ((unsigned)job->normal_mode > MK_NORMALS_SLERP)
-        return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: unknown normal mode");
+    mk_result r = mk_plan_validate_weights(m, job->weights, job->weight_count, job->stacking, job->normal_mode,
+                                           "eval job", err);
+    if (r != MK_OK) return r;
     if ((unsigned)job->store_mode > MK_STORE_STREAMING)
         return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: unknown store mode");
     if (!job->scratch || (uintptr_t)job->scratch % 16)
@@ -159,49 +92,10 @@ typedef struct frame {
     const mk_asset *asset;
     const mk_blob_mesh *mesh;
     const mk_blob_target *targets;  /* mesh's first target */
-    float *coef;                    /* per mesh-local target */
-    int32_t *slerp_channel;         /* per target: mesh-local channel whose normals slerp, or -1 */
-    channel_span *spans;            /* per mesh-local channel */
-    int slerp;
+    const float *coef;              /* per mesh-local target */
+    const int32_t *slerp_channel;   /* per target: mesh-local channel whose normals slerp, or -1 */
+    const mk_plan_span *spans;      /* per mesh-local channel */
 } frame;
-
-static void compute_coefficients(frame *f, const mk_eval_job *job, mk_stacking stacking)
-{
-    const mk_blob_mesh *m = f->mesh;
-    const mk_asset *a = f->asset;
-    for (uint32_t t = 0; t < m->target_count; t++) { f->coef[t] = 0.0f; f->slerp_channel[t] = -1; }
-    float suffix = 1.0f;
-    for (uint32_t c = m->channel_count; c-- > 0;) {
-        const mk_blob_channel *ch = &a->channels[m->first_channel + c];
-        uint32_t first = ch->first_target - m->first_target;
-        float w = job->weights[c];
-        channel_span *s = &f->spans[c];
-        s->target_a = s->target_b = -1;
-        s->t = 0.0f;
-        s->scale = suffix;
-        if (w != 0.0f && suffix != 0.0f) {
-            int32_t ia, ib;
-            float ca, cb;
-            channel_span_strided(&f->targets[first].full_weight, sizeof(mk_blob_target), ch->target_count, w,
-                                 &ia, &ca, &ib, &cb, &s->t);
-            if (ia >= 0) { f->coef[first + (uint32_t)ia] = ca * suffix; s->target_a = (int32_t)first + ia; }
-            if (ib >= 0) { f->coef[first + (uint32_t)ib] = cb * suffix; s->target_b = (int32_t)first + ib; }
-            if (f->slerp) {
-                if (ia >= 0) f->slerp_channel[first + (uint32_t)ia] = (int32_t)c;
-                if (ib >= 0) f->slerp_channel[first + (uint32_t)ib] = (int32_t)c;
-            }
-        }
-        if (stacking == MK_STACKING_SEQUENTIAL) {
-            /* beta = clamp(w / f_first, 0, 1) with f_first the smallest positive full weight. */
-            float f_first = 0.0f;
-            for (uint32_t k = 0; k < ch->target_count; k++)
-                if (f->targets[first + k].full_weight > 0) { f_first = f->targets[first + k].full_weight; break; }
-            float beta = f_first > 0 ? w / f_first : 0.0f;
-            beta = beta < 0 ? 0 : beta > 1 ? 1 : beta;
-            suffix *= 1.0f - beta;
-        }
-    }
-}
 
 /* ---- block accumulation ---- */
 
@@ -310,7 +204,7 @@ static void slerp3(const float *a, const float *b, float t, float *out)
  * slerp(n_a, n_b, t) - n_base, scaled by the sequential factor. base_normals addresses the
  * block's vertex 0. */
 static void add_slerp_normals(float *acc_n, const float *delta_a, const float *delta_b, uint64_t touched,
-                              const channel_span *span, const float *base_normals)
+                              const mk_plan_span *span, const float *base_normals)
 {
     for (; touched; touched &= touched - 1) {
         unsigned i = (unsigned)mk_ctz64(touched);
@@ -510,17 +404,14 @@ static void prepare_frame(const mk_eval_job *job, frame *f)
 {
     const mk_asset *a = job->asset;
     const mk_blob_mesh *m = &a->meshes[job->mesh];
-    mk_stacking stacking = job->stacking == MK_STACKING_ASSET ? (mk_stacking)m->stacking : job->stacking;
-    uint8_t *scratch = job->scratch;
+    const mk_plan plan = mk_plan_at(job->scratch, m->target_count, m->channel_count);
     f->asset = a;
     f->mesh = m;
     f->targets = &a->targets[m->first_target];
-    f->coef = (float *)(void *)scratch;
-    f->slerp_channel = (int32_t *)(void *)(scratch + align16((size_t)m->target_count * sizeof(float)));
-    f->spans = (channel_span *)(void *)(scratch + align16((size_t)m->target_count * sizeof(float))
-                                        + align16((size_t)m->target_count * sizeof(int32_t)));
-    f->slerp = job->normals != NULL && job->normal_mode == MK_NORMALS_SLERP;
-    compute_coefficients(f, job, stacking);
+    f->coef = plan.coef;
+    f->slerp_channel = plan.slerp_channel;
+    f->spans = plan.spans;
+    mk_plan_fill(a, m, job->weights, job->stacking, job->normals != NULL && job->normal_mode == MK_NORMALS_SLERP, &plan);
 }
 
 mk_result mk_eval_run(const mk_eval_job *job, mk_error *err)

@@ -23,6 +23,7 @@
 #include <time.h>
 #include <unistd.h>
 #include "asset.h"
+#include "bench_gpu.h"
 #include "cli.h"
 #include "frame.h"
 #include "naive.h"
@@ -40,7 +41,7 @@ typedef struct bench_args {
     const char *file;
     uint64_t vertices, channels, active, threads, frames, profile;
     double density;
-    int json, quiet;
+    int json, quiet, gpu;
 } bench_args;
 
 static int run_bench(void *p);
@@ -65,6 +66,11 @@ static const cli_option options[] = {
       "Profiling mode: only N rounds of evaluation (for perf or callgrind), no baselines.", NULL, NULL, 1, 1000000, 0,
       0 },
     { "--quiet", NULL, CLI_FLAG, offsetof(bench_args, quiet), "No progress lines.", NULL, NULL, 0, 0, 0, 0 },
+    { "--gpu", NULL, CLI_FLAG, offsetof(bench_args, gpu),
+      "Also time the GPU path (docs/gpu.md): GPU ns per frame from timestamp queries, the CPU time of planning and "
+      "recording a frame, and the ratio to the device's own buffer-copy bandwidth, beside the CPU figures of the "
+      "same run (no surface, naive or normal-quality measurements then).",
+      NULL, NULL, 0, 0, 0, 0 },
 };
 
 const cli_verb cli_verb_bench = {
@@ -107,6 +113,41 @@ static mk_result measure_normals(const pb_asset *l, const float *weights, uint32
     for (int m = 0; m < PB_QUALITY_MODES; m++) out[m] = pb_normal_quality_stats(&q, m);
     pb_normal_quality_free(&q);
     return r;
+}
+
+/* bench --gpu: the GPU path timed (tools/bench_gpu.c) beside the CPU frame of the same run. */
+static int report_gpu(const bench_args *args, const mk_asset *a, const float *weights, uint32_t frames, double bytes,
+                      double cpu_ns, double cpu_ns_positions, double cpu_bound_ns)
+{
+    cli_gpu_bench g;
+    mk_error err;
+    if (cli_bench_gpu(a, weights, frames, &g, &err) != MK_OK) return cli_fail("bench", &err);
+    const double gpu_bound_ns = g.copy_bytes_per_ns > 0 ? bytes / g.copy_bytes_per_ns : 0;
+    if (args->json) {
+        printf("{\"device\": \"");
+        for (const char *c = g.device; *c; c++)
+            if (*c != '"' && *c != '\\' && (unsigned char)*c >= 32) putchar(*c);
+        printf("\", \"gpu_ns_per_frame\": %.0f, \"gpu_ns_per_frame_min\": %.0f, \"gpu_ns_per_frame_positions\": %.0f, "
+               "\"cpu_record_ns_per_frame\": %.0f, \"upload_ms\": %.3f, \"bytes_per_frame\": %.0f, "
+               "\"gpu_copy_gb_per_s\": %.3f, \"gpu_bound_ns\": %.0f, \"gpu_ratio_to_bound\": %.3f, "
+               "\"cpu_ns_per_frame\": %.0f, \"cpu_ns_per_frame_positions\": %.0f, \"cpu_bound_ns\": %.0f, "
+               "\"gpu_speedup_vs_cpu\": %.3f}\n",
+               g.gpu_ns, g.gpu_ns_min, g.gpu_ns_positions, g.record_ns, g.upload_ms, bytes, g.copy_bytes_per_ns,
+               gpu_bound_ns, gpu_bound_ns / g.gpu_ns, cpu_ns, cpu_ns_positions, cpu_bound_ns, cpu_ns / g.gpu_ns);
+        return 0;
+    }
+    printf("device: %s, frames: %u (median of %u passes after one warm-up)\n", g.device, frames, 3u);
+    printf("gpu_ns_per_frame           %12.0f  (positions + normals; best %.0f)\n", g.gpu_ns, g.gpu_ns_min);
+    printf("gpu_ns_per_frame_positions %12.0f\n", g.gpu_ns_positions);
+    printf("cpu_record_ns_per_frame    %12.0f  (plans written, dispatches recorded)\n", g.record_ns);
+    printf("upload_ms                  %12.3f  (the blob, once)\n", g.upload_ms);
+    printf("bytes_per_frame            %12.0f\n", bytes);
+    printf("gpu_bound_ns               %12.0f  (device copy bandwidth %.2f GB/s)\n", gpu_bound_ns, g.copy_bytes_per_ns);
+    printf("gpu_ratio_to_bound         %12.3f\n", gpu_bound_ns / g.gpu_ns);
+    printf("cpu_ns_per_frame           %12.0f  (%u thread%s, same run; positions only %.0f)\n", cpu_ns,
+           (unsigned)args->threads, args->threads == 1 ? "" : "s", cpu_ns_positions);
+    printf("gpu_speedup_vs_cpu         %12.2f\n", cpu_ns / g.gpu_ns);
+    return 0;
 }
 
 static int run_bench(void *p)
@@ -235,6 +276,11 @@ static int run_bench(void *p)
     copy_probe_free(&probe);
     ctx.probe = NULL;
     double bound_ns = bandwidth > 0 ? bytes / bandwidth : 0;
+    int status = 0;
+    if (args->gpu) {
+        status = report_gpu(args, a, weights, frames, bytes, ns, ns_positions, bound_ns);
+        goto done;
+    }
     double diff = 0;
     cli_progress_update(&progress, "naive baseline", -1);
     double naive_ns = bench_naive_frames(&l, weights, frames < 20 ? frames : 20, &diff);
@@ -330,6 +376,7 @@ static int run_bench(void *p)
                    thread_count, 1.0 / thread_count);
         }
     }
+done:
     for (uint32_t t = 0; t < thread_count; t++) free(ctx.scratch[t]);
     free(ctx.scratch);
     free(ctx.positions);
@@ -338,5 +385,5 @@ static int run_bench(void *p)
     free(workers);
     free(weights);
     pb_asset_free(&l);
-    return 0;
+    return status;
 }

@@ -8,12 +8,13 @@
 #include "cli.h"
 #include "conform.h"
 #include "conform_report.h"
+#include "gpu_eval.h"
 #include "json_write.h"
 #include "normal_quality.h"
 
 typedef struct conform_args {
     const char *manifest, *filter, *report;
-    int precision, stacking, stacking_given, normals, normals_given, json, normal_quality;
+    int precision, stacking, stacking_given, normals, normals_given, json, normal_quality, gpu;
     double normal_tolerance, weight_tolerance;
 } conform_args;
 
@@ -23,6 +24,10 @@ static const cli_option options[] = {
     { "--case", "SUBSTRING", CLI_STRING, offsetof(conform_args, filter),
       "Only the cases whose name or source path contains SUBSTRING (an error when none does).", NULL, NULL, 0, 0, 0,
       0 },
+    { "--gpu", NULL, CLI_FLAG, offsetof(conform_args, gpu),
+      "Evaluate on the GPU path (Vulkan compute on the first GPU, else lavapipe; docs/gpu.md) instead of the CPU "
+      "runtime.",
+      NULL, NULL, 0, 0, 0, 0 },
     { "--precision", "P", CLI_CHOICE, offsetof(conform_args, precision),
       "How sources are written before playback: q16 (the allowed error grows by each target's quantization step) "
       "or float.",
@@ -235,6 +240,16 @@ static int run_conform(void *p)
         .normal_tolerance_deg = args->normal_tolerance,
         .weight_tolerance = args->weight_tolerance,
     };
+    cli_gpu *gpu = NULL;
+    pb_evaluator evaluator;
+    if (args->gpu) {
+        if (cli_gpu_open(&gpu, &evaluator, args->json, &err) != MK_OK) {
+            pb_manifest_free(&manifest);
+            cli_report_free(report);
+            return cli_fail("conform", &err);
+        }
+        opt.evaluator = &evaluator;
+    }
     if (report) cli_report_hook(report, &opt);
     int report_status = -1;
     mk_write_options wo = { .precision = args->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16 };
@@ -288,6 +303,7 @@ static int run_conform(void *p)
         }
         pb_asset_free(&asset);
     }
+    if (cli_gpu_close(gpu)) failed++;   /* validation messages (MORPHKIT_VK_VALIDATION=1) fail the run */
     if (args->json) {
         json_end_array(&w);
         if (quality) {

@@ -13,12 +13,13 @@
 #include "frame.h"
 #include "frame_plan.h"
 #include "frame_write.h"
+#include "gpu_eval.h"
 #include "json_write.h"
 
 typedef struct frames_args {
     const char *input, *output, *clip, *times, *weights;
     uint64_t frames;
-    int stacking, stacking_given, normals, space, precision;
+    int stacking, stacking_given, normals, space, precision, gpu;
 } frames_args;
 
 static int run_frames(void *p);
@@ -44,6 +45,10 @@ static const cli_option options[] = {
       offsetof(frames_args, stacking_given) },
     { "--normals", "MODE", CLI_CHOICE, offsetof(frames_args, normals), "How normal changes combine.", "nlerp",
       "nlerp|slerp", 0, 0, 0, 0 },
+    { "--gpu", NULL, CLI_FLAG, offsetof(frames_args, gpu),
+      "Evaluate on the GPU path (Vulkan compute on the first GPU, else lavapipe; docs/gpu.md) instead of the CPU "
+      "runtime.",
+      NULL, NULL, 0, 0, 0, 0 },
     { "--space", "S", CLI_CHOICE, offsetof(frames_args, space), "Coordinates of the frames.", "local", "local|world", 0, 0,
       0, 0 },
     { "--precision", "P", CLI_CHOICE, offsetof(frames_args, precision),
@@ -103,9 +108,15 @@ static int run_frames(void *p)
     }
     const mk_asset *a = &l.asset;
     cli_frame_plan fp;
+    cli_gpu *gpu = NULL;
+    pb_evaluator evaluator;
     int status = cli_frame_plan_make(verb, a, args->input, args->clip, args->times, args->weights,
                                      (uint32_t)args->frames, &fp);
     if (status >= 0) goto done;
+    if (args->gpu && cli_gpu_open(&gpu, &evaluator, 0, &err) != MK_OK) {
+        status = cli_fail(verb->name, &err);
+        goto done;
+    }
     status = CLI_EXIT_FAILURE;
     const cli_frame *plans = fp.frames;
     const uint32_t plan_count = fp.count;
@@ -183,7 +194,7 @@ static int run_frames(void *p)
 
     for (uint32_t i = 0; i < plan_count; i++) {
         pb_frame frame = { .asset = a, .stacking = stacking, .normal_mode = args->normals ? MK_NORMALS_SLERP : MK_NORMALS_NLERP,
-                           .world = args->space };
+                           .world = args->space, .evaluator = gpu ? &evaluator : NULL };
         int played = cli_frame_play(verb, args->input, &fp, i, &frame);
         if (played >= 0) {
             status = played;
@@ -238,6 +249,7 @@ cleanup:
     free(texts);
     free(sizes);
 done:
+    if (cli_gpu_close(gpu) && status == CLI_EXIT_OK) status = CLI_EXIT_FAILURE;
     cli_frame_plan_free(&fp);
     pb_asset_free(&l);
     return status;

@@ -9,12 +9,13 @@
 #include "frame.h"
 #include "frame_plan.h"
 #include "frame_write.h"
+#include "gpu_eval.h"
 #include "weights_arg.h"
 
 typedef struct play_args {
     const char *input, *output, *clip, *weights;
     double time;
-    int time_given, stacking, stacking_given, normals, space, format, format_given;
+    int time_given, stacking, stacking_given, normals, space, format, format_given, gpu;
 } play_args;
 
 static int run_play(void *p);
@@ -41,6 +42,10 @@ static const cli_option options[] = {
     { "--normals", "MODE", CLI_CHOICE, offsetof(play_args, normals),
       "How normal changes combine (docs/semantics.md); surface: recomputed from the evaluated surface.",
       "nlerp", "nlerp|slerp|surface", 0, 0, 0, 0 },
+    { "--gpu", NULL, CLI_FLAG, offsetof(play_args, gpu),
+      "Evaluate on the GPU path (Vulkan compute on the first GPU, else lavapipe; docs/gpu.md) instead of the CPU "
+      "runtime. Surface normals are then computed on the CPU from the GPU's positions.",
+      NULL, NULL, 0, 0, 0, 0 },
     { "--space", "S", CLI_CHOICE, offsetof(play_args, space),
       "Coordinates of the output: world (each mesh's node transform at rest applied) or local (mesh space).", "world",
       "world|local", 0, 0, 0, 0 },
@@ -107,6 +112,8 @@ static int run_play(void *p)
     }
     char *text = NULL, why[1024];
     size_t text_size = 0;
+    cli_gpu *gpu = NULL;
+    pb_evaluator evaluator;
     pb_frame frame = { .asset = a, .clip = clip, .time = args->time, .stacking = stacking, .normal_mode = nmode,
                        .surface_normals = args->normals == 2, .world = !args->space };
     frame.weights = calloc(a->channel_count + 1u, sizeof(float));
@@ -115,6 +122,10 @@ static int run_play(void *p)
     if (args->weights && weights_arg_apply(a, args->weights, frame.weights, why, sizeof why) != 0) {
         status = cli_usage_error(verb, "--weights: %s", why);
         goto done;
+    }
+    if (args->gpu) {
+        if (cli_gpu_open(&gpu, &evaluator, 0, &err) != MK_OK) { status = cli_fail(verb->name, &err); goto done; }
+        frame.evaluator = &evaluator;
     }
     if (pb_frame_evaluate(&frame, &err) != MK_OK) { status = cli_fail(verb->name, &err); goto done; }
     FILE *f = open_memstream(&text, &text_size);
@@ -143,6 +154,7 @@ static int run_play(void *p)
         fprintf(report, "  %-32s %8.4f\n", ch.name, (double)frame.weights[c]);
     }
 done:
+    if (cli_gpu_close(gpu) && !status) status = CLI_EXIT_FAILURE;
     free(text);
     pb_frame_free(&frame);
     free(frame.weights);

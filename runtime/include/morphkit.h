@@ -263,6 +263,30 @@ mk_result mk_eval_run(const mk_eval_job *job, mk_error *err);
  * budgeting memory bandwidth; it uses the job's scratch. */
 uint64_t mk_eval_traffic(const mk_eval_job *job);
 
+/* ---- GPU plan ---- */
+
+/* What a GPU needs from one frame's weights to evaluate one mesh (docs/gpu.md): per target its
+ * displacement coefficient (in-between span factor times the sequential suffix product, 0 when
+ * inactive), per target the channel whose normals slerp (or -1), and per channel its span (two
+ * targets, the position in the span, the sequential factor). The same numbers the CPU
+ * evaluation computes first, in the layout the compute shader reads; the blob itself is
+ * uploaded once and never changes. Its cost grows with the mesh's targets and channels, not its
+ * vertices. Weights are checked as mk_eval_validate checks them (a NaN weight is refused). */
+typedef struct mk_gpu_plan_job {
+    const mk_asset *asset;
+    uint32_t mesh;
+    const float *weights;         /* one per channel of the mesh (mesh-local channel order) */
+    uint32_t weight_count;        /* must equal the mesh's channel count */
+    mk_stacking stacking;         /* MK_STACKING_ASSET (0) uses the blob's per-mesh setting */
+    mk_normal_mode normal_mode;   /* default nlerp */
+    void *plan;                   /* output: mk_gpu_plan_size() bytes, 16-byte aligned (mapped GPU memory is fine) */
+    size_t plan_size;
+} mk_gpu_plan_job;
+
+/* Bytes of a mesh's plan (0 for an invalid mesh): 8 per target and 16 per channel, rounded. */
+size_t mk_gpu_plan_size(const mk_asset *asset, uint32_t mesh);
+mk_result mk_gpu_plan_run(const mk_gpu_plan_job *job, mk_error *err);
+
 /* ---- Surface normals ---- */
 
 /* Normals of the evaluated surface (docs/semantics.md, "Surface normals"): for every vertex

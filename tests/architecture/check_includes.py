@@ -3,7 +3,7 @@
 include from, then checks every C/C++ source of the repository:
   - a quoted #include resolves to a header of the file's own module or of a listed folder;
   - the blob layout (runtime/format.h) is included only by the runtime, the blob writer and
-    reader, and the blob's own tests;
+    reader, the GPU path's bindings (gpu/mesh.c) and the blob's own tests;
   - the runtime includes nothing but C library headers;
   - no two files include each other through a circle, and the modules form no circle;
   - code, build files and docs cite nothing outside the repository (the team's background
@@ -76,8 +76,10 @@ def resolve(src, name):
 
 LIBC = {"assert", "float", "limits", "math", "stdalign", "stdbool", "stddef", "stdint", "string", "stdio", "stdlib",
         "errno", "inttypes", "immintrin", "emmintrin", "smmintrin", "arm_neon", "stdatomic"}
-GENERATED = {"box_blob.h"}   # written by `morphkit embed` in samples/build_time_bake's build
-LAYOUT_OK = ("runtime/", "offline/writer.c", "offline/block_mask.c", "offline/reader.c", "tests/runtime/", "tests/fuzz/")
+GENERATED = {"box_blob.h",          # written by `morphkit embed` in samples/build_time_bake's build
+             "morph_eval.spv.inc"}  # the compute shader's SPIR-V, compiled by glslc (gpu/meson.build)
+LAYOUT_OK = ("runtime/", "offline/writer.c", "offline/block_mask.c", "offline/reader.c", "gpu/mesh.c", "tests/runtime/",
+             "tests/fuzz/")
 graph, bad_rule, bad_layout, bad_runtime, unresolved = {}, [], [], [], []
 for src in sources:
     mod = module_of(src)
@@ -109,7 +111,7 @@ for src in sources:
             bad_rule.append("%s (%s) includes %s (%s), which its row does not list" % (src, mod, target, tmod))
 check("every quoted include resolves to a repository header", unresolved)
 check("each module includes only from the folders its row lists", bad_rule)
-check("only the runtime, the blob writer/reader and the blob's tests see runtime/format.h", bad_layout)
+check("only the runtime, the blob writer/reader, the GPU bindings and the blob's tests see runtime/format.h", bad_layout)
 check("the runtime includes only C library headers", bad_runtime)
 
 # ---- circles: files, then modules ----

@@ -35,6 +35,7 @@ def check(name, cond, detail=""):
     else:
         counts["failed"] += 1
         print("FAIL " + name + ("\n     " + detail.replace("\n", "\n     ")[-1500:] if detail else ""))
+    return bool(cond)
 
 
 def skip(name, why):

@@ -27,7 +27,7 @@ for cc in gcc clang; do
     for opt in "-O2" "-O3" "-O3 -march=native"; do
       for clones in "" "-DMK_NO_TARGET_CLONES"; do
         flags="-std=$std $opt $clones"
-        if ! $cc $flags -I"$src/runtime/include" -I"$src/runtime" "$src"/runtime/open.c "$src"/runtime/eval.c \
+        if ! $cc $flags -I"$src/runtime/include" -I"$src/runtime" "$src"/runtime/open.c "$src"/runtime/eval.c "$src"/runtime/plan.c \
              "$src"/runtime/curve.c "$src"/runtime/checksum.c "$src"/runtime/error.c "$src"/runtime/surface.c "$src/tests/runtime/determinism_driver.c" -lm \
              -o "$dir/d" 2>"$dir/log"; then
           failed=$((failed+1)); echo "FAIL $cc $flags: does not build"; head -5 "$dir/log"; continue
