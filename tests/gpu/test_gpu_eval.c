@@ -15,6 +15,7 @@
 #include <string.h>
 #include "check.h"
 #include "fixtures.h"
+#include "format.h"
 #include "harness.h"
 #include "random_asset.h"
 
@@ -34,7 +35,11 @@ static mkg_harness *device(void)
     return harness_state > 0 ? &harness : NULL;
 }
 
-#define NEED_DEVICE(h) mkg_harness *h = device(); if (!h) SKIP("no Vulkan device: %s", harness_why)
+/* Validation messages before the current case: each case answers for its own. */
+static unsigned messages_before;
+
+#define NEED_DEVICE(h) mkg_harness *h = device(); if (!h) SKIP("no Vulkan device: %s", harness_why); \
+    messages_before = h->validation_messages
 
 /* Largest differences of one mesh's frame, GPU against CPU. */
 typedef struct diff {
@@ -111,7 +116,8 @@ static void check_within(const diff *d, const char *what)
 
 static void check_no_validation_messages(const mkg_harness *h)
 {
-    CHECK_MSG(h->validation_messages == 0, "the Vulkan validation layer reported %u messages", h->validation_messages);
+    CHECK_MSG(h->validation_messages == messages_before, "the Vulkan validation layer reported %u messages",
+              h->validation_messages - messages_before);
 }
 
 /* A raw asset written as a blob, opened and uploaded. */
@@ -399,14 +405,69 @@ static void test_refusals(void)
     check_no_validation_messages(h);
 }
 
+/* Hostile blobs: bytes of the rich fixture's int16 blob changed at random (checksum rewritten so
+ * the structural checks are reached); every one mk_asset_open accepts is evaluated on every mesh.
+ * Under GPU-assisted validation (the gpu_bounds test sets VK_LAYER_ENABLES) a read or write
+ * outside a binding is a validation message, which fails the case. */
+static void test_hostile_blobs(void)
+{
+    NEED_DEVICE(h);
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_rich(&raw);
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    size_t size;
+    const uint8_t *blob = fixture_blob(&raw, MK_PRECISION_Q16, &arena, &size);
+    uint8_t *copy = aligned_alloc(16, size);
+    const char *env = getenv("MK_GPU_HOSTILE");
+    const int tries = env ? atoi(env) : 400;
+    rng r = { 0x4057113u };
+    int accepted = 0;
+    float p[3 * 160], n[3 * 160], t[4 * 160], w[8] = { 0.7f, -0.3f, 1.4f, 0.5f, 2.0f, 0.9f, 0, 0 };
+    for (int k = 0; copy && k < tries; k++) {
+        memcpy(copy, blob, size);
+        for (uint32_t c = 1 + below(&r, 4); c-- > 0;) {
+            const size_t at = 64 + below(&r, (uint32_t)(size - 64));
+            copy[at] = below(&r, 3) ? (uint8_t)next_u64(&r) : (uint8_t)(copy[at] ^ (1u << below(&r, 8)));
+        }
+        const uint64_t sum = mk_checksum(copy + 32, size - 32);
+        memcpy(copy + 24, &sum, sizeof sum);
+        mk_asset a;
+        mk_error err;
+        if (mk_asset_open(copy, size, &a, &err) != MK_OK) continue;
+        accepted++;
+        mkg_asset *ga = NULL;
+        if (mkg_asset_upload(h->ctx, &a, h->queue, h->family, &ga, &err) != MK_OK) {
+            CHECK_MSG(0, "upload of an accepted blob failed: %s", err.message);
+            continue;
+        }
+        for (uint32_t m = 0; m < a.mesh_count; m++) {
+            mk_mesh_info mi;
+            mk_mesh_get(&a, m, &mi);
+            if (mi.vertex_count > 160 || mi.channel_count > 8) continue;   /* a changed count: nothing to read back into */
+            mk_result res = mkg_harness_eval(h, ga, m, w, mi.channel_count, MK_STACKING_ASSET, (mk_normal_mode)(k & 1), p,
+                                             mi.has_normals ? n : NULL, mi.has_tangents ? t : NULL, &err);
+            CHECK_MSG(res == MK_OK, "blob %d mesh %u: %s", k, m, err.message);
+        }
+        mkg_asset_destroy(ga);
+    }
+    fprintf(stderr, "hostile blobs: %d of %d changed blobs opened and were evaluated\n", accepted, tries);
+    CHECK(accepted > tries / 10);   /* most changes land in delta data, which any value may hold */
+    free(copy);
+    mk_arena_free_all(&arena);
+    mk_raw_free(&raw);
+    check_no_validation_messages(h);
+}
+
 static void test_close(void)
 {
     NEED_DEVICE(h);
     mkg_harness_close(h);
     harness_state = 0;
     CHECK_MSG(h->validation || !getenv("MK_GPU_REQUIRE_VALIDATION"), "the validation layer is required but missing");
-    check_no_validation_messages(h);
+    CHECK_MSG(h->validation_messages == 0, "the Vulkan validation layer reported %u messages in all", h->validation_messages);
 }
 
 CHECK_MAIN(CASE(test_random_assets), CASE(test_rich_clips), CASE(test_offset_and_float_entries),
-           CASE(test_interleaved_outputs), CASE(test_refusals), CASE(test_close))
+           CASE(test_interleaved_outputs), CASE(test_refusals), CASE(test_hostile_blobs), CASE(test_close))
