@@ -88,7 +88,9 @@ mk_result mkg_asset_upload(mkg_context *ctx, const mk_asset *asset, VkQueue queu
     mkg_buffer_destroy(ctx, staging, staging_memory);
     if (r != VK_SUCCESS) {
         mkg_asset_destroy(a);
-        return mkg_fail(err, r == VK_ERROR_OUT_OF_DEVICE_MEMORY ? MK_ERROR_OUT_OF_MEMORY : MK_ERROR_UNSUPPORTED,
+        return mkg_fail(err,
+                        r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY ? MK_ERROR_OUT_OF_MEMORY
+                                                                                              : MK_ERROR_UNSUPPORTED,
                         "mkg_asset_upload: %s (%llu bytes) failed: %s", step, (unsigned long long)size,
                         mkg_vk_result_name(r));
     }

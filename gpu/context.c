@@ -44,6 +44,8 @@ const char *mkg_vk_result_name(VkResult r)
     }
 }
 
+VkDeviceSize mkg_offset_alignment(const mkg_context *ctx) { return ctx->offset_alignment; }
+
 static int memory_type(const mkg_context *ctx, uint32_t type_bits, VkMemoryPropertyFlags properties)
 {
     for (uint32_t i = 0; i < ctx->memory.memoryTypeCount; i++)
@@ -66,10 +68,10 @@ VkResult mkg_buffer_create(const mkg_context *ctx, VkDeviceSize size, VkBufferUs
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(dev, *buffer, &req);
     int type = memory_type(ctx, req.memoryTypeBits, properties);
-    if (type < 0) {
+    if (type < 0) {   /* no memory type with these properties for this buffer */
         mkg_buffer_destroy(ctx, *buffer, VK_NULL_HANDLE);
         *buffer = VK_NULL_HANDLE;
-        return VK_ERROR_OUT_OF_DEVICE_MEMORY;
+        return VK_ERROR_FEATURE_NOT_PRESENT;
     }
     VkMemoryAllocateInfo ai = { .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, .allocationSize = req.size,
                                 .memoryTypeIndex = (uint32_t)type };
@@ -106,6 +108,16 @@ mk_result mkg_context_create(const mkg_device *device, mkg_context **out, mk_err
         free(ctx);
         return MK_ERROR_UNSUPPORTED;
     }
+    if (ctx->props.limits.maxPerStageDescriptorStorageBuffers < MKG_BINDINGS) {
+        mkg_fail(err, MK_ERROR_UNSUPPORTED, "the GPU path binds %u storage buffers; %s allows %u per stage", MKG_BINDINGS,
+                 ctx->props.deviceName, ctx->props.limits.maxPerStageDescriptorStorageBuffers);
+        free(ctx);
+        return MK_ERROR_UNSUPPORTED;
+    }
+    ctx->offset_alignment = ctx->props.limits.minStorageBufferOffsetAlignment;
+    const char *forced = getenv("MORPHKIT_GPU_OFFSET_ALIGNMENT");
+    const unsigned long want = forced ? strtoul(forced, NULL, 10) : 0;
+    if (want > ctx->offset_alignment && want <= 65536 && (want & (want - 1)) == 0) ctx->offset_alignment = want;
     VkDevice dev = device->device;
     const VkAllocationCallbacks *ac = device->allocator;
     VkDescriptorSetLayoutBinding bindings[MKG_BINDINGS];
@@ -153,6 +165,16 @@ void mkg_context_destroy(mkg_context *ctx)
     if (ctx->pipeline_layout) vkDestroyPipelineLayout(dev, ctx->pipeline_layout, ac);
     if (ctx->set_layout) vkDestroyDescriptorSetLayout(dev, ctx->set_layout, ac);
     free(ctx);
+}
+
+void mkg_cmd_output_acquire(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAccessFlags src_access)
+{
+    /* The earlier uses (reads or writes at src_stage) and the last evaluation's writes happen before
+     * this evaluation writes. */
+    VkMemoryBarrier b = { .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER, .srcAccessMask = src_access | VK_ACCESS_SHADER_WRITE_BIT,
+                          .dstAccessMask = VK_ACCESS_SHADER_WRITE_BIT };
+    vkCmdPipelineBarrier(cmd, src_stage | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
+                         &b, 0, NULL, 0, NULL);
 }
 
 void mkg_cmd_output_barrier(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access)

@@ -62,6 +62,7 @@ static int pick_device(mkg_harness *h)
                 h->family = f;
                 h->props = p;
                 h->timestamps = q[f].timestampValidBits != 0;
+                h->timestamp_bits = q[f].timestampValidBits;
                 break;
             }
     }
@@ -107,7 +108,7 @@ mk_result mkg_harness_open(mkg_harness *h, unsigned flags, mk_error *err)
     }
     VkPhysicalDeviceFeatures have, on = { 0 };
     vkGetPhysicalDeviceFeatures(h->physical, &have);
-    h->robust = want && have.robustBufferAccess;
+    h->robust = (flags & MKG_HARNESS_ROBUST) && have.robustBufferAccess;
     on.robustBufferAccess = h->robust ? VK_TRUE : VK_FALSE;
     const float priority = 1.0f;
     VkDeviceQueueCreateInfo qi = { .sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO, .queueFamilyIndex = h->family,

@@ -23,12 +23,15 @@ typedef struct mkg_harness {
     int validation;                     /* the validation layer is on */
     int robust;                         /* robustBufferAccess is on */
     int timestamps;                     /* the queue has timestamps */
+    uint32_t timestamp_bits;            /* their valid bits */
     unsigned validation_messages;       /* warnings and errors the layer reported */
 } mkg_harness;
 
 enum {
-    MKG_HARNESS_VALIDATION = 1,         /* the validation layer and robust buffer access, when present */
-    MKG_HARNESS_REQUIRE_VALIDATION = 2  /* fail when the validation layer is missing */
+    MKG_HARNESS_VALIDATION = 1,         /* the validation layer, when present */
+    MKG_HARNESS_REQUIRE_VALIDATION = 2, /* fail when the validation layer is missing */
+    MKG_HARNESS_ROBUST = 4              /* robust buffer access, when the device has it (it hides
+                                         * out-of-bounds writes from the tests: they are dropped) */
 };
 
 /* Opens the device; MK_ERROR_UNSUPPORTED when Vulkan has no device with a compute queue. */

@@ -8,6 +8,7 @@
 struct mkg_context {
     mkg_device dev;
     VkPhysicalDeviceProperties props;
+    VkDeviceSize offset_alignment;   /* of storage-buffer bindings (mkg_offset_alignment) */
     VkPhysicalDeviceMemoryProperties memory;
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout pipeline_layout;
@@ -52,6 +53,10 @@ mk_result mkg_fail(mk_error *err, mk_result code, const char *format, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+/* The offset alignment bindings are cut to: the device's minStorageBufferOffsetAlignment, or
+ * MORPHKIT_GPU_OFFSET_ALIGNMENT when that is a larger power of two (the tests bind as a device
+ * with 256-byte alignment would, where lavapipe asks for 16). */
+VkDeviceSize mkg_offset_alignment(const mkg_context *ctx);
 /* The failing Vulkan call's result as text. */
 const char *mkg_vk_result_name(VkResult r);
 

@@ -33,8 +33,10 @@ static mk_result data_window(const mkg_mesh *gm, const mk_blob_mesh *m, window *
     cover(&lo, &hi, m->block_entries, 4 * ((uint64_t)m->block_count + 1));
     cover(&lo, &hi, m->entries, 16 * m->entry_count);
     cover(&lo, &hi, m->target_data, m->target_data_size);
-    w->offset = align_down(lo, lim->minStorageBufferOffsetAlignment);
-    w->range = hi - w->offset;
+    /* The shader reads whole 32-bit words: an int16 entry may end 2 bytes into its last word (the
+     * blob's sizes need not be multiples of 4; the uploaded buffer is padded to whole words). */
+    w->offset = align_down(lo, mkg_offset_alignment(gm->asset->ctx));
+    w->range = align_up(hi, 4) - w->offset;
     if (w->range > lim->maxStorageBufferRange)
         return mkg_fail(err, MK_ERROR_UNSUPPORTED,
                         "mesh %u: its blob data spans %llu bytes, more than one storage buffer binding of this device "
@@ -56,9 +58,13 @@ static mk_result targets_window(const mkg_mesh *gm, const mk_blob_mesh *m, windo
     const mk_asset *a = gm->asset->asset;
     const VkPhysicalDeviceLimits *lim = &gm->asset->ctx->props.limits;
     const uint64_t first = (uint64_t)((const uint8_t *)&a->targets[m->first_target] - a->data);
-    const uint64_t size = m->target_count ? 32u * (uint64_t)m->target_count : 16u;   /* never an empty range */
-    w->offset = align_down(first, lim->minStorageBufferOffsetAlignment);
-    w->range = first + size - w->offset;
+    if (!m->target_count) {   /* nothing is read: bind the header, never an empty or outside range */
+        *w = (window){ 0, 16 };
+        p->first_target = 0;
+        return MK_OK;
+    }
+    w->offset = align_down(first, mkg_offset_alignment(gm->asset->ctx));
+    w->range = first + 32u * (uint64_t)m->target_count - w->offset;
     if (w->range > lim->maxStorageBufferRange)
         return mkg_fail(err, MK_ERROR_UNSUPPORTED, "mesh %u: its %u target records exceed maxStorageBufferRange (%u bytes)",
                         gm->mesh, m->target_count, lim->maxStorageBufferRange);
@@ -72,18 +78,19 @@ static mk_result output_window(const mkg_mesh *gm, const mkg_output *o, const ch
 {
     const VkPhysicalDeviceLimits *lim = &gm->asset->ctx->props.limits;
     const VkDeviceSize stride = o->stride ? o->stride : elem;
-    if (o->offset % 4 || stride % 4 || stride < elem)
+    if (o->offset % 4 || stride % 4 || stride < elem || stride > lim->maxStorageBufferRange)
         return mkg_fail(err, MK_ERROR_INVALID_ARGUMENT,
                         "mesh %u: the %s output's offset (%llu) and stride (%llu) must be multiples of 4, the stride at "
-                        "least %llu",
-                        gm->mesh, name, (unsigned long long)o->offset, (unsigned long long)stride, (unsigned long long)elem);
+                        "least %llu and at most maxStorageBufferRange (%u)",
+                        gm->mesh, name, (unsigned long long)o->offset, (unsigned long long)stride, (unsigned long long)elem,
+                        lim->maxStorageBufferRange);
     const VkDeviceSize need = stride * (vertex_count - 1u) + elem;
     if (o->size < need)
         return mkg_fail(err, MK_ERROR_BUFFER_TOO_SMALL,
                         "mesh %u: the %s output needs %llu bytes for %u vertices at stride %llu; %llu given", gm->mesh,
                         name, (unsigned long long)need, vertex_count, (unsigned long long)stride,
                         (unsigned long long)o->size);
-    w->offset = align_down(o->offset, lim->minStorageBufferOffsetAlignment);
+    w->offset = align_down(o->offset, mkg_offset_alignment(gm->asset->ctx));
     w->range = o->offset - w->offset + need;
     if (w->range > lim->maxStorageBufferRange)
         return mkg_fail(err, MK_ERROR_UNSUPPORTED, "mesh %u: the %s output spans %llu bytes, more than maxStorageBufferRange (%u)",
@@ -161,7 +168,7 @@ mk_result mkg_mesh_create(mkg_asset *asset, const mkg_mesh_desc *d, mkg_mesh **o
     gm->asset = asset;
     gm->mesh = d->mesh;
     gm->plan_size = mk_gpu_plan_size(a, d->mesh);
-    gm->plan_stride = align_up(gm->plan_size ? gm->plan_size : 16, lim->minStorageBufferOffsetAlignment);
+    gm->plan_stride = align_up(gm->plan_size ? gm->plan_size : 16, mkg_offset_alignment(ctx));
     mkg_params *p = &gm->params;
     p->vertex_count = m->vertex_count;
     p->target_count = m->target_count;

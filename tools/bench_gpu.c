@@ -37,6 +37,13 @@ typedef struct bench_state {
     VkQueryPool queries;
 } bench_state;
 
+/* Ticks between two timestamps, within the queue's valid bits (the counter wraps there). */
+static uint64_t tick_span(const mkg_harness *h, const uint64_t ticks[2])
+{
+    const uint64_t mask = h->timestamp_bits >= 64 ? ~(uint64_t)0 : (((uint64_t)1 << h->timestamp_bits) - 1);
+    return (ticks[1] - ticks[0]) & mask;
+}
+
 /* Records and runs one frame between two timestamps; returns the GPU ns, adds the CPU ns of the
  * plans and recording to *record_ns. */
 static mk_result time_frame(bench_state *s, const float *weights, int normals, double *gpu_ns, double *record_ns,
@@ -62,7 +69,7 @@ static mk_result time_frame(bench_state *s, const float *weights, int normals, d
     VkResult vr = vkGetQueryPoolResults(s->h.device, s->queries, 0, 2, sizeof ticks, ticks, sizeof ticks[0],
                                         VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
     if (vr != VK_SUCCESS) return mk_error_set(err, MK_ERROR_UNSUPPORTED, UINT64_MAX, "reading timestamps failed");
-    *gpu_ns = (double)(ticks[1] - ticks[0]) * s->h.props.limits.timestampPeriod;
+    *gpu_ns = (double)tick_span(&s->h, ticks) * s->h.props.limits.timestampPeriod;
     return MK_OK;
 }
 
@@ -87,7 +94,7 @@ static mk_result copy_bandwidth(bench_state *s, VkDeviceSize size, double *bytes
         uint64_t ticks[2];
         if (r == MK_OK && vkGetQueryPoolResults(s->h.device, s->queries, 0, 2, sizeof ticks, ticks, sizeof ticks[0],
                                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT) == VK_SUCCESS) {
-            double ns = (double)(ticks[1] - ticks[0]) * s->h.props.limits.timestampPeriod;
+            double ns = (double)tick_span(&s->h, ticks) * s->h.props.limits.timestampPeriod;
             if (ns > 0 && 2.0 * (double)size / ns > best) best = 2.0 * (double)size / ns;
         }
     }

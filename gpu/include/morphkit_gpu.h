@@ -12,10 +12,22 @@
  *   mkg_asset *ga;      mkg_asset_upload(ctx, &asset, queue, family, &ga, &err);
  *   mkg_mesh *gm;       mkg_mesh_create(ga, &(mkg_mesh_desc){ .mesh = 0, .frames_in_flight = 2,
  *                           .positions = { vbuf, 0, 32, size } }, &gm, &err);
- *   per frame:          mkg_mesh_record(gm, cmd, &(mkg_frame){ .weights = w, .weight_count = n,
+ *   per frame:          mkg_cmd_output_acquire(cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT,
+ *                           VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);   (last frame's draws are done with vbuf)
+ *                       mkg_mesh_record(gm, cmd, &(mkg_frame){ .weights = w, .weight_count = n,
  *                           .slot = frame % 2 }, &err);
  *                       mkg_cmd_output_barrier(cmd, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT,
- *                           VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);
+ *                           VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT);   (this frame's draws see the results)
+ *
+ * Requirements: the instance was created with apiVersion 1.1 or later (the shader is SPIR-V 1.3)
+ * and the device allows 6 storage buffers per stage. The blob is uploaded on, and frames are
+ * recorded for, queues of one family (the buffer is not shared between families).
+ *
+ * State: mkg_mesh_record binds its compute pipeline, descriptor set 0 and push constants on the
+ * command buffer; rebind your own compute state after it.
+ *
+ * Lifetime: destroy meshes, then assets, then the context, each once the GPU has finished every
+ * command buffer that uses it (the library does not wait).
  *
  * Thread safety: objects are not locked; record one mkg_mesh from one thread at a time. */
 #ifndef MORPHKIT_GPU_H
@@ -89,6 +101,11 @@ typedef struct mkg_frame {
  * secondary command buffer in the recording state, on a queue with compute). Nothing reaches
  * the command buffer when the frame is refused (bad weights, slot out of range). */
 mk_result mkg_mesh_record(mkg_mesh *mesh, VkCommandBuffer cmd, const mkg_frame *frame, mk_error *err);
+
+/* A barrier from earlier uses of the outputs (e.g. the previous frame's draws reading them at the
+ * vertex input stage) and from the previous evaluation's writes, to this frame's evaluation:
+ * record it before mkg_mesh_record when the outputs are reused across frames. */
+void mkg_cmd_output_acquire(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAccessFlags src_access);
 
 /* A barrier from the evaluation's writes to a later use of the outputs (e.g. the vertex input
  * stage reading vertex attributes, or VK_PIPELINE_STAGE_TRANSFER_BIT for a copy). */
