@@ -3,7 +3,7 @@
 include from, then checks every C/C++ source of the repository:
   - a quoted #include resolves to a header of the file's own module or of a listed folder;
   - the blob layout (runtime/format.h) is included only by the runtime, the blob writer and
-    reader, the GPU path's bindings (gpu/mesh.c) and the blob's own tests;
+    reader, the GPU path's bindings (gpu/mesh.c) and the blob's own tests (runtime, fuzz, gpu);
   - the runtime includes nothing but C library headers;
   - no two files include each other through a circle, and the modules form no circle;
   - code, build files and docs cite nothing outside the repository (the team's background
@@ -79,7 +79,7 @@ LIBC = {"assert", "float", "limits", "math", "stdalign", "stdbool", "stddef", "s
 GENERATED = {"box_blob.h",          # written by `morphkit embed` in samples/build_time_bake's build
              "morph_eval.spv.inc"}  # the compute shader's SPIR-V, compiled by glslc (gpu/meson.build)
 LAYOUT_OK = ("runtime/", "offline/writer.c", "offline/block_mask.c", "offline/reader.c", "gpu/mesh.c", "tests/runtime/",
-             "tests/fuzz/")
+             "tests/fuzz/", "tests/gpu/")
 graph, bad_rule, bad_layout, bad_runtime, unresolved = {}, [], [], [], []
 for src in sources:
     mod = module_of(src)
