@@ -65,23 +65,18 @@ mk_result mkg_asset_upload(mkg_context *ctx, const mk_asset *asset, VkQueue queu
     VkBuffer staging = VK_NULL_HANDLE;
     VkDeviceMemory staging_memory = VK_NULL_HANDLE;
     VkResult r = mkg_buffer_create(ctx, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                   VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, &a->buffer, &a->memory);
+                                   VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, &a->buffer, &a->memory, NULL);
     const char *step = "creating the blob's buffer";
+    void *mapped = NULL;
     if (r == VK_SUCCESS) {
         step = "creating the staging buffer";
         r = mkg_buffer_create(ctx, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                               VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, &staging,
-                              &staging_memory);
-    }
-    void *mapped = NULL;
-    if (r == VK_SUCCESS) {
-        step = "mapping the staging buffer";
-        r = vkMapMemory(ctx->dev.device, staging_memory, 0, size, 0, &mapped);
+                              &staging_memory, &mapped);
     }
     if (r == VK_SUCCESS) {
         memcpy(mapped, asset->data, asset->size);
         memset((uint8_t *)mapped + asset->size, 0, (size_t)(size - asset->size));
-        vkUnmapMemory(ctx->dev.device, staging_memory);
         step = "copying the blob to the GPU";
         r = copy_and_wait(ctx, queue, queue_family, staging, a->buffer, size);
     }

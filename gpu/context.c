@@ -10,6 +10,8 @@ static const uint32_t morph_eval_spv[] =
 #include "morph_eval.spv.inc"
 ;
 
+/* offline's mk_error_set does the same, but this library is for engines and links only the
+ * runtime and libvulkan, not the offline core. */
 mk_result mkg_fail(mk_error *err, mk_result code, const char *format, ...)
 {
     if (!err) return code;
@@ -44,8 +46,6 @@ const char *mkg_vk_result_name(VkResult r)
     }
 }
 
-VkDeviceSize mkg_offset_alignment(const mkg_context *ctx) { return ctx->offset_alignment; }
-
 static int memory_type(const mkg_context *ctx, uint32_t type_bits, VkMemoryPropertyFlags properties)
 {
     for (uint32_t i = 0; i < ctx->memory.memoryTypeCount; i++)
@@ -55,7 +55,7 @@ static int memory_type(const mkg_context *ctx, uint32_t type_bits, VkMemoryPrope
 }
 
 VkResult mkg_buffer_create(const mkg_context *ctx, VkDeviceSize size, VkBufferUsageFlags usage,
-                           VkMemoryPropertyFlags properties, VkBuffer *buffer, VkDeviceMemory *memory)
+                           VkMemoryPropertyFlags properties, VkBuffer *buffer, VkDeviceMemory *memory, void **mapped)
 {
     VkDevice dev = ctx->dev.device;
     const VkAllocationCallbacks *ac = ctx->dev.allocator;
@@ -77,6 +77,7 @@ VkResult mkg_buffer_create(const mkg_context *ctx, VkDeviceSize size, VkBufferUs
                                 .memoryTypeIndex = (uint32_t)type };
     r = vkAllocateMemory(dev, &ai, ac, memory);
     if (r == VK_SUCCESS) r = vkBindBufferMemory(dev, *buffer, *memory, 0);
+    if (r == VK_SUCCESS && mapped) r = vkMapMemory(dev, *memory, 0, VK_WHOLE_SIZE, 0, mapped);
     if (r != VK_SUCCESS) {
         mkg_buffer_destroy(ctx, *buffer, *memory);
         *buffer = VK_NULL_HANDLE;
@@ -115,9 +116,9 @@ mk_result mkg_context_create(const mkg_device *device, mkg_context **out, mk_err
         return MK_ERROR_UNSUPPORTED;
     }
     ctx->offset_alignment = ctx->props.limits.minStorageBufferOffsetAlignment;
-    const char *forced = getenv("MORPHKIT_GPU_OFFSET_ALIGNMENT");
-    const unsigned long want = forced ? strtoul(forced, NULL, 10) : 0;
-    if (want > ctx->offset_alignment && want <= 65536 && (want & (want - 1)) == 0) ctx->offset_alignment = want;
+    const VkDeviceSize coarser = device->offset_alignment;
+    if (coarser > ctx->offset_alignment && coarser <= 65536 && (coarser & (coarser - 1)) == 0)
+        ctx->offset_alignment = coarser;
     VkDevice dev = device->device;
     const VkAllocationCallbacks *ac = device->allocator;
     VkDescriptorSetLayoutBinding bindings[MKG_BINDINGS];

@@ -24,7 +24,9 @@ typedef struct mkg_harness {
     int robust;                         /* robustBufferAccess is on */
     int timestamps;                     /* the queue has timestamps */
     uint32_t timestamp_bits;            /* their valid bits */
-    unsigned validation_messages;       /* warnings and errors the layer reported */
+    unsigned validation_messages;       /* warnings and errors the layer reported; still set after
+                                         * mkg_harness_close, which counts those at destruction
+                                         * (objects left alive) too */
 } mkg_harness;
 
 enum {

@@ -8,7 +8,7 @@
 struct mkg_context {
     mkg_device dev;
     VkPhysicalDeviceProperties props;
-    VkDeviceSize offset_alignment;   /* of storage-buffer bindings (mkg_offset_alignment) */
+    VkDeviceSize offset_alignment;   /* of storage-buffer bindings: the device's minimum or mkg_device's */
     VkPhysicalDeviceMemoryProperties memory;
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout pipeline_layout;
@@ -44,7 +44,7 @@ struct mkg_mesh {
     VkDescriptorPool pool;
     VkDescriptorSet *sets;          /* one per slot */
     mkg_params params;
-    uint32_t groups_x, groups_y;
+    uint32_t groups_y;              /* rows of params.groups_x workgroups */
 };
 
 /* Fills err (optional) with code and a printf-style message; returns code. */
@@ -53,16 +53,14 @@ mk_result mkg_fail(mk_error *err, mk_result code, const char *format, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
-/* The offset alignment bindings are cut to: the device's minStorageBufferOffsetAlignment, or
- * MORPHKIT_GPU_OFFSET_ALIGNMENT when that is a larger power of two (the tests bind as a device
- * with 256-byte alignment would, where lavapipe asks for 16). */
-VkDeviceSize mkg_offset_alignment(const mkg_context *ctx);
 /* The failing Vulkan call's result as text. */
 const char *mkg_vk_result_name(VkResult r);
 
-/* A buffer with memory of the given properties bound to it; VK_SUCCESS or the failing call's. */
+/* A buffer with memory of the given properties bound to it, and mapped whole into *mapped when
+ * mapped is not NULL (host-visible properties); VK_SUCCESS or the failing call's result.
+ * mkg_buffer_destroy frees the memory, which unmaps it. */
 VkResult mkg_buffer_create(const mkg_context *ctx, VkDeviceSize size, VkBufferUsageFlags usage,
-                           VkMemoryPropertyFlags properties, VkBuffer *buffer, VkDeviceMemory *memory);
+                           VkMemoryPropertyFlags properties, VkBuffer *buffer, VkDeviceMemory *memory, void **mapped);
 void mkg_buffer_destroy(const mkg_context *ctx, VkBuffer buffer, VkDeviceMemory memory);
 
 #endif

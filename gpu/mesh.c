@@ -35,7 +35,7 @@ static mk_result data_window(const mkg_mesh *gm, const mk_blob_mesh *m, window *
     cover(&lo, &hi, m->target_data, m->target_data_size);
     /* The shader reads whole 32-bit words: an int16 entry may end 2 bytes into its last word (the
      * blob's sizes need not be multiples of 4; the uploaded buffer is padded to whole words). */
-    w->offset = align_down(lo, mkg_offset_alignment(gm->asset->ctx));
+    w->offset = align_down(lo, gm->asset->ctx->offset_alignment);
     w->range = align_up(hi, 4) - w->offset;
     if (w->range > lim->maxStorageBufferRange)
         return mkg_fail(err, MK_ERROR_UNSUPPORTED,
@@ -63,7 +63,7 @@ static mk_result targets_window(const mkg_mesh *gm, const mk_blob_mesh *m, windo
         p->first_target = 0;
         return MK_OK;
     }
-    w->offset = align_down(first, mkg_offset_alignment(gm->asset->ctx));
+    w->offset = align_down(first, gm->asset->ctx->offset_alignment);
     w->range = first + 32u * (uint64_t)m->target_count - w->offset;
     if (w->range > lim->maxStorageBufferRange)
         return mkg_fail(err, MK_ERROR_UNSUPPORTED, "mesh %u: its %u target records exceed maxStorageBufferRange (%u bytes)",
@@ -90,7 +90,7 @@ static mk_result output_window(const mkg_mesh *gm, const mkg_output *o, const ch
                         "mesh %u: the %s output needs %llu bytes for %u vertices at stride %llu; %llu given", gm->mesh,
                         name, (unsigned long long)need, vertex_count, (unsigned long long)stride,
                         (unsigned long long)o->size);
-    w->offset = align_down(o->offset, mkg_offset_alignment(gm->asset->ctx));
+    w->offset = align_down(o->offset, gm->asset->ctx->offset_alignment);
     w->range = o->offset - w->offset + need;
     if (w->range > lim->maxStorageBufferRange)
         return mkg_fail(err, MK_ERROR_UNSUPPORTED, "mesh %u: the %s output spans %llu bytes, more than maxStorageBufferRange (%u)",
@@ -168,7 +168,7 @@ mk_result mkg_mesh_create(mkg_asset *asset, const mkg_mesh_desc *d, mkg_mesh **o
     gm->asset = asset;
     gm->mesh = d->mesh;
     gm->plan_size = mk_gpu_plan_size(a, d->mesh);
-    gm->plan_stride = align_up(gm->plan_size ? gm->plan_size : 16, mkg_offset_alignment(ctx));
+    gm->plan_stride = align_up(gm->plan_size ? gm->plan_size : 16, ctx->offset_alignment);
     mkg_params *p = &gm->params;
     p->vertex_count = m->vertex_count;
     p->target_count = m->target_count;
@@ -191,18 +191,16 @@ mk_result mkg_mesh_create(mkg_asset *asset, const mkg_mesh_desc *d, mkg_mesh **o
     }
     /* One workgroup per block, in rows of at most the device's x limit. */
     const uint32_t max_x = lim->maxComputeWorkGroupCount[0];
-    gm->groups_x = m->block_count < max_x ? m->block_count : max_x;
-    gm->groups_y = (m->block_count + gm->groups_x - 1) / gm->groups_x;
-    p->groups_x = gm->groups_x;
+    p->groups_x = m->block_count < max_x ? m->block_count : max_x;
+    gm->groups_y = (m->block_count + p->groups_x - 1) / p->groups_x;
     if (res == MK_OK && gm->groups_y > lim->maxComputeWorkGroupCount[1])
         res = mkg_fail(err, MK_ERROR_UNSUPPORTED, "mesh %u: %u blocks need more workgroups than this device dispatches",
                        d->mesh, m->block_count);
     if (res == MK_OK) {
+        void *mapped = NULL;
         VkResult r = mkg_buffer_create(ctx, gm->plan_stride * gm->slots, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-                                       &gm->plan_buffer, &gm->plan_memory);
-        void *mapped = NULL;
-        if (r == VK_SUCCESS) r = vkMapMemory(ctx->dev.device, gm->plan_memory, 0, VK_WHOLE_SIZE, 0, &mapped);
+                                       &gm->plan_buffer, &gm->plan_memory, &mapped);
         gm->plan_mapped = mapped;
         if (r != VK_SUCCESS)
             res = mkg_fail(err, MK_ERROR_OUT_OF_MEMORY, "mesh %u: creating the plan buffer failed (%s)", d->mesh,
@@ -223,7 +221,6 @@ void mkg_mesh_destroy(mkg_mesh *gm)
     if (!gm) return;
     const mkg_context *ctx = gm->asset->ctx;
     if (gm->pool) vkDestroyDescriptorPool(ctx->dev.device, gm->pool, ctx->dev.allocator);   /* frees the sets */
-    if (gm->plan_mapped) vkUnmapMemory(ctx->dev.device, gm->plan_memory);
     mkg_buffer_destroy(ctx, gm->plan_buffer, gm->plan_memory);
     free(gm->sets);
     free(gm);
@@ -246,8 +243,6 @@ mk_result mkg_mesh_record(mkg_mesh *gm, VkCommandBuffer cmd, const mkg_frame *f,
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx->pipeline);
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx->pipeline_layout, 0, 1, &gm->sets[f->slot], 0, NULL);
     vkCmdPushConstants(cmd, ctx->pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof gm->params, &gm->params);
-    vkCmdDispatch(cmd, gm->groups_x, gm->groups_y, 1);
+    vkCmdDispatch(cmd, gm->params.groups_x, gm->groups_y, 1);
     return MK_OK;
 }
-
-uint32_t mkg_mesh_workgroups(const mkg_mesh *gm) { return gm ? gm->asset->asset->meshes[gm->mesh].block_count : 0; }

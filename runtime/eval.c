@@ -31,14 +31,11 @@
 
 /* ---- scratch layout ---- */
 
-/* The scratch is the frame's plan. */
-static size_t scratch_bytes(uint32_t targets, uint32_t channels) { return mk_plan_bytes(targets, channels); }
-
 size_t mk_eval_scratch_size(const mk_asset *asset, uint32_t mesh)
 {
     if (!asset || mesh >= asset->mesh_count) return 0;
     const mk_blob_mesh *m = &asset->meshes[mesh];
-    return scratch_bytes(m->target_count, m->channel_count) + 16;
+    return mk_plan_bytes(m->target_count, m->channel_count) + 16;   /* the scratch is the frame's plan */
 }
 
 /* ---- validation ---- */
@@ -65,7 +62,7 @@ mk_result mk_eval_validate(const mk_eval_job *job, mk_error *err)
         return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: unknown store mode");
     if (!job->scratch || (uintptr_t)job->scratch % 16)
         return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: scratch is NULL or not 16-byte aligned");
-    if (job->scratch_size < scratch_bytes(m->target_count, m->channel_count))
+    if (job->scratch_size < mk_plan_bytes(m->target_count, m->channel_count))
         return mk_error_fail(err, MK_ERROR_BUFFER_TOO_SMALL, MK_NO_OFFSET, "eval job: scratch is smaller than mk_eval_scratch_size()");
     uint32_t n = job_vertex_count(job);
     if (!job->positions) return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "eval job: positions output is NULL");
@@ -92,9 +89,7 @@ typedef struct frame {
     const mk_asset *asset;
     const mk_blob_mesh *mesh;
     const mk_blob_target *targets;  /* mesh's first target */
-    const float *coef;              /* per mesh-local target */
-    const int32_t *slerp_channel;   /* per target: mesh-local channel whose normals slerp, or -1 */
-    const mk_plan_span *spans;      /* per mesh-local channel */
+    mk_plan plan;                   /* in the job's scratch */
 } frame;
 
 /* ---- block accumulation ---- */
@@ -340,7 +335,7 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
         for (uint32_t e = block_first[b]; e < block_first[b + 1]; e++) {
             const mk_blob_entry *en = &entries[e];
             const uint32_t ti = mk_entry_target(en);
-            const float c = f.coef[ti];
+            const float c = f.plan.coef[ti];
             if (c == 0.0f) continue;
             const mk_blob_target *tg = &f.targets[ti];
             const int q = mk_entry_quantized(en);   /* per entry: a quantized target's outliers are float */
@@ -355,19 +350,19 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
             if (!want_normals && !want_tangents) continue;
             p += attribute_bytes;
             if (tg->flags & MK_TARGET_HAS_NORMALS) {
-                const int32_t sc = f.slerp_channel[ti];
+                const int32_t sc = f.plan.slerp_channel[ti];
                 if (sc < 0) {
                     if (want_normals) add_attribute(acc_n, en->mask, p, q, c * (q ? tg->normal_scale : 1.0f));
                 } else {
                     /* Gather this channel's two span targets' raw normal deltas. */
                     if (sc != open_channel) {
-                        if (open_channel >= 0) add_slerp_normals(acc_n, slerp_a, slerp_b, touched, &f.spans[open_channel], bn);
+                        if (open_channel >= 0) add_slerp_normals(acc_n, slerp_a, slerp_b, touched, &f.plan.spans[open_channel], bn);
                         memset(slerp_a, 0, sizeof slerp_a);
                         memset(slerp_b, 0, sizeof slerp_b);
                         open_channel = sc;
                         touched = 0;
                     }
-                    float *dst = (int32_t)ti == f.spans[sc].target_a ? slerp_a : slerp_b;
+                    float *dst = (int32_t)ti == f.plan.spans[sc].target_a ? slerp_a : slerp_b;
                     add_attribute(dst, en->mask, p, q, q ? tg->normal_scale : 1.0f);
                     touched |= en->mask;
                 }
@@ -376,7 +371,7 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
             if (want_tangents && (tg->flags & MK_TARGET_HAS_TANGENTS))
                 add_attribute(acc_t, en->mask, p, q, c * (q ? tg->tangent_scale : 1.0f));
         }
-        if (open_channel >= 0) add_slerp_normals(acc_n, slerp_a, slerp_b, touched, &f.spans[open_channel], bn);
+        if (open_channel >= 0) add_slerp_normals(acc_n, slerp_a, slerp_b, touched, &f.plan.spans[open_channel], bn);
 
         /* Each output vertex is written once. */
         const size_t out = (size_t)(block_start + lo - first);
@@ -404,14 +399,11 @@ static void prepare_frame(const mk_eval_job *job, frame *f)
 {
     const mk_asset *a = job->asset;
     const mk_blob_mesh *m = &a->meshes[job->mesh];
-    const mk_plan plan = mk_plan_at(job->scratch, m->target_count, m->channel_count);
     f->asset = a;
     f->mesh = m;
     f->targets = &a->targets[m->first_target];
-    f->coef = plan.coef;
-    f->slerp_channel = plan.slerp_channel;
-    f->spans = plan.spans;
-    mk_plan_fill(a, m, job->weights, job->stacking, job->normals != NULL && job->normal_mode == MK_NORMALS_SLERP, &plan);
+    f->plan = mk_plan_at(job->scratch, m->target_count);
+    mk_plan_fill(a, m, job->weights, job->stacking, job->normals != NULL && job->normal_mode == MK_NORMALS_SLERP, &f->plan);
 }
 
 mk_result mk_eval_run(const mk_eval_job *job, mk_error *err)
@@ -441,7 +433,7 @@ uint64_t mk_eval_traffic(const mk_eval_job *job)
     for (uint32_t e = block_first[b0]; e < block_first[b1]; e++) {
         bytes += sizeof(mk_blob_entry);                                 /* every header is read */
         const uint32_t ti = mk_entry_target(&entries[e]);
-        if (f.coef[ti] == 0.0f) continue;
+        if (f.plan.coef[ti] == 0.0f) continue;
         bytes += mk_entry_bytes(&entries[e], f.targets[ti].flags & ~strip);
     }
     /* Base arrays read and outputs written. */

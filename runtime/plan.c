@@ -65,9 +65,8 @@ size_t mk_plan_bytes(uint32_t target_count, uint32_t channel_count)
     return 2 * align16((size_t)target_count * sizeof(float)) + align16((size_t)channel_count * sizeof(mk_plan_span));
 }
 
-mk_plan mk_plan_at(void *memory, uint32_t target_count, uint32_t channel_count)
+mk_plan mk_plan_at(void *memory, uint32_t target_count)
 {
-    (void)channel_count;
     uint8_t *p = memory;
     const size_t per_target = align16((size_t)target_count * sizeof(float));
     mk_plan plan = {
@@ -78,30 +77,28 @@ mk_plan mk_plan_at(void *memory, uint32_t target_count, uint32_t channel_count)
     return plan;
 }
 
-mk_result mk_plan_validate_weights(const mk_blob_mesh *m, const float *weights, uint32_t weight_count,
-                                   mk_stacking stacking, mk_normal_mode normal_mode, const char *job, mk_error *err)
+/* "JOB: WHAT" as the job's error. */
+static mk_result job_fail(mk_error *err, mk_result code, const char *job, const char *what)
 {
-    const char *what = NULL;
-    mk_result code = MK_ERROR_INVALID_ARGUMENT;
-    if (weight_count != m->channel_count) {
-        code = MK_ERROR_OUT_OF_RANGE;
-        what = ": weight_count differs from the mesh's channel count";
-    } else if (m->channel_count && !weights) {
-        what = ": weights is NULL";
-    } else {
-        for (uint32_t c = 0; c < m->channel_count && !what; c++)
-            if (!isfinite(weights[c])) {
-                code = MK_ERROR_NOT_FINITE;
-                what = ": a weight is NaN or infinite";
-            }
-        if (!what && (unsigned)stacking > MK_STACKING_SEQUENTIAL) what = ": unknown stacking mode";
-        else if (!what && (unsigned)normal_mode > MK_NORMALS_SLERP) what = ": unknown normal mode";
-    }
-    if (!what) return MK_OK;
     mk_error_start(err, code, MK_NO_OFFSET);
     mk_error_text(err, job);
     mk_error_text(err, what);
     return mk_error_end(err, code);
+}
+
+mk_result mk_plan_validate_weights(const mk_blob_mesh *m, const float *weights, uint32_t weight_count,
+                                   mk_stacking stacking, mk_normal_mode normal_mode, const char *job, mk_error *err)
+{
+    if (weight_count != m->channel_count)
+        return job_fail(err, MK_ERROR_OUT_OF_RANGE, job, ": weight_count differs from the mesh's channel count");
+    if (m->channel_count && !weights) return job_fail(err, MK_ERROR_INVALID_ARGUMENT, job, ": weights is NULL");
+    for (uint32_t c = 0; c < m->channel_count; c++)
+        if (!isfinite(weights[c])) return job_fail(err, MK_ERROR_NOT_FINITE, job, ": a weight is NaN or infinite");
+    if ((unsigned)stacking > MK_STACKING_SEQUENTIAL)
+        return job_fail(err, MK_ERROR_INVALID_ARGUMENT, job, ": unknown stacking mode");
+    if ((unsigned)normal_mode > MK_NORMALS_SLERP)
+        return job_fail(err, MK_ERROR_INVALID_ARGUMENT, job, ": unknown normal mode");
+    return MK_OK;
 }
 
 void mk_plan_fill(const mk_asset *a, const mk_blob_mesh *m, const float *weights, mk_stacking stacking, int slerp,
@@ -167,7 +164,7 @@ mk_result mk_gpu_plan_run(const mk_gpu_plan_job *job, mk_error *err)
         return mk_error_fail(err, MK_ERROR_INVALID_ARGUMENT, MK_NO_OFFSET, "gpu plan job: plan is NULL or not 16-byte aligned");
     if (job->plan_size < mk_plan_bytes(m->target_count, m->channel_count))
         return mk_error_fail(err, MK_ERROR_BUFFER_TOO_SMALL, MK_NO_OFFSET, "gpu plan job: plan is smaller than mk_gpu_plan_size()");
-    const mk_plan plan = mk_plan_at(job->plan, m->target_count, m->channel_count);
+    const mk_plan plan = mk_plan_at(job->plan, m->target_count);
     mk_plan_fill(a, m, job->weights, job->stacking, job->normal_mode == MK_NORMALS_SLERP, &plan);
     return MK_OK;
 }

@@ -37,7 +37,7 @@ typedef struct mk_plan {
 size_t mk_plan_bytes(uint32_t target_count, uint32_t channel_count);
 
 /* The plan's parts in memory of mk_plan_bytes (16-byte aligned). */
-mk_plan mk_plan_at(void *memory, uint32_t target_count, uint32_t channel_count);
+mk_plan mk_plan_at(void *memory, uint32_t target_count);
 
 /* Checks the frame's inputs as every job does: weight count, finite weights, known stacking and
  * normal mode. */

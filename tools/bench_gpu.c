@@ -4,6 +4,7 @@
 #include <string.h>
 #include "alloc.h"
 #include "bench_gpu.h"
+#include "gpu_eval.h"
 #include "timing.h"
 #if MK_HAVE_GPU
 #include "harness.h"
@@ -30,7 +31,8 @@ typedef struct bench_mesh {
 } bench_mesh;
 
 typedef struct bench_state {
-    mkg_harness h;
+    cli_gpu *gpu;                     /* the device, opened as for --gpu of the other commands */
+    mkg_harness *h;
     mkg_asset *asset;
     bench_mesh *meshes;
     uint32_t mesh_count;
@@ -49,27 +51,27 @@ static uint64_t tick_span(const mkg_harness *h, const uint64_t ticks[2])
 static mk_result time_frame(bench_state *s, const float *weights, int normals, double *gpu_ns, double *record_ns,
                             mk_error *err)
 {
-    mk_result r = mkg_harness_begin(&s->h, err);
+    mk_result r = mkg_harness_begin(s->h, err);
     if (r != MK_OK) return r;
-    vkCmdResetQueryPool(s->h.cmd, s->queries, 0, 2);
-    vkCmdWriteTimestamp(s->h.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s->queries, 0);
+    vkCmdResetQueryPool(s->h->cmd, s->queries, 0, 2);
+    vkCmdWriteTimestamp(s->h->cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s->queries, 0);
     double t0 = bench_now_ns();
     for (uint32_t m = 0; m < s->mesh_count && r == MK_OK; m++) {
         const bench_mesh *bm = &s->meshes[m];
         mkg_frame f = { .weights = weights + bm->first_channel, .weight_count = bm->channel_count };
-        r = mkg_mesh_record(normals && bm->both ? bm->both : bm->positions, s->h.cmd, &f, err);
+        r = mkg_mesh_record(normals && bm->both ? bm->both : bm->positions, s->h->cmd, &f, err);
     }
     *record_ns += bench_now_ns() - t0;
-    vkCmdWriteTimestamp(s->h.cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s->queries, 1);
+    vkCmdWriteTimestamp(s->h->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s->queries, 1);
     mk_error ignored;
-    mk_result submitted = mkg_harness_submit(&s->h, r == MK_OK ? err : &ignored);
+    mk_result submitted = mkg_harness_submit(s->h, r == MK_OK ? err : &ignored);
     if (r != MK_OK) return r;
     if (submitted != MK_OK) return submitted;
     uint64_t ticks[2];
-    VkResult vr = vkGetQueryPoolResults(s->h.device, s->queries, 0, 2, sizeof ticks, ticks, sizeof ticks[0],
+    VkResult vr = vkGetQueryPoolResults(s->h->device, s->queries, 0, 2, sizeof ticks, ticks, sizeof ticks[0],
                                         VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
     if (vr != VK_SUCCESS) return mk_error_set(err, MK_ERROR_UNSUPPORTED, UINT64_MAX, "reading timestamps failed");
-    *gpu_ns = (double)tick_span(&s->h, ticks) * s->h.props.limits.timestampPeriod;
+    *gpu_ns = (double)tick_span(s->h, ticks) * s->h->props.limits.timestampPeriod;
     return MK_OK;
 }
 
@@ -78,61 +80,63 @@ static mk_result time_frame(bench_state *s, const float *weights, int normals, d
 static mk_result copy_bandwidth(bench_state *s, VkDeviceSize size, double *bytes_per_ns, mk_error *err)
 {
     mkg_host_buffer a, b;
-    mk_result r = mkg_device_buffer_create(&s->h, size, &a, err);
+    mk_result r = mkg_device_buffer_create(s->h, size, &a, err);
     if (r != MK_OK) return r;
-    r = mkg_device_buffer_create(&s->h, size, &b, err);
+    r = mkg_device_buffer_create(s->h, size, &b, err);
     double best = 0;
     for (int k = 0; r == MK_OK && k < COPIES; k++) {
-        r = mkg_harness_begin(&s->h, err);
+        r = mkg_harness_begin(s->h, err);
         if (r != MK_OK) break;
-        vkCmdResetQueryPool(s->h.cmd, s->queries, 0, 2);
-        vkCmdWriteTimestamp(s->h.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s->queries, 0);
+        vkCmdResetQueryPool(s->h->cmd, s->queries, 0, 2);
+        vkCmdWriteTimestamp(s->h->cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s->queries, 0);
         VkBufferCopy region = { 0, 0, size };
-        vkCmdCopyBuffer(s->h.cmd, a.buffer, b.buffer, 1, &region);
-        vkCmdWriteTimestamp(s->h.cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s->queries, 1);
-        r = mkg_harness_submit(&s->h, err);
+        vkCmdCopyBuffer(s->h->cmd, a.buffer, b.buffer, 1, &region);
+        vkCmdWriteTimestamp(s->h->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s->queries, 1);
+        r = mkg_harness_submit(s->h, err);
         uint64_t ticks[2];
-        if (r == MK_OK && vkGetQueryPoolResults(s->h.device, s->queries, 0, 2, sizeof ticks, ticks, sizeof ticks[0],
+        if (r == MK_OK && vkGetQueryPoolResults(s->h->device, s->queries, 0, 2, sizeof ticks, ticks, sizeof ticks[0],
                                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT) == VK_SUCCESS) {
-            double ns = (double)tick_span(&s->h, ticks) * s->h.props.limits.timestampPeriod;
+            double ns = (double)tick_span(s->h, ticks) * s->h->props.limits.timestampPeriod;
             if (ns > 0 && 2.0 * (double)size / ns > best) best = 2.0 * (double)size / ns;
         }
     }
-    mkg_host_buffer_destroy(&s->h, &b);
-    mkg_host_buffer_destroy(&s->h, &a);
+    mkg_host_buffer_destroy(s->h, &b);
+    mkg_host_buffer_destroy(s->h, &a);
     *bytes_per_ns = best;
     return r;
 }
 
-static void state_free(bench_state *s)
+/* Frees everything and closes the device; nonzero when the validation layer reported messages. */
+static int state_free(bench_state *s)
 {
     for (uint32_t m = 0; s->meshes && m < s->mesh_count; m++) {
         mkg_mesh_destroy(s->meshes[m].both);
         mkg_mesh_destroy(s->meshes[m].positions);
-        mkg_host_buffer_destroy(&s->h, &s->meshes[m].out);
+        mkg_host_buffer_destroy(s->h, &s->meshes[m].out);
     }
     free(s->meshes);
-    if (s->queries) vkDestroyQueryPool(s->h.device, s->queries, NULL);
+    if (s->queries) vkDestroyQueryPool(s->h->device, s->queries, NULL);
     mkg_asset_destroy(s->asset);
-    mkg_harness_close(&s->h);
+    return cli_gpu_close(s->gpu);
 }
 
 /* The asset uploaded and each mesh's outputs and evaluations made. */
 static mk_result prepare(bench_state *s, const mk_asset *a, cli_gpu_bench *out, mk_error *err)
 {
-    const char *v = getenv("MORPHKIT_VK_VALIDATION");
-    mk_result r = mkg_harness_open(&s->h, v && strcmp(v, "1") == 0 ? MKG_HARNESS_REQUIRE_VALIDATION : 0, err);
+    pb_evaluator unused;
+    mk_result r = cli_gpu_open(&s->gpu, &unused, 1, err);
     if (r != MK_OK) return r;
-    snprintf(out->device, sizeof out->device, "%s", s->h.props.deviceName);
-    if (!s->h.timestamps)
+    s->h = cli_gpu_harness(s->gpu);
+    snprintf(out->device, sizeof out->device, "%s", s->h->props.deviceName);
+    if (!s->h->timestamps)
         return mk_error_set(err, MK_ERROR_UNSUPPORTED, UINT64_MAX, "%s has no timestamps on its compute queue",
                             out->device);
     VkQueryPoolCreateInfo qi = { .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO, .queryType = VK_QUERY_TYPE_TIMESTAMP,
                                  .queryCount = 2 };
-    if (vkCreateQueryPool(s->h.device, &qi, NULL, &s->queries) != VK_SUCCESS)
+    if (vkCreateQueryPool(s->h->device, &qi, NULL, &s->queries) != VK_SUCCESS)
         return mk_error_set(err, MK_ERROR_UNSUPPORTED, UINT64_MAX, "creating a timestamp query pool failed");
     double t0 = bench_now_ns();
-    r = mkg_asset_upload(s->h.ctx, a, s->h.queue, s->h.family, &s->asset, err);
+    r = mkg_asset_upload(s->h->ctx, a, s->h->queue, s->h->family, &s->asset, err);
     out->upload_ms = (bench_now_ns() - t0) / 1e6;
     s->mesh_count = a->mesh_count;
     s->meshes = calloc(a->mesh_count + 1u, sizeof *s->meshes);
@@ -144,7 +148,7 @@ static mk_result prepare(bench_state *s, const mk_asset *a, cli_gpu_bench *out, 
         bm->first_channel = mi.first_channel;
         bm->channel_count = mi.channel_count;
         const VkDeviceSize v = mi.vertex_count;
-        r = mkg_device_buffer_create(&s->h, 24 * v, &bm->out, err);
+        r = mkg_device_buffer_create(s->h, 24 * v, &bm->out, err);
         mkg_mesh_desc d = { .mesh = m, .frames_in_flight = 1, .positions = { bm->out.buffer, 0, 12, 12 * v } };
         if (r == MK_OK) r = mkg_mesh_create(s->asset, &d, &bm->positions, err);
         d.normals = (mkg_output){ bm->out.buffer, 12 * v, 12, 12 * v };
@@ -179,7 +183,7 @@ mk_result cli_bench_gpu(const mk_asset *a, const float *weights, uint32_t frames
         }
     if (r == MK_OK) {
         out->gpu_ns = median(gpu, kept);
-        out->gpu_ns_min = gpu[0];
+        out->gpu_ns_min = gpu[0];   /* median sorted them */
         out->gpu_ns_positions = median(gpu_p, kept);
         out->record_ns = median(rec, kept);
         r = copy_bandwidth(&s, (VkDeviceSize)64 << 20, &out->copy_bytes_per_ns, err);
@@ -187,10 +191,8 @@ mk_result cli_bench_gpu(const mk_asset *a, const float *weights, uint32_t frames
     free(gpu);
     free(gpu_p);
     free(rec);
-    unsigned messages = s.h.validation_messages;
-    state_free(&s);
-    if (r == MK_OK && messages)
-        r = mk_error_set(err, MK_ERROR_UNSUPPORTED, UINT64_MAX, "the Vulkan validation layer reported %u messages", messages);
+    if (s.gpu && state_free(&s) && r == MK_OK)
+        r = mk_error_set(err, MK_ERROR_UNSUPPORTED, UINT64_MAX, "the Vulkan validation layer reported messages (above)");
     return r;
 }
 
@@ -202,7 +204,9 @@ mk_result cli_bench_gpu(const mk_asset *a, const float *weights, uint32_t frames
     (void)weights;
     (void)frames;
     memset(out, 0, sizeof *out);
-    return mk_error_set(err, MK_ERROR_UNSUPPORTED, UINT64_MAX, "this morphkit was built without the GPU path");
+    cli_gpu *gpu;
+    pb_evaluator unused;
+    return cli_gpu_open(&gpu, &unused, 1, err);   /* says this build has no GPU path */
 }
 
 #endif

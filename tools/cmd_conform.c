@@ -24,10 +24,7 @@ static const cli_option options[] = {
     { "--case", "SUBSTRING", CLI_STRING, offsetof(conform_args, filter),
       "Only the cases whose name or source path contains SUBSTRING (an error when none does).", NULL, NULL, 0, 0, 0,
       0 },
-    { "--gpu", NULL, CLI_FLAG, offsetof(conform_args, gpu),
-      "Evaluate on the GPU path (Vulkan compute on the first GPU, else lavapipe; docs/gpu.md) instead of the CPU "
-      "runtime.",
-      NULL, NULL, 0, 0, 0, 0 },
+    { "--gpu", NULL, CLI_FLAG, offsetof(conform_args, gpu), CLI_GPU_OPTION_HELP, NULL, NULL, 0, 0, 0, 0 },
     { "--precision", "P", CLI_CHOICE, offsetof(conform_args, precision),
       "How sources are written before playback: q16 (the allowed error grows by each target's quantization step) "
       "or float.",

@@ -45,10 +45,7 @@ static const cli_option options[] = {
       offsetof(frames_args, stacking_given) },
     { "--normals", "MODE", CLI_CHOICE, offsetof(frames_args, normals), "How normal changes combine.", "nlerp",
       "nlerp|slerp", 0, 0, 0, 0 },
-    { "--gpu", NULL, CLI_FLAG, offsetof(frames_args, gpu),
-      "Evaluate on the GPU path (Vulkan compute on the first GPU, else lavapipe; docs/gpu.md) instead of the CPU "
-      "runtime.",
-      NULL, NULL, 0, 0, 0, 0 },
+    { "--gpu", NULL, CLI_FLAG, offsetof(frames_args, gpu), CLI_GPU_OPTION_HELP, NULL, NULL, 0, 0, 0, 0 },
     { "--space", "S", CLI_CHOICE, offsetof(frames_args, space), "Coordinates of the frames.", "local", "local|world", 0, 0,
       0, 0 },
     { "--precision", "P", CLI_CHOICE, offsetof(frames_args, precision),

@@ -42,10 +42,7 @@ static const cli_option options[] = {
     { "--normals", "MODE", CLI_CHOICE, offsetof(play_args, normals),
       "How normal changes combine (docs/semantics.md); surface: recomputed from the evaluated surface.",
       "nlerp", "nlerp|slerp|surface", 0, 0, 0, 0 },
-    { "--gpu", NULL, CLI_FLAG, offsetof(play_args, gpu),
-      "Evaluate on the GPU path (Vulkan compute on the first GPU, else lavapipe; docs/gpu.md) instead of the CPU "
-      "runtime. Surface normals are then computed on the CPU from the GPU's positions.",
-      NULL, NULL, 0, 0, 0, 0 },
+    { "--gpu", NULL, CLI_FLAG, offsetof(play_args, gpu), CLI_GPU_OPTION_HELP " Surface normals are then computed on the CPU from the GPU's positions.", NULL, NULL, 0, 0, 0, 0 },
     { "--space", "S", CLI_CHOICE, offsetof(play_args, space),
       "Coordinates of the output: world (each mesh's node transform at rest applied) or local (mesh space).", "world",
       "world|local", 0, 0, 0, 0 },

@@ -73,6 +73,8 @@ mk_result cli_gpu_open(cli_gpu **out, pb_evaluator *evaluator, int quiet, mk_err
     return MK_OK;
 }
 
+struct mkg_harness *cli_gpu_harness(cli_gpu *g) { return &g->h; }
+
 int cli_gpu_close(cli_gpu *g)
 {
     if (!g) return 0;
@@ -100,6 +102,12 @@ int cli_gpu_close(cli_gpu *g)
 {
     (void)g;
     return 0;
+}
+
+struct mkg_harness *cli_gpu_harness(cli_gpu *g)
+{
+    (void)g;
+    return NULL;
 }
 
 #endif

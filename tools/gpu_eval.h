@@ -10,10 +10,17 @@
 
 typedef struct cli_gpu cli_gpu;
 
+/* The help of the --gpu option of play, frames and conform. */
+#define CLI_GPU_OPTION_HELP \
+    "Evaluate on the GPU path (Vulkan compute on the first GPU, else lavapipe; docs/gpu.md) instead of the CPU runtime."
+
 /* Opens the device (validation layer on when MORPHKIT_VK_VALIDATION=1) and fills evaluator.
  * Prints the device on stderr unless quiet. */
 mk_result cli_gpu_open(cli_gpu **out, pb_evaluator *evaluator, int quiet, mk_error *err);
-/* Closes it; returns nonzero when the validation layer reported messages. */
+/* Closes it; returns nonzero when the validation layer reported messages (those at destruction,
+ * such as objects left alive, included). */
 int cli_gpu_close(cli_gpu *gpu);
+/* The opened device, for the commands that record their own work on it (bench --gpu). */
+struct mkg_harness *cli_gpu_harness(cli_gpu *gpu);
 
 #endif

@@ -49,6 +49,8 @@ typedef struct mkg_device {
     VkPhysicalDevice physical_device;
     VkDevice device;
     const VkAllocationCallbacks *allocator;   /* optional, used for every Vulkan object */
+    VkDeviceSize offset_alignment;            /* optional: cut buffer bindings at offsets of this power of two
+                                               * when it exceeds minStorageBufferOffsetAlignment (0: the device's) */
 } mkg_device;
 
 /* The pipeline and its layouts. */
@@ -110,10 +112,6 @@ void mkg_cmd_output_acquire(VkCommandBuffer cmd, VkPipelineStageFlags src_stage,
 /* A barrier from the evaluation's writes to a later use of the outputs (e.g. the vertex input
  * stage reading vertex attributes, or VK_PIPELINE_STAGE_TRANSFER_BIT for a copy). */
 void mkg_cmd_output_barrier(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access);
-
-/* Workgroups a mesh's evaluation dispatches (one per 64-vertex block) and the bytes of its
- * plan, for budgeting. */
-uint32_t mkg_mesh_workgroups(const mkg_mesh *mesh);
 
 #ifdef __cplusplus
 }

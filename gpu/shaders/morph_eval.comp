@@ -78,10 +78,13 @@ uint plan_part() { return ((pc.target_count + 3u) & ~3u); }   // words of one pe
 
 int plan_slerp_channel(uint t) { return int(plan[plan_part() + t]); }
 
+// Word of channel c's span in the plan.
+uint plan_span_at(int c) { return 2u * plan_part() + 4u * uint(c); }
+
 // Span of channel c: target_a, target_b (-1: the implicit zero key), t, sequential scale.
 void plan_span(int c, out int a, out int b, out float t, out float scale)
 {
-    uint w = 2u * plan_part() + 4u * uint(c);
+    uint w = plan_span_at(c);
     a = int(plan[w]);
     b = int(plan[w + 1u]);
     t = uintBitsToFloat(plan[w + 2u]);
@@ -171,7 +174,7 @@ void main()
 
     // Slerp channels: a channel's targets are adjacent in the entry order, so its span's two
     // raw deltas are gathered while its entries pass, then blended once.
-    int open_channel = -1;
+    int open_channel = -1, open_target_a = -1;   // the channel and its span's first target
     vec3 slerp_a = vec3(0.0), slerp_b = vec3(0.0);
     bool touched = false;
 
@@ -214,14 +217,12 @@ void main()
                         slerp_a = vec3(0.0);
                         slerp_b = vec3(0.0);
                         open_channel = sc;
+                        open_target_a = int(plan[plan_span_at(sc)]);
                         touched = false;
                     }
                     if (has) {
-                        int ta, tb;
-                        float t, scale;
-                        plan_span(sc, ta, tb, t, scale);
                         vec3 d = normal_scale * entry_delta(at, q, m, attr, rank);
-                        if (int(ti) == ta) slerp_a += d;
+                        if (int(ti) == open_target_a) slerp_a += d;
                         else slerp_b += d;
                         touched = true;
                     }
