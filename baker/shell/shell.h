@@ -15,7 +15,6 @@
 #ifndef SHELL_H
 #define SHELL_H
 
-#include <stdio.h>
 #include "raw.h"
 #include "parallel.h"
 
@@ -203,7 +202,8 @@ shell_collider *shell_collider_create(const shell_mesh *m, mk_arena *arena);
 mk_result shell_collide(shell_collider *col, const shell_mesh *m, const double *x, double *p, double thickness,
                         mk_team *team, mk_arena *arena, uint32_t *vt, uint32_t *ee, uint32_t *rounds, mk_error *err);
 
-/* Writes the per-frame log as CSV (header line, then one line per frame). */
-int shell_write_log(FILE *f, const shell_run *run);
+/* The per-frame log as CSV (a header line, then one line per frame): *size bytes of arena memory,
+ * NUL-terminated; NULL when out of memory. */
+char *shell_log_csv(const shell_run *run, mk_arena *arena, size_t *size);
 
 #endif

@@ -7,6 +7,7 @@
  * team of threads in a way that gives the same result for any thread count, so a run is
  * reproducible bit for bit. */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 #include "shell.h"
 #include "bake_util.h"
@@ -413,14 +414,29 @@ mk_result shell_simulate(const shell_mesh *m, const shell_params *p, mk_arena *a
     return r;
 }
 
-int shell_write_log(FILE *f, const shell_run *run)
+/* Writes the log into buf (NULL: only counts) and returns its length, or -1 on an encoding error. */
+static long format_log(const shell_run *run, char *buf, size_t cap)
 {
-    int bad = fprintf(f, "frame,time,volume_ratio,membrane_energy,bending_energy,aniso_energy,"
-                         "vt_collisions,ee_collisions,collision_rounds,ms_frame,ms_collision\n") < 0;
-    for (uint32_t k = 0; k <= run->frames && !bad; k++) {
+    size_t n = 0;
+    int w = snprintf(buf, cap, "frame,time,volume_ratio,membrane_energy,bending_energy,aniso_energy,"
+                               "vt_collisions,ee_collisions,collision_rounds,ms_frame,ms_collision\n");
+    for (uint32_t k = 0; w >= 0; k++) {
+        n += (size_t)w;
+        if (k > run->frames) return (long)n;
         const shell_frame_stats *s = &run->stats[k];
-        bad = fprintf(f, "%u,%.6g,%.9g,%.9g,%.9g,%.9g,%u,%u,%u,%.3f,%.3f\n", k, s->time, s->volume_ratio, s->membrane,
-                      s->bending, s->aniso, s->vt_hits, s->ee_hits, s->collision_rounds, s->ms_step, s->ms_collision) < 0;
+        w = snprintf(buf ? buf + n : NULL, buf ? cap - n : 0, "%u,%.6g,%.9g,%.9g,%.9g,%.9g,%u,%u,%u,%.3f,%.3f\n", k,
+                     s->time, s->volume_ratio, s->membrane, s->bending, s->aniso, s->vt_hits, s->ee_hits,
+                     s->collision_rounds, s->ms_step, s->ms_collision);
     }
-    return bad ? -1 : 0;
+    return -1;
+}
+
+char *shell_log_csv(const shell_run *run, mk_arena *arena, size_t *size)
+{
+    long n = format_log(run, NULL, 0);
+    char *buf = n >= 0 ? mk_arena_alloc(arena, (size_t)n + 1) : NULL;
+    if (!buf) return NULL;
+    format_log(run, buf, (size_t)n + 1);
+    *size = (size_t)n;
+    return buf;
 }

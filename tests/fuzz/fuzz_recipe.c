@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* libFuzzer target: bake recipes (baker/recipe.c) on a small generated mesh. Any input must
+/* libFuzzer target: bake recipes (baker/recipe/) on a small generated mesh. Any input must
  * give MK_OK or a clean error -- never a crash, an out-of-bounds access or a leak -- and on
  * error the raw model keeps its channels. Recipes run as untrusted (no file reads, capped work).
  * tests/baker/test_fuzz_recipe.c runs this same function over the sample recipes with
