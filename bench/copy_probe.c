@@ -2,8 +2,8 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "clock.h"
 #include "copy_probe.h"
-#include "timing.h"
 
 int copy_probe_init(copy_probe *p)
 {

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include "surface.h"
 #include <stdlib.h>
+#include "clock.h"
 #include "frame.h"
 #include "timing.h"
 

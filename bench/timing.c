@@ -6,15 +6,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+#include "clock.h"
 #include "timing.h"
-
-double bench_now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
-}
 
 /* Threads split a mesh the way a job system would: into ranges of BENCH_CHUNK_BLOCKS
  * 64-vertex blocks (so no two jobs share a block), each one mk_eval_run job, taken from a

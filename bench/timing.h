@@ -43,7 +43,6 @@ typedef struct timed_config {
 /* Rounds over the configurations; each result is its best pass. */
 #define BENCH_PASSES 5
 
-double bench_now_ns(void);
 /* A pool thread's loop (index >= 1); the caller's thread is index 0. */
 void *bench_worker_main(void *worker);
 /* Times the configurations round-robin and keeps each one's best pass (ns per frame). */

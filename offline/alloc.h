@@ -45,13 +45,15 @@ uint32_t mk_arena_threads(const mk_arena *arena, uint32_t threads);
 void *mk_arena_alloc(mk_arena *arena, size_t size);
 /* count * size with overflow check. */
 void *mk_arena_array(mk_arena *arena, size_t count, size_t size);
-/* Grows an array allocated from this arena: returns new zeroed-tail copy (old is released). */
+/* Grows an array allocated from this arena: returns new zeroed-tail copy (old is released).
+ * ptr may be NULL (then a new block, as mk_arena_alloc). */
 void *mk_arena_realloc(mk_arena *arena, void *ptr, size_t old_size, size_t new_size);
 /* Grows a block of this arena to new_size bytes (never shrinks it: a smaller size returns ptr);
  * the bytes past its old size are zeroed. With the default allocator the block is moved by
  * realloc, which keeps a large block's pages (mremap) instead of copying them into fresh ones;
  * otherwise as mk_arena_realloc. NULL (and ptr left as it was) when refused. */
 void *mk_arena_grow(mk_arena *arena, void *ptr, size_t new_size);
+/* ptr may be NULL (nothing is released). */
 void mk_arena_release(mk_arena *arena, void *ptr);
 /* Releases ptrs[0 .. n) (NULLs skipped) while holding `lock`: for workers giving arrays back to
  * an arena they share. */

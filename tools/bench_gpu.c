@@ -5,7 +5,7 @@
 #include "alloc.h"
 #include "bench_gpu.h"
 #include "gpu_eval.h"
-#include "timing.h"
+#include "clock.h"
 #if MK_HAVE_GPU
 #include "harness.h"
 

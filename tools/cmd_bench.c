@@ -25,6 +25,7 @@
 #include "asset.h"
 #include "bench_gpu.h"
 #include "cli.h"
+#include "clock.h"
 #include "frame.h"
 #include "naive.h"
 #include "normal_quality.h"

@@ -278,12 +278,12 @@ mk_result fbx_convert_curve(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *cur
     }
     r = finish(doc, raw, path, k, n, scale, out_keys, out_count);
 done:
-    fbx_release(doc->arena, times);
-    fbx_release(doc->arena, values);
-    fbx_release(doc->arena, flags);
-    fbx_release(doc->arena, data);
-    fbx_release(doc->arena, refs);
-    fbx_release(doc->arena, k);
+    mk_arena_release(doc->arena, times);
+    mk_arena_release(doc->arena, values);
+    mk_arena_release(doc->arena, flags);
+    mk_arena_release(doc->arena, data);
+    mk_arena_release(doc->arena, refs);
+    mk_arena_release(doc->arena, k);
     return r;
 }
 
@@ -312,13 +312,13 @@ mk_result fbx_convert_legacy_curve(fbx_doc *doc, mk_raw_asset *raw, const fbx_no
     if (r != MK_OK) return r;
     /* Each key takes at least 3 values: bounds KeyCount before allocating. */
     if ((uint64_t)key_count > size / 3 + 1) {
-        fbx_release(doc->arena, data);
+        mk_arena_release(doc->arena, data);
         return mk_error_set(doc->err, MK_ERROR_PARSE, key_node->offset, "FBX %s: KeyCount %lld exceeds the %zu key values",
                             path, (long long)key_count, size);
     }
     size_t n = (size_t)key_count;
     dkey *k = mk_arena_array(doc->arena, n ? n : 1, sizeof *k);
-    if (!k) { fbx_release(doc->arena, data); return mk_error_oom(doc->err, "FBX curve"); }
+    if (!k) { mk_arena_release(doc->arena, data); return mk_error_oom(doc->err, "FBX curve"); }
     size_t pos = 0;
     const char *problem = NULL;
     double slope_left = 0.0, weight_left = THIRD, prev_time = 0.0;
@@ -427,15 +427,15 @@ mk_result fbx_convert_legacy_curve(fbx_doc *doc, mk_raw_asset *raw, const fbx_no
 #undef USE
     if (pos != size) mk_raw_warn(raw, "FBX %s: %zu trailing key values ignored", path, size - pos);
     r = finish(doc, raw, path, k, n, scale, out_keys, out_count);
-    fbx_release(doc->arena, data);
-    fbx_release(doc->arena, k);
+    mk_arena_release(doc->arena, data);
+    mk_arena_release(doc->arena, k);
     return r;
 fail:
-    fbx_release(doc->arena, data);
-    fbx_release(doc->arena, k);
+    mk_arena_release(doc->arena, data);
+    mk_arena_release(doc->arena, k);
     return mk_error_set(doc->err, MK_ERROR_PARSE, key_node->offset, "FBX %s: %s (key value %zu)", path, problem, pos);
 not_finite:
-    fbx_release(doc->arena, data);
-    fbx_release(doc->arena, k);
+    mk_arena_release(doc->arena, data);
+    mk_arena_release(doc->arena, k);
     return fbx_error_not_finite(doc, key_node, bad, "key %zu", i);
 }

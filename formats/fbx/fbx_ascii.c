@@ -126,8 +126,8 @@ static mk_result push_value(ascii_parser *p, const fbx_value *v)
 {
     if (p->value_top == p->value_cap) {
         size_t cap = p->value_cap ? p->value_cap * 2 : 256;
-        fbx_value *grown = fbx_grow(p->doc->arena, p->values, p->value_cap * sizeof *p->values,
-                                    cap * sizeof *p->values);
+        fbx_value *grown = mk_arena_realloc(p->doc->arena, p->values, p->value_cap * sizeof *p->values,
+                                            cap * sizeof *p->values);
         if (!grown) return mk_error_oom(p->doc->err, "FBX values");
         p->values = grown;
         p->value_cap = cap;
@@ -140,8 +140,8 @@ static mk_result push_node(ascii_parser *p, const fbx_node *n)
 {
     if (p->node_top == p->node_cap) {
         size_t cap = p->node_cap ? p->node_cap * 2 : 256;
-        fbx_node *grown = fbx_grow(p->doc->arena, p->nodes, p->node_cap * sizeof *p->nodes,
-                                   cap * sizeof *p->nodes);
+        fbx_node *grown = mk_arena_realloc(p->doc->arena, p->nodes, p->node_cap * sizeof *p->nodes,
+                                           cap * sizeof *p->nodes);
         if (!grown) return mk_error_oom(p->doc->err, "FBX nodes");
         p->nodes = grown;
         p->node_cap = cap;
@@ -475,7 +475,7 @@ mk_result fbx_parse_ascii(fbx_doc *doc)
     memset(&doc->root, 0, sizeof doc->root);
     doc->root.name = "";
     mk_result r = parse_children(&p, &doc->root, 0, 1);
-    fbx_release(doc->arena, p.nodes);
-    fbx_release(doc->arena, p.values);
+    mk_arena_release(doc->arena, p.nodes);
+    mk_arena_release(doc->arena, p.values);
     return r;
 }

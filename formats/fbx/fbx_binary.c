@@ -56,8 +56,8 @@ static mk_result push_node(bin_parser *p, const fbx_node *node)
 {
     if (p->top == p->cap) {
         size_t cap = p->cap ? p->cap * 2 : 256;
-        fbx_node *grown = fbx_grow(p->doc->arena, p->stack, p->cap * sizeof *p->stack,
-                                   cap * sizeof *p->stack);
+        fbx_node *grown = mk_arena_realloc(p->doc->arena, p->stack, p->cap * sizeof *p->stack,
+                                           cap * sizeof *p->stack);
         if (!grown) return mk_error_oom(p->doc->err, "FBX node stack");
         p->stack = grown;
         p->cap = cap;
@@ -286,13 +286,13 @@ mk_result fbx_parse_binary(fbx_doc *doc)
         int is_null;
         mk_result r = parse_node(&p, &pos, p.size, 0, &is_null);
         if (r != MK_OK) {
-            fbx_release(doc->arena, p.stack);
+            mk_arena_release(doc->arena, p.stack);
             return r;
         }
         if (is_null) { terminated = 1; break; }
     }
     if (!terminated) {
-        fbx_release(doc->arena, p.stack);
+        mk_arena_release(doc->arena, p.stack);
         return mk_error_set(doc->err, MK_ERROR_PARSE, pos,
                             "FBX truncated: the top-level node list has no closing null record");
     }
@@ -304,6 +304,6 @@ mk_result fbx_parse_binary(fbx_doc *doc)
         memcpy(doc->root.children, p.stack, p.top * sizeof(fbx_node));
         doc->root.child_count = (uint32_t)p.top;
     }
-    fbx_release(doc->arena, p.stack);
+    mk_arena_release(doc->arena, p.stack);
     return MK_OK;
 }

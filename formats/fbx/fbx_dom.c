@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* Accessors over the FBX document tree: child lookup, scalar values, properties and lazy array
  * decoding (zlib via libdeflate for binary arrays, text for ASCII arrays, scalar runs for
- * FBX 5.x/6.x binary).
+ * FBX 5.x/6.x binary), with the arrays decoded ahead (fbx_prefetch.c) handed over or dropped
+ * here, and the document's decoder, spare arrays and prefetched arrays freed (fbx_doc_free).
  */
 #include <math.h>
 #include <stdarg.h>
@@ -15,23 +16,13 @@
 #error "the FBX array decoder assumes a little-endian host (it copies little-endian payloads and swaps big-endian files); adapt it for this host"
 #endif
 
-void *fbx_grow(mk_arena *arena, void *ptr, size_t old_size, size_t new_size)
-{
-    if (!ptr) return mk_arena_alloc(arena, new_size);
-    return mk_arena_realloc(arena, ptr, old_size, new_size);
-}
-
-void fbx_release(mk_arena *arena, void *ptr)
-{
-    if (ptr) mk_arena_release(arena, ptr);
-}
-
 void fbx_doc_free(fbx_doc *doc)
 {
     fbx_prefetch_drop(doc);
     if (doc->inflater) libdeflate_free_decompressor(doc->inflater);
     doc->inflater = NULL;
-    for (size_t i = 0; i < sizeof doc->spare / sizeof doc->spare[0]; i++) fbx_release(doc->arena, doc->spare[i].ptr);
+    for (size_t i = 0; i < sizeof doc->spare / sizeof doc->spare[0]; i++)
+        mk_arena_release(doc->arena, doc->spare[i].ptr);
     memset(doc->spare, 0, sizeof doc->spare);
 }
 
@@ -52,7 +43,7 @@ void fbx_recycle(fbx_doc *doc, void *ptr, size_t size)
 {
     if (!ptr) return;
     if (size < FBX_SPARE_MIN) {
-        fbx_release(doc->arena, ptr);
+        mk_arena_release(doc->arena, ptr);
         return;
     }
     size_t slot = 0;  /* an empty slot, else the smallest spare */
@@ -61,10 +52,10 @@ void fbx_recycle(fbx_doc *doc, void *ptr, size_t size)
         if (doc->spare[i].size < doc->spare[slot].size) slot = i;
     }
     if (doc->spare[slot].ptr && doc->spare[slot].size >= size) {  /* every spare is bigger: keep them */
-        fbx_release(doc->arena, ptr);
+        mk_arena_release(doc->arena, ptr);
         return;
     }
-    fbx_release(doc->arena, doc->spare[slot].ptr);
+    mk_arena_release(doc->arena, doc->spare[slot].ptr);
     doc->spare[slot].ptr = ptr;
     doc->spare[slot].size = spare_capacity(size);  /* at least what array_buffer allocated for it */
 }
@@ -259,11 +250,11 @@ static mk_result decode_binary(fbx_doc *doc, const fbx_node *node, const fbx_val
         if (!target) return mk_error_oom(doc->err, "FBX array");
         if (!doc->inflater) doc->inflater = libdeflate_alloc_decompressor();
         struct libdeflate_decompressor *d = doc->inflater;
-        if (!d) { fbx_release(doc->arena, inflated); return mk_error_oom(doc->err, "zlib decoder"); }
+        if (!d) { mk_arena_release(doc->arena, inflated); return mk_error_oom(doc->err, "zlib decoder"); }
         size_t actual = 0;
         enum libdeflate_result lr = libdeflate_zlib_decompress(d, src, (size_t)v->u.a.size, target, bytes, &actual);
         if (lr != LIBDEFLATE_SUCCESS || actual != bytes) {
-            fbx_release(doc->arena, inflated);
+            mk_arena_release(doc->arena, inflated);
             /* The output buffer is exactly the declared size, so a stream that would inflate
              * beyond it stops with INSUFFICIENT_SPACE instead of writing more. */
             return array_error(doc, node, v->offset, MK_ERROR_PARSE,
@@ -293,7 +284,7 @@ static mk_result decode_binary(fbx_doc *doc, const fbx_node *node, const fbx_val
         default: ok = store_i64(out, i, elem, p[0]); break;
         }
     }
-    fbx_release(doc->arena, inflated);
+    mk_arena_release(doc->arena, inflated);
     if (!ok) return array_error(doc, node, v->offset, MK_ERROR_PARSE, "array value out of range for its use");
     return MK_OK;
 }
@@ -352,6 +343,31 @@ static mk_result decode_ascii(fbx_doc *doc, const fbx_node *node, const fbx_valu
     return MK_OK;
 }
 
+/* Arrays decoded ahead by fbx_prefetch (fbx_prefetch.c), handed over by fbx_node_array. */
+int fbx_prefetch_take(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void **out, size_t *count, mk_result *r)
+{
+    for (uint32_t i = 0; i < doc->prefetched_count; i++) {
+        fbx_prefetched *p = &doc->prefetched[i];
+        if (p->node != node || p->elem != elem) continue;
+        p->node = NULL;
+        *out = p->data;
+        *count = p->count;
+        *r = p->result;
+        if (p->result != MK_OK && doc->err) *doc->err = p->error;
+        return 1;
+    }
+    return 0;
+}
+
+void fbx_prefetch_drop(fbx_doc *doc)
+{
+    for (uint32_t i = 0; i < doc->prefetched_count; i++)
+        if (doc->prefetched[i].node) mk_arena_release(doc->arena, doc->prefetched[i].data);
+    mk_arena_release(doc->arena, doc->prefetched);
+    doc->prefetched = NULL;
+    doc->prefetched_count = 0;
+}
+
 mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void **out, size_t *count)
 {
     *out = NULL;
@@ -366,7 +382,7 @@ mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void
         void *data = array_buffer(doc, (size_t)v->count * esize);  /* every element is written below */
         if (!data) return mk_error_oom(doc->err, "FBX array");
         mk_result r = v->type == 'a' ? decode_ascii(doc, node, v, elem, data) : decode_binary(doc, node, v, elem, data);
-        if (r != MK_OK) { fbx_release(doc->arena, data); return r; }
+        if (r != MK_OK) { mk_arena_release(doc->arena, data); return r; }
         *out = data;
         *count = v->count;
         return MK_OK;
@@ -381,7 +397,7 @@ mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void
         else if (v->kind == FBX_INT || v->kind == FBX_CHAR) ok = store_i64(data, i, elem == FBX_ELEM_F32_BITS ? FBX_ELEM_F32 : elem, v->u.i);
         else ok = 0;
         if (!ok) {
-            fbx_release(doc->arena, data);
+            mk_arena_release(doc->arena, data);
             return array_error(doc, node, v->offset, MK_ERROR_PARSE, "expected a number in the value list");
         }
     }

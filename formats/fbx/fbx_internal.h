@@ -90,10 +90,6 @@ int fbx_ascii_not_finite(const char *s, size_t n, double *out);
  * in [*start, *pos). */
 int fbx_ascii_array_token(const char *s, size_t size, size_t *pos, size_t *start);
 
-/* Arena helpers that accept NULL (grow from nothing, release nothing). */
-void *fbx_grow(mk_arena *arena, void *ptr, size_t old_size, size_t new_size);
-void fbx_release(mk_arena *arena, void *ptr);
-
 /* ---- Tree accessors (fbx_dom.c) ---- */
 /* Sets parent pointers and depths after parsing (the parsers move nodes while building). */
 void fbx_link_parents(fbx_node *node);
@@ -122,12 +118,13 @@ mk_result fbx_node_array(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void
 /* Same for the child named `name`; *out NULL and count 0 when the child is absent (MK_OK). */
 mk_result fbx_child_array(fbx_doc *doc, const fbx_node *node, const char *name, fbx_elem elem,
                           void **out, size_t *count);
-/* fbx_prefetch.c: decodes the arrays of nodes[i] as elems[i] (a node may be NULL) on
+/* fbx_prefetch (fbx_prefetch.c) decodes the arrays of nodes[i] as elems[i] (a node may be NULL) on
  * doc->threads worker threads, so that the next fbx_node_array of each (node, elem) returns at
  * once what decoding it then would return: the array, or the error (with the same message).
  * Small arrays, and a single large one, are left to be decoded when asked; so is everything
  * when the bookkeeping cannot be allocated. fbx_prefetch_drop releases what was not asked
- * for (call it before the next fbx_prefetch and before the document is freed). */
+ * for (call it before the next fbx_prefetch and before the document is freed). fbx_prefetch_take
+ * and fbx_prefetch_drop are in fbx_dom.c, beside the decoder that hands the arrays over. */
 typedef struct fbx_prefetched {
     const fbx_node *node;   /* NULL once handed over */
     fbx_elem elem;

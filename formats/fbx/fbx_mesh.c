@@ -80,8 +80,8 @@ static mk_result read_layer(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *ele
 
 static void free_layer(fbx_doc *doc, layer *l)
 {
-    fbx_release(doc->arena, l->data);
-    fbx_release(doc->arena, l->index);
+    mk_arena_release(doc->arena, l->data);
+    mk_arena_release(doc->arena, l->index);
     l->data = NULL;
     l->index = NULL;
 }
@@ -123,11 +123,11 @@ typedef struct rv_key {
 static mk_result grow_vertices(mk_arena *arena, uint32_t **next, uint32_t **cp, rv_key **keys, size_t *cap, mk_error *err)
 {
     size_t grown = *cap * 2;
-    uint32_t *a = fbx_grow(arena, *next, *cap * sizeof **next, grown * sizeof **next);
+    uint32_t *a = mk_arena_realloc(arena, *next, *cap * sizeof **next, grown * sizeof **next);
     if (a) *next = a;
-    uint32_t *b = a ? fbx_grow(arena, *cp, *cap * sizeof **cp, grown * sizeof **cp) : NULL;
+    uint32_t *b = a ? mk_arena_realloc(arena, *cp, *cap * sizeof **cp, grown * sizeof **cp) : NULL;
     if (b) *cp = b;
-    rv_key *c = b ? fbx_grow(arena, *keys, *cap * sizeof **keys, grown * sizeof **keys) : NULL;
+    rv_key *c = b ? mk_arena_realloc(arena, *keys, *cap * sizeof **keys, grown * sizeof **keys) : NULL;
     if (!c) return mk_error_oom(err, "FBX render vertices");
     *keys = c;
     *cap = grown;
@@ -362,7 +362,7 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
             double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
             for (int k = 0; k < 3; k++) mesh->normals[3 * v + (size_t)k] = len > 0 && isfinite(len) ? (float)(n[k] / len) : 0.0f;
         }
-        fbx_release(arena, acc);
+        mk_arena_release(arena, acc);
     }
 
     /* Control point -> render vertices (CSR, increasing vertex order) for blend shapes. */
@@ -380,28 +380,28 @@ mk_result fbx_build_mesh(fbx_doc *doc, mk_raw_asset *raw, const fbx_node *geomet
 
 done:
     fbx_prefetch_drop(doc);  /* what was not asked for */
-    fbx_release(arena, vertices);
-    fbx_release(arena, polygon_index);
+    mk_arena_release(arena, vertices);
+    mk_arena_release(arena, polygon_index);
     free_layer(doc, &normals);
     free_layer(doc, &uvs);
-    fbx_release(arena, pv_rv);
-    fbx_release(arena, cp_head);
-    fbx_release(arena, rv_next);
-    fbx_release(arena, rv_cp);
-    fbx_release(arena, rv_keys);
+    mk_arena_release(arena, pv_rv);
+    mk_arena_release(arena, cp_head);
+    mk_arena_release(arena, rv_next);
+    mk_arena_release(arena, rv_cp);
+    mk_arena_release(arena, rv_keys);
     if (r != MK_OK) fbx_mesh_map_free(doc, map);
     return r;
 }
 
 void fbx_mesh_map_free(fbx_doc *doc, fbx_mesh_map *map)
 {
-    fbx_release(doc->arena, map->first);
-    fbx_release(doc->arena, map->vertices);
-    fbx_release(doc->arena, map->cp_entry);
-    fbx_release(doc->arena, map->entry_cp);
-    fbx_release(doc->arena, map->sum_pos);
-    fbx_release(doc->arena, map->sum_nrm);
-    fbx_release(doc->arena, map->pairs);
+    mk_arena_release(doc->arena, map->first);
+    mk_arena_release(doc->arena, map->vertices);
+    mk_arena_release(doc->arena, map->cp_entry);
+    mk_arena_release(doc->arena, map->entry_cp);
+    mk_arena_release(doc->arena, map->sum_pos);
+    mk_arena_release(doc->arena, map->sum_nrm);
+    mk_arena_release(doc->arena, map->pairs);
     map->first = map->vertices = NULL;
     map->cp_entry = map->entry_cp = NULL;
     map->sum_pos = map->sum_nrm = NULL;

@@ -5,7 +5,9 @@
  * document (its own decoder and arena; the first worker, the calling thread, the document's
  * arena and spare arrays); the arrays are adopted by the document's arena afterwards. A decode
  * does not depend on which worker runs it, so what fbx_node_array hands over is what it would
- * have decoded itself, error messages included. */
+ * have decoded itself, error messages included. Handing over and dropping the arrays
+ * (fbx_prefetch_take, fbx_prefetch_drop) is the decoder's, in fbx_dom.c: this file only calls
+ * the decoder. */
 #include <string.h>
 #include "fbx_internal.h"
 #include "parallel.h"
@@ -49,8 +51,8 @@ void fbx_prefetch(fbx_doc *doc, const fbx_node *const *nodes, const fbx_elem *el
     fbx_prefetched *items = mk_arena_array(doc->arena, n, sizeof *items);
     prefetch_worker *w = mk_arena_array(doc->arena, workers, sizeof *w);
     if (!items || !w) {
-        fbx_release(doc->arena, items);
-        fbx_release(doc->arena, w);
+        mk_arena_release(doc->arena, items);
+        mk_arena_release(doc->arena, w);
         return;
     }
     n = 0;
@@ -76,31 +78,7 @@ void fbx_prefetch(fbx_doc *doc, const fbx_node *const *nodes, const fbx_elem *el
         fbx_doc_free(&w[k].doc);
         mk_arena_adopt(doc->arena, &w[k].arena);
     }
-    fbx_release(doc->arena, w);
+    mk_arena_release(doc->arena, w);
     doc->prefetched = items;
     doc->prefetched_count = n;
-}
-
-int fbx_prefetch_take(fbx_doc *doc, const fbx_node *node, fbx_elem elem, void **out, size_t *count, mk_result *r)
-{
-    for (uint32_t i = 0; i < doc->prefetched_count; i++) {
-        fbx_prefetched *p = &doc->prefetched[i];
-        if (p->node != node || p->elem != elem) continue;
-        p->node = NULL;
-        *out = p->data;
-        *count = p->count;
-        *r = p->result;
-        if (p->result != MK_OK && doc->err) *doc->err = p->error;
-        return 1;
-    }
-    return 0;
-}
-
-void fbx_prefetch_drop(fbx_doc *doc)
-{
-    for (uint32_t i = 0; i < doc->prefetched_count; i++)
-        if (doc->prefetched[i].node) fbx_release(doc->arena, doc->prefetched[i].data);
-    fbx_release(doc->arena, doc->prefetched);
-    doc->prefetched = NULL;
-    doc->prefetched_count = 0;
 }

@@ -373,12 +373,13 @@ static mk_result bind(scene *s, uint32_t object_index, const char *prop, uint32_
 {
     if (s->binding_count == s->binding_cap) {
         uint32_t cap = s->binding_cap ? s->binding_cap * 2 : 16;
-        binding *b = fbx_grow(s->doc->arena, s->bindings, s->binding_cap * sizeof(binding), cap * sizeof(binding));
+        binding *b =
+            mk_arena_realloc(s->doc->arena, s->bindings, s->binding_cap * sizeof(binding), cap * sizeof(binding));
         if (!b) return mk_error_oom(s->doc->err, "FBX bindings");
         s->bindings = b;
         s->binding_cap = cap;
         /* Rehash into a table of 2 x capacity slots (slot = binding index + 1). */
-        fbx_release(s->doc->arena, s->binding_table);
+        mk_arena_release(s->doc->arena, s->binding_table);
         s->binding_table_size = (size_t)cap * 2;
         s->binding_table = mk_arena_array(s->doc->arena, s->binding_table_size, sizeof(uint32_t));
         if (!s->binding_table) return mk_error_oom(s->doc->err, "FBX bindings");
@@ -572,12 +573,13 @@ static mk_result found_add(scene *s, found_channels *f, const char *name, uint32
     fbx_doc *doc = s->doc;
     if (f->count == f->cap) {
         uint32_t cap = f->cap ? f->cap * 2 : 16;
-        fbx_channel_plan *plans = fbx_grow(doc->arena, f->plans, f->cap * sizeof *plans, cap * sizeof *plans);
+        fbx_channel_plan *plans = mk_arena_realloc(doc->arena, f->plans, f->cap * sizeof *plans, cap * sizeof *plans);
         if (plans) f->plans = plans;
-        channel_key *keys = plans ? fbx_grow(doc->arena, f->keys, f->cap * sizeof *keys, cap * sizeof *keys) : NULL;
+        channel_key *keys =
+            plans ? mk_arena_realloc(doc->arena, f->keys, f->cap * sizeof *keys, cap * sizeof *keys) : NULL;
         if (!keys) {
-            fbx_release(doc->arena, shapes);
-            fbx_release(doc->arena, full_weights);
+            mk_arena_release(doc->arena, shapes);
+            mk_arena_release(doc->arena, full_weights);
             return mk_error_oom(doc->err, "FBX channels");
         }
         f->keys = keys;
@@ -594,11 +596,11 @@ static mk_result found_add(scene *s, found_channels *f, const char *name, uint32
 static void found_free(scene *s, found_channels *f)
 {
     for (uint32_t i = 0; i < f->count; i++) {
-        fbx_release(s->doc->arena, f->plans[i].shapes);
-        fbx_release(s->doc->arena, (void *)f->plans[i].full_weights);
+        mk_arena_release(s->doc->arena, f->plans[i].shapes);
+        mk_arena_release(s->doc->arena, (void *)f->plans[i].full_weights);
     }
-    fbx_release(s->doc->arena, f->plans);
-    fbx_release(s->doc->arena, f->keys);
+    mk_arena_release(s->doc->arena, f->plans);
+    mk_arena_release(s->doc->arena, f->keys);
     memset(f, 0, sizeof *f);
 }
 
@@ -641,7 +643,7 @@ static mk_result find_channels_7x(scene *s, uint32_t geometry, found_channels *f
             mk_result r = vertex_weights ? MK_OK
                           : fbx_child_array(doc, ch->node, "FullWeights", FBX_ELEM_F64, (void **)&full_weights, &fw_count);
             if (r != MK_OK) {
-                fbx_release(doc->arena, shapes);
+                mk_arena_release(doc->arena, shapes);
                 return r;
             }
             channel_key key = { cc->src, "DeformPercent", 13 };
@@ -876,8 +878,8 @@ static mk_result add_track(scene *s, uint32_t clip_index, uint32_t channel, mk_k
     }
     if (clip->track_count == s->track_cap) {
         uint32_t cap = s->track_cap ? s->track_cap * 2 : 8;
-        mk_raw_track *grown = fbx_grow(&s->raw->arena, clip->tracks, clip->track_count * sizeof(mk_raw_track),
-                                       cap * sizeof(mk_raw_track));
+        mk_raw_track *grown = mk_arena_realloc(&s->raw->arena, clip->tracks,
+                                               clip->track_count * sizeof(mk_raw_track), cap * sizeof(mk_raw_track));
         if (!grown) return mk_error_oom(s->doc->err, "FBX tracks");
         clip->tracks = grown;
         s->track_cap = cap;

@@ -68,10 +68,10 @@ static mk_result decode_and_expand(const shape_loop *l, shape_worker *w, shape_j
     if (r == MK_OK && l->options->target_normals != MK_TARGET_NORMALS_NONE)   /* not even decoded */
         r = fbx_child_array(doc, node, "Normals", FBX_ELEM_F64, (void **)&normals, &n_nrm);
     if (r != MK_OK) {
-        fbx_release(doc->arena, weights);
-        fbx_release(doc->arena, indexes);
-        fbx_release(doc->arena, positions);
-        fbx_release(doc->arena, normals);
+        mk_arena_release(doc->arena, weights);
+        mk_arena_release(doc->arena, indexes);
+        mk_arena_release(doc->arena, positions);
+        mk_arena_release(doc->arena, normals);
         return r;
     }
     j->decoded = 1;
@@ -236,8 +236,8 @@ mk_result fbx_add_channels(fbx_doc *doc, mk_raw_asset *raw, const mk_import_opti
     uint32_t workers = mk_parallel_threads(mk_arena_threads(&raw->arena, options->threads), (uint32_t)total);
     l.workers = mk_arena_array(doc->arena, workers, sizeof *l.workers);
     if (!l.jobs || !l.workers) {
-        fbx_release(doc->arena, l.jobs);
-        fbx_release(doc->arena, l.workers);
+        mk_arena_release(doc->arena, l.jobs);
+        mk_arena_release(doc->arena, l.workers);
         return mk_error_oom(doc->err, "FBX shapes");
     }
     size_t n = 0;
@@ -293,7 +293,7 @@ mk_result fbx_add_channels(fbx_doc *doc, mk_raw_asset *raw, const mk_import_opti
     memcpy(doc->spare, l.workers[0].doc.spare, sizeof doc->spare);
     *map = l.workers[0].map;
     for (size_t i = 0; i < total; i++) drop_job_arrays(raw, &l.jobs[i]);  /* after an error: what was not used */
-    fbx_release(doc->arena, l.workers);
-    fbx_release(doc->arena, l.jobs);
+    mk_arena_release(doc->arena, l.workers);
+    mk_arena_release(doc->arena, l.jobs);
     return r;
 }

@@ -10,24 +10,11 @@ include from, then checks every C/C++ source of the repository:
     files, issue numbers);
   - every C/C++ source starts with its SPDX licence line (engines copy sources).
 Prints one line per check and "N passed, N failed"."""
-import os, re, subprocess, sys
+import os, re, subprocess
+
+from structure import check, circles, finish
 
 root = os.environ.get("MORPHKIT_SOURCE_ROOT") or os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-passed = failed = 0
-
-
-def check(name, problems):
-    global passed, failed
-    if problems:
-        failed += 1
-        print("FAIL " + name)
-        for p in problems[:40]:
-            print("     " + p)
-        if len(problems) > 40:
-            print("     ... %d more" % (len(problems) - 40))
-    else:
-        passed += 1
-        print("ok   " + name)
 
 
 # ---- the table ----
@@ -114,31 +101,8 @@ check("each module includes only from the folders its row lists", bad_rule)
 check("only the runtime, the blob writer/reader, the GPU bindings and the blob's tests see runtime/format.h", bad_layout)
 check("the runtime includes only C library headers", bad_runtime)
 
-# ---- circles: files, then modules ----
-def find_cycle(g):
-    color, stack = {}, []
-    def visit(n):
-        color[n] = 1
-        stack.append(n)
-        for m in g.get(n, []):
-            if color.get(m) == 1:
-                return stack[stack.index(m):] + [m]
-            if color.get(m) is None:
-                c = visit(m)
-                if c:
-                    return c
-        stack.pop()
-        color[n] = 2
-        return None
-    for n in list(g):
-        if color.get(n) is None:
-            c = visit(n)
-            if c:
-                return c
-    return None
-
-cycle = find_cycle(graph)
-check("no include circle between files", [" -> ".join(cycle)] if cycle else [])
+# ---- circles: files, then modules (the calls between files: check_calls.py) ----
+check("no include circle between files", [" -> ".join(c) for c in circles(graph)])
 mgraph = {}
 for src, targets in graph.items():
     a = module_of(src)
@@ -146,8 +110,7 @@ for src, targets in graph.items():
         b = module_of(t)
         if a and b and a != b and a != "tests":
             mgraph.setdefault(a, set()).add(b)
-mcycle = find_cycle({k: sorted(v) for k, v in mgraph.items()})
-check("no circle between modules", [" -> ".join(mcycle)] if mcycle else [])
+check("no circle between modules", [" -> ".join(c) for c in circles({k: sorted(v) for k, v in mgraph.items()})])
 
 # ---- licence ----
 missing = [f for f in sources if "SPDX-License-Identifier: MIT" not in open(os.path.join(root, f), errors="replace").readline()]
@@ -166,5 +129,4 @@ for f in files:
             outside.append("%s:%d: %s" % (f, i, line.strip()[:100]))
 check("code and docs cite nothing outside the repository", outside)
 
-print("%d passed, %d failed" % (passed, failed))
-sys.exit(1 if failed else 0)
+finish()
