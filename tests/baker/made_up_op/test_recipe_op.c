@@ -80,6 +80,48 @@ static void made_up_op_is_listed_and_its_fields_checked(void)
     expect_error("{\"op\": \"scale\", \"factor\": 2, \"samples\": 1}", "channels[0].samples: must be an integer in 2..100000");
 }
 
+/* What ops add to a channel's report through their finish: the solver's figures (laplacian) and
+ * the simulated volume curve (shell). */
+typedef struct seen_reports {
+    int count;
+    mk_bake_channel_report r[4];
+} seen_reports;
+
+static void on_channel(void *user, const mk_bake_channel_report *r)
+{
+    seen_reports *seen = user;
+    if (seen->count < 4) seen->r[seen->count++] = *r;
+}
+
+static void ops_report_their_own_figures(void)
+{
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    fixture_grid(&raw, "sheet", 2, 1, 20, 10);
+    fixture_sphere(&raw, "ball", 1, 12, 8);
+    const char *recipe =
+        "{\"channels\": ["
+        " {\"mesh\": \"sheet\", \"op\": \"laplacian\", \"inbetweens\": 1,"
+        "  \"anchors\": {\"min\": [-1, -1, -1], \"max\": [0.01, 2, 1]},"
+        "  \"handles\": [{\"min\": [1.99, -1, -1], \"max\": [3, 2, 1], \"translate\": [0, 0, 0.5]}]},"
+        " {\"mesh\": \"ball\", \"op\": \"shell\", \"frames\": 4, \"dt\": 0.02}]}";
+    seen_reports seen = { 0 };
+    mk_bake_options o = { .channel_done = on_channel, .user = &seen };
+    mk_bake_report rep;
+    mk_error err;
+    mk_result r = mk_bake_recipe(&raw, recipe, strlen(recipe), &o, &rep, &err);
+    CHECK_MSG(r == MK_OK, "bake: %s", err.message);
+    CHECK_EQ_INT(seen.count, 2);
+    if (seen.count == 2) {
+        CHECK_EQ_INT(seen.r[0].factorizations, 1);
+        CHECK(seen.r[0].solves >= 1);
+        CHECK_EQ_INT(seen.r[1].volume_frames, 5);
+        CHECK(seen.r[1].volume_ratios && seen.r[1].volume_ratios[0] == 1);
+        CHECK_NEAR(seen.r[1].frame_seconds, 0.02, 0);
+    }
+    mk_raw_free(&raw);
+}
+
 /* The lists of names errors give (meshes, a source's channels) end with ", ..." while it fits. */
 static void name_lists_stop_before_they_are_cut(void)
 {
@@ -92,4 +134,5 @@ static void name_lists_stop_before_they_are_cut(void)
 
 CHECK_MAIN(CASE(made_up_op_bakes_its_channel),
            CASE(name_lists_stop_before_they_are_cut),
+           CASE(ops_report_their_own_figures),
            CASE(made_up_op_is_listed_and_its_fields_checked))
