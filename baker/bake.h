@@ -54,6 +54,11 @@ typedef struct mk_bake_channel_report {
     uint32_t volume_frames;
     double frame_seconds;
     const uint32_t *key_frames;
+    /* transfer, reported with the first channel of a recipe entry: the correspondence used
+     * ("closest" or "iterative"; NULL otherwise) and, iterative, how far the fitted source's
+     * vertices lie from the target (mean, max; fraction of the target's diagonal). */
+    const char *correspondence;
+    double fit_mean, fit_max;
 } mk_bake_channel_report;
 
 typedef struct mk_bake_options {

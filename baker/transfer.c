@@ -11,8 +11,8 @@
  *   and S'_m = A S_m A^-1 the source triangle's gradient conjugated by the alignment A.
  * - The energy only sees differences of positions: each connected component's translation is
  *   free. One vertex per component (its first welded vertex) is fixed at 0 to make the matrix
- *   definite; after the solve the component is translated so that the mean of its triangles'
- *   centroids matches the mean of the aligned deformed source at their matched points.
+ *   definite; after the solve the component is translated so that its triangles' centroids move
+ *   on average as the source moves at their matched points (mapped by the alignment A).
  * - Target vertices in no matched triangle (loose or only in degenerate triangles) stay at rest.
  */
 #include <math.h>
@@ -30,15 +30,19 @@ struct mk_transfer {
     const mk_raw_mesh *source, *target;
     double A[9], A_inv[9], t[3];
     double *aligned;            /* source rest positions aligned to the target, 3 per vertex */
+    double *fitted;             /* iterative: the aligned source fitted to the target, 3 per vertex */
     double *source_inverse;     /* 9 per source triangle: V^-1 at rest (zeros when degenerate) */
     double *gradient;           /* 9 per source triangle: A S A^-1 of the current shape */
     uint32_t *match;            /* per target triangle: source triangle or UINT32_MAX */
     double *barycentric;        /* 3 per target triangle */
     uint32_t welded;
     uint32_t *weld;             /* render -> welded */
-    uint32_t used_count;        /* matched target triangles */
+    uint32_t used_count;        /* target triangles in a pair */
     uint32_t *used;             /* their target triangle indices */
-    double *coef;               /* 12 per matched triangle: column c, corner q at [4 c + q] */
+    uint32_t *slot;             /* per target triangle: its index in used, UINT32_MAX when in no pair */
+    uint32_t pair_count;        /* (target triangle, source triangle) pairs: every match, both ways */
+    uint32_t (*pairs)[2];       /* used index, source triangle */
+    double *coef;               /* 12 per used triangle: column c, corner q at [4 c + q] */
     uint32_t *unknown;          /* welded -> unknown row, UINT32_MAX when pinned or unused */
     uint32_t *component;        /* welded -> component, UINT32_MAX when in no matched triangle */
     uint32_t component_count;
@@ -49,40 +53,13 @@ struct mk_transfer {
     mk_transfer_stats stats;
 };
 
-/* Inverse of a 3x3 matrix from its cofactors; 0 when singular. */
-static int mat3_inverse(double out[9], const double m[9])
-{
-    double det = mat3_det(m), cof[9];
-    if (!(fabs(det) > 0) || !isfinite(det)) return 0;
-    mat3_cofactor(cof, m);
-    for (int r = 0; r < 3; r++)
-        for (int c = 0; c < 3; c++) out[3 * r + c] = cof[3 * c + r] / det;
-    return 1;
-}
-
-/* Edge matrix [v2 - v1, v3 - v1, v4 - v1] (columns, row-major storage) with the fourth vertex
- * v4 = v1 + n / sqrt(|n|), n = (v2 - v1) x (v3 - v1) (v4 = v1 for a collapsed triangle). */
-static void edge_matrix(double V[9], const double a[3], const double b[3], const double c[3])
-{
-    double e1[3], e2[3], n[3];
-    vec3_sub(e1, b, a);
-    vec3_sub(e2, c, a);
-    vec3_cross(n, e1, e2);
-    double l = vec3_length(n), s = l > 0 ? 1 / sqrt(l) : 0;
-    for (int r = 0; r < 3; r++) {
-        V[3 * r] = e1[r];
-        V[3 * r + 1] = e2[r];
-        V[3 * r + 2] = n[r] * s;
-    }
-}
-
 static void corner(double out[3], const mk_raw_mesh *mesh, uint32_t t, int k)
 {
     const float *p = mesh->positions + 3 * (size_t)mesh->triangles[3 * (size_t)t + k];
     out[0] = p[0]; out[1] = p[1]; out[2] = p[2];
 }
 
-/* Unknown row of corner q (0..2: the welded vertices, 3: the fourth vertex) of matched triangle u. */
+/* Unknown row of corner q (0..2: the welded vertices, 3: the fourth vertex) of used triangle u. */
 static uint32_t variable(const mk_transfer *x, uint32_t u, int q)
 {
     if (q == 3) return x->unknown_count - x->used_count + u;
@@ -108,16 +85,10 @@ static mk_result build_system(mk_transfer *x, mk_error *err)
             x->component[x->weld[tri[k]]] = 0;  /* used; numbered below */
         }
         /* coefficients of T = V~ V^-1 on (v1, v2, v3, v4) per column c */
-        double a3[3], b3[3], c3[3], V[9], W[9];
+        double a3[3], b3[3], c3[3];
         corner(a3, tg, x->used[u], 0); corner(b3, tg, x->used[u], 1); corner(c3, tg, x->used[u], 2);
-        edge_matrix(V, a3, b3, c3);
-        if (!mat3_inverse(W, V))
+        if (!bake_transfer_coefficients(x->coef + 12 * (size_t)u, a3, b3, c3))
             return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "target triangle %u is degenerate", x->used[u]);
-        for (int c = 0; c < 3; c++) {
-            double *k = x->coef + 12 * (size_t)u + 4 * c;
-            k[1] = W[c]; k[2] = W[3 + c]; k[3] = W[6 + c];
-            k[0] = -(k[1] + k[2] + k[3]);
-        }
     }
     /* components (numbered by their smallest welded vertex) and the pinned vertex of each */
     x->component_count = 0;
@@ -140,16 +111,17 @@ static mk_result build_system(mk_transfer *x, mk_error *err)
     if (!x->shift) return mk_error_oom(err, "transfer system");
     mk_arena_release(&x->arena, parent);
 
-    /* normal equations: sum over matched triangles and columns of a_c a_c^T (upper triangle) */
+    /* normal equations: sum over pairs and columns of a_c a_c^T (upper triangle) */
     bake_spd_start(&x->spd, 0, 0);
-    cholmod_triplet *T = cholmod_allocate_triplet(x->unknown_count, x->unknown_count, 30 * (size_t)x->used_count,
+    cholmod_triplet *T = cholmod_allocate_triplet(x->unknown_count, x->unknown_count, 30 * (size_t)x->pair_count,
                                                   1, CHOLMOD_REAL, &x->spd.cm);
     if (!T) return mk_error_oom(err, "transfer system");
     int *ti = T->i, *tj = T->j;
     double *tx = T->x;
     size_t k = 0;
-    for (uint32_t u = 0; u < x->used_count; u++)
+    for (uint32_t pr = 0; pr < x->pair_count; pr++)
         for (int c = 0; c < 3; c++) {
+            uint32_t u = x->pairs[pr][0];
             const double *a = x->coef + 12 * (size_t)u + 4 * c;
             for (int p = 0; p < 4; p++)
                 for (int q = 0; q < 4; q++) {
@@ -162,6 +134,85 @@ static mk_result build_system(mk_transfer *x, mk_error *err)
     mk_result r = bake_spd_factor(&x->spd, &T, 3, err);
     x->stats.factor_seconds = x->spd.factor_seconds;
     return r;
+}
+
+/* Whether the aligned source and the target coincide: every target triangle matched, its centroid
+ * within TRANSFER_COINCIDE of the diagonal from its match. */
+static int coincide(const mk_transfer *x, const double *positions)
+{
+    const mk_raw_mesh *src = x->source, *tg = x->target;
+    double lo[3], hi[3], diagonal;
+    bake_bounds(tg, lo, hi, &diagonal);
+    if (x->stats.unmatched) return 0;
+    for (uint32_t t = 0; t < tg->triangle_count; t++) {
+        const uint32_t *tt = tg->triangles + 3 * (size_t)t, *st = src->triangles + 3 * (size_t)x->match[t];
+        const double *b = x->barycentric + 3 * (size_t)t;
+        double d[3];
+        for (int c = 0; c < 3; c++) {
+            double centroid = 0, on = 0;
+            for (int k = 0; k < 3; k++) {
+                centroid += tg->positions[3 * (size_t)tt[k] + c] / 3.0;
+                on += b[k] * positions[3 * (size_t)st[k] + c];
+            }
+            d[c] = centroid - on;
+        }
+        if (!(vec3_length(d) <= TRANSFER_COINCIDE * diagonal)) return 0;
+    }
+    return 1;
+}
+
+/* The correspondence phase: the aligned source fitted to the target (bake_transfer_register),
+ * then every target triangle matched again at the fitted positions. */
+static mk_result register_source(mk_transfer *x, const mk_transfer_params *params, mk_error *err)
+{
+    static const double default_steps[] = { TRANSFER_DEFAULT_STEPS };
+    const mk_raw_mesh *src = x->source, *tg = x->target;
+    x->fitted = mk_arena_array(&x->arena, 3 * (size_t)src->vertex_count + 1, sizeof(double));
+    if (!x->fitted) return mk_error_oom(err, "transfer registration");
+    memcpy(x->fitted, x->aligned, 3 * (size_t)src->vertex_count * sizeof(double));
+    bake_register_params rp = { src, tg, params->marker_count, params->markers,
+                                params->step_count ? params->step_count : sizeof default_steps / sizeof default_steps[0],
+                                params->step_count ? params->steps : default_steps, 1.0, 0.001 };
+    bake_register_stats rs;
+    mk_result r = bake_transfer_register(&rp, x->fitted, &x->arena, &rs, err);
+    if (r != MK_OK) return r;
+    x->stats.fit_mean = rs.mean_distance;
+    x->stats.fit_max = rs.max_distance;
+    x->stats.marker_distance = rs.marker_distance;
+    x->stats.register_seconds = rs.seconds;
+    x->stats.register_solves = rs.solves;
+    return bake_transfer_correspond(src, x->fitted, tg, NULL, &x->arena, x->match, x->barycentric, &x->stats.flipped,
+                                    &x->stats.unmatched, err);
+}
+
+/* The other direction: every source triangle paired with the target triangle nearest its centroid
+ * among those facing its way, at the fitted positions (unless that pair is a target's match). */
+static mk_result pair_source_triangles(mk_transfer *x, mk_error *err)
+{
+    const mk_raw_mesh *src = x->source, *tg = x->target;
+    double *target_pos = mk_arena_array(&x->arena, 3 * (size_t)tg->vertex_count + 1, sizeof(double));
+    if (!target_pos) return mk_error_oom(err, "transfer pairs");
+    for (size_t i = 0; i < 3 * (size_t)tg->vertex_count; i++) target_pos[i] = tg->positions[i];
+    bake_tri_grid grid;
+    mk_result r = bake_tri_grid_build(&grid, tg, target_pos, &x->arena, err);
+    if (r != MK_OK) return r;
+    for (uint32_t s = 0; s < src->triangle_count; s++) {
+        double n[3], c[3] = { 0, 0, 0 }, b[3];
+        const uint32_t *st = src->triangles + 3 * (size_t)s;
+        mk_face_normal(src, x->fitted, s, n);
+        if (!(vec3_length(n) > 0)) continue;
+        for (int k = 0; k < 3; k++)
+            for (int q = 0; q < 3; q++) c[q] += x->fitted[3 * (size_t)st[k] + q] / 3.0;
+        uint32_t t = bake_tri_grid_closest(&grid, c, n, b, NULL, NULL);
+        if (t == UINT32_MAX || x->match[t] == s) continue;
+        if (x->slot[t] == UINT32_MAX) {
+            x->slot[t] = x->used_count;
+            x->used[x->used_count++] = t;
+        }
+        x->pairs[x->pair_count][0] = x->slot[t];
+        x->pairs[x->pair_count++][1] = s;
+    }
+    return MK_OK;
 }
 
 mk_result mk_transfer_create(const mk_transfer_params *params, const mk_allocator *allocator,
@@ -189,14 +240,18 @@ mk_result mk_transfer_create(const mk_transfer_params *params, const mk_allocato
                                  &x->stats.alignment_residual, err)) != MK_OK) goto fail;
     memcpy(x->stats.alignment, x->A, sizeof x->A);
     memcpy(x->stats.alignment + 9, x->t, sizeof x->t);
-    if (!mat3_inverse(x->A_inv, x->A)) FAIL(mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "markers: singular alignment"));
+    if (!mat3_inverse(x->A_inv, x->A, 0)) FAIL(mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "markers: singular alignment"));
+    size_t ns = src->triangle_count, nt = tg->triangle_count;
     x->aligned = mk_arena_array(&x->arena, 3 * (size_t)src->vertex_count + 1, sizeof(double));
-    x->source_inverse = mk_arena_array(&x->arena, 9 * (size_t)src->triangle_count + 1, sizeof(double));
-    x->gradient = mk_arena_array(&x->arena, 9 * (size_t)src->triangle_count + 1, sizeof(double));
-    x->match = mk_arena_array(&x->arena, (size_t)tg->triangle_count + 1, sizeof(uint32_t));
-    x->barycentric = mk_arena_array(&x->arena, 3 * (size_t)tg->triangle_count + 1, sizeof(double));
-    x->used = mk_arena_array(&x->arena, (size_t)tg->triangle_count + 1, sizeof(uint32_t));
-    if (!x->aligned || !x->source_inverse || !x->gradient || !x->match || !x->barycentric || !x->used)
+    x->source_inverse = mk_arena_array(&x->arena, 9 * ns + 1, sizeof(double));
+    x->gradient = mk_arena_array(&x->arena, 9 * ns + 1, sizeof(double));
+    x->match = mk_arena_array(&x->arena, nt + 1, sizeof(uint32_t));
+    x->barycentric = mk_arena_array(&x->arena, 3 * nt + 1, sizeof(double));
+    x->used = mk_arena_array(&x->arena, nt + 1, sizeof(uint32_t));
+    x->slot = mk_arena_array(&x->arena, nt + 1, sizeof(uint32_t));
+    x->pairs = mk_arena_array(&x->arena, nt + ns + 1, sizeof *x->pairs);
+    if (!x->aligned || !x->source_inverse || !x->gradient || !x->match || !x->barycentric || !x->used || !x->slot ||
+        !x->pairs)
         FAIL(mk_error_oom(err, "transfer"));
     for (uint32_t v = 0; v < src->vertex_count; v++) {
         double p[3] = { src->positions[3 * (size_t)v], src->positions[3 * (size_t)v + 1], src->positions[3 * (size_t)v + 2] };
@@ -206,13 +261,28 @@ mk_result mk_transfer_create(const mk_transfer_params *params, const mk_allocato
     for (uint32_t s = 0; s < src->triangle_count; s++) {
         double a[3], b[3], c[3], V[9];
         corner(a, src, s, 0); corner(b, src, s, 1); corner(c, src, s, 2);
-        edge_matrix(V, a, b, c);
-        if (!mat3_inverse(x->source_inverse + 9 * (size_t)s, V)) memset(x->source_inverse + 9 * (size_t)s, 0, 9 * sizeof(double));
+        bake_transfer_edge_matrix(V, a, b, c);
+        if (!mat3_inverse(x->source_inverse + 9 * (size_t)s, V, TRANSFER_EDGE_MIN_DET))
+            memset(x->source_inverse + 9 * (size_t)s, 0, 9 * sizeof(double));
     }
-    if ((r = bake_transfer_correspond(src, x->aligned, tg, &x->arena, x->match, x->barycentric, &x->stats.flipped,
+    if ((r = bake_transfer_correspond(src, x->aligned, tg, NULL, &x->arena, x->match, x->barycentric, &x->stats.flipped,
                                       &x->stats.unmatched, err)) != MK_OK) goto fail;
-    for (uint32_t t = 0; t < tg->triangle_count; t++)
-        if (x->match[t] != UINT32_MAX) x->used[x->used_count++] = t;
+    int iterative = params->correspondence == MK_TRANSFER_ITERATIVE ||
+                    (params->correspondence == MK_TRANSFER_AUTO && !coincide(x, x->aligned));
+    x->stats.iterative = iterative;
+    if (iterative && (r = register_source(x, params, err)) != MK_OK) goto fail;
+    /* pairs: every target triangle with its match, then (iterative) every source triangle with the
+     * target triangle nearest its centroid at the fitted positions */
+    for (uint32_t t = 0; t < tg->triangle_count; t++) {
+        x->slot[t] = UINT32_MAX;
+        if (x->match[t] == UINT32_MAX) continue;
+        x->slot[t] = x->used_count;
+        x->pairs[x->pair_count][0] = x->used_count;
+        x->pairs[x->pair_count++][1] = x->match[t];
+        x->used[x->used_count++] = t;
+    }
+    if (iterative && (r = pair_source_triangles(x, err)) != MK_OK) goto fail;
+    x->stats.pairs = x->pair_count;
     if (x->used_count == 0)
         FAIL(mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
                           "no target triangle has a source triangle facing its way (are the meshes aligned? give markers)"));
@@ -235,13 +305,13 @@ mk_result mk_transfer_apply(mk_transfer *x, const double *source_positions, doub
     for (size_t i = 0; i < 3 * (size_t)src->vertex_count; i++)
         if (!isfinite(source_positions[i]))
             return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX, "source vertex %zu: position is not finite", i / 3);
-    /* gradients of the matched source triangles, conjugated by the alignment */
-    for (uint32_t u = 0; u < x->used_count; u++) {
-        uint32_t s = x->match[x->used[u]];
+    /* gradients of the paired source triangles, conjugated by the alignment */
+    for (uint32_t pr = 0; pr < x->pair_count; pr++) {
+        uint32_t s = x->pairs[pr][1];
         const uint32_t *tri = src->triangles + 3 * (size_t)s;
         double V[9], S[9];
-        edge_matrix(V, source_positions + 3 * (size_t)tri[0], source_positions + 3 * (size_t)tri[1],
-                    source_positions + 3 * (size_t)tri[2]);
+        bake_transfer_edge_matrix(V, source_positions + 3 * (size_t)tri[0], source_positions + 3 * (size_t)tri[1],
+                                  source_positions + 3 * (size_t)tri[2]);
         mat3_mul(S, V, x->source_inverse + 9 * (size_t)s);
         mat3_mul(S, x->A, S);
         mat3_mul(x->gradient + 9 * (size_t)s, S, x->A_inv);
@@ -249,8 +319,9 @@ mk_result mk_transfer_apply(mk_transfer *x, const double *source_positions, doub
     uint32_t nu = x->unknown_count;
     double *b = x->spd.rhs->x;
     memset(b, 0, 3 * (size_t)nu * sizeof(double));
-    for (uint32_t u = 0; u < x->used_count; u++) {
-        const double *S = x->gradient + 9 * (size_t)x->match[x->used[u]];
+    for (uint32_t pr = 0; pr < x->pair_count; pr++) {
+        uint32_t u = x->pairs[pr][0];
+        const double *S = x->gradient + 9 * (size_t)x->pairs[pr][1];
         for (int q = 0; q < 4; q++) {
             uint32_t row = variable(x, u, q);
             if (row == UINT32_MAX) continue;
@@ -270,26 +341,33 @@ mk_result mk_transfer_apply(mk_transfer *x, const double *source_positions, doub
     memset(x->shift, 0, 4 * (size_t)x->component_count * sizeof(double));
     for (uint32_t u = 0; u < x->used_count; u++) {
         uint32_t t = x->used[u], s = x->match[t];
+        if (s == UINT32_MAX) continue;  /* paired from the source's side only */
         const uint32_t *tt = tg->triangles + 3 * (size_t)t, *st = src->triangles + 3 * (size_t)s;
         const double *bary = x->barycentric + 3 * (size_t)t;
-        double p[3] = { 0, 0, 0 }, q[3];
+        /* the source's displacement at the matched point, in the target's frame */
+        double d[3] = { 0, 0, 0 }, q[3];
         for (int k = 0; k < 3; k++)
-            for (int c = 0; c < 3; c++) p[c] += bary[k] * source_positions[3 * (size_t)st[k] + c];
-        mat3_mul_vec(q, x->A, p);
+            for (int c = 0; c < 3; c++)
+                d[c] += bary[k] * (source_positions[3 * (size_t)st[k] + c] - src->positions[3 * (size_t)st[k] + c]);
+        mat3_mul_vec(q, x->A, d);
         double *sh = x->shift + 4 * (size_t)x->component[x->weld[tt[0]]];
         for (int c = 0; c < 3; c++) {
-            double centroid = 0;
-            for (int k = 0; k < 3; k++) centroid += x->solution[3 * (size_t)x->weld[tt[k]] + c] / 3;
-            sh[c] += q[c] + x->t[c] - centroid;
+            double moved = 0, rest = 0;
+            for (int k = 0; k < 3; k++) {
+                moved += x->solution[3 * (size_t)x->weld[tt[k]] + c] / 3;
+                rest += tg->positions[3 * (size_t)tt[k] + c] / 3.0;
+            }
+            sh[c] += rest + q[c] - moved;
         }
         sh[3] += 1;
     }
     for (uint32_t v = 0; v < tg->vertex_count; v++) {
         uint32_t w = x->weld[v], comp = x->component[w];
+        const double *sh = comp == UINT32_MAX ? NULL : x->shift + 4 * (size_t)comp;
         for (int c = 0; c < 3; c++) {
             size_t i = 3 * (size_t)v + (size_t)c;
-            if (comp == UINT32_MAX) target_positions[i] = tg->positions[i];
-            else target_positions[i] = x->solution[3 * (size_t)w + c] + x->shift[4 * (size_t)comp + c] / x->shift[4 * (size_t)comp + 3];
+            /* a component in no matched triangle, or paired from the source's side only, stays */
+            target_positions[i] = sh && sh[3] > 0 ? x->solution[3 * (size_t)w + c] + sh[c] / sh[3] : tg->positions[i];
         }
     }
     x->stats.solves = x->spd.solves;

@@ -16,11 +16,22 @@
 
 #include "raw.h"
 
+/* How target triangles find their source triangles. */
+typedef enum mk_transfer_correspondence {
+    MK_TRANSFER_AUTO = 0,          /* closest when the aligned meshes coincide, else iterative */
+    MK_TRANSFER_CLOSEST,           /* one pass: each target triangle's nearest aligned source triangle */
+    MK_TRANSFER_ITERATIVE          /* the source fitted to the target first, then matches both ways */
+} mk_transfer_correspondence;
+
 typedef struct mk_transfer_params {
     const mk_raw_mesh *source;     /* rest pose: positions and triangles */
     const mk_raw_mesh *target;
-    uint32_t marker_count;         /* pairs (source vertex, target vertex) aligning the source */
+    uint32_t marker_count;         /* pairs (source vertex, target vertex) aligning the source; with
+                                    * the iterative correspondence they are also held together */
     const uint32_t (*markers)[2];
+    mk_transfer_correspondence correspondence;
+    uint32_t step_count;           /* iterative: the closest-point weights w_C, increasing; 0: the */
+    const double *steps;           /* default (TRANSFER_DEFAULT_STEPS, docs/baking.md) */
 } mk_transfer_params;
 
 typedef struct mk_transfer_stats {
@@ -29,6 +40,13 @@ typedef struct mk_transfer_stats {
     uint32_t flipped;              /* target triangles whose nearest source triangle faced away
                                     * (the nearest compatible one was used instead) */
     uint32_t unmatched;            /* target triangles without any compatible source triangle */
+    uint32_t pairs;                /* (target, source) triangle pairs in the system */
+    int iterative;                 /* the correspondence used: 1 iterative, 0 closest */
+    double fit_mean, fit_max;      /* iterative: distance of the fitted source's vertices to the
+                                    * target (nearest point facing their way), x target diagonal */
+    double marker_distance;        /* iterative: largest marker pair distance after the fit, x diagonal */
+    double register_seconds;       /* iterative: the fit */
+    uint32_t register_solves;
     double alignment[12];          /* the source -> target map: row-major 3x3 A (s R) then t */
     double alignment_residual;     /* RMS marker distance after alignment, mesh units */
     double correspond_seconds;     /* alignment + closest triangles */

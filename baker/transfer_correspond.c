@@ -141,14 +141,7 @@ static int triangle(const mk_raw_mesh *mesh, const double *positions, uint32_t t
     return !(vec3_length(n) > TRANSFER_DEGENERATE * longest);
 }
 
-/* A uniform grid over the aligned source triangles' bounding boxes (CSR: cell -> triangles). */
-typedef struct tri_grid {
-    double lo[3], h;
-    int32_t dims[3];
-    uint32_t *first, *tris;
-} tri_grid;
-
-static void cell_range(const tri_grid *g, const double lo[3], const double hi[3], int32_t a[3], int32_t b[3])
+static void cell_range(const bake_tri_grid *g, const double lo[3], const double hi[3], int32_t a[3], int32_t b[3])
 {
     for (int c = 0; c < 3; c++) {
         double fa = floor((lo[c] - g->lo[c]) / g->h), fb = floor((hi[c] - g->lo[c]) / g->h);
@@ -157,26 +150,43 @@ static void cell_range(const tri_grid *g, const double lo[3], const double hi[3]
     }
 }
 
-static size_t cell_index(const tri_grid *g, int32_t x, int32_t y, int32_t z)
+static size_t cell_index(const bake_tri_grid *g, int32_t x, int32_t y, int32_t z)
 {
     return ((size_t)z * (size_t)g->dims[1] + (size_t)y) * (size_t)g->dims[0] + (size_t)x;
 }
 
-static mk_result build_grid(tri_grid *g, const mk_raw_mesh *source, const double *aligned, const unsigned char *bad,
-                            mk_arena *arena, mk_error *err)
+static void triangle_box(const bake_tri_grid *g, uint32_t s, double lo[3], double hi[3])
 {
-    uint32_t ns = source->triangle_count, live = 0;
+    for (int c = 0; c < 3; c++) { lo[c] = INFINITY; hi[c] = -INFINITY; }
+    for (int k = 0; k < 3; k++)
+        for (int c = 0; c < 3; c++) {
+            double v = g->positions[3 * (size_t)g->mesh->triangles[3 * (size_t)s + k] + c];
+            lo[c] = fmin(lo[c], v);
+            hi[c] = fmax(hi[c], v);
+        }
+}
+
+mk_result bake_tri_grid_build(bake_tri_grid *g, const mk_raw_mesh *mesh, const double *positions, mk_arena *arena,
+                              mk_error *err)
+{
+    uint32_t ns = mesh->triangle_count, live = 0;
+    memset(g, 0, sizeof *g);
+    g->mesh = mesh;
+    g->positions = positions;
+    g->normal = mk_arena_array(arena, 3 * (size_t)ns + 1, sizeof(double));
+    g->bad = mk_arena_array(arena, (size_t)ns + 1, 1);
+    g->seen = mk_arena_array(arena, (size_t)ns + 1, sizeof(uint32_t));
+    if (!g->normal || !g->bad || !g->seen) return mk_error_oom(err, "triangle grid");
+    for (uint32_t s = 0; s < ns; s++) {
+        double v[3][3];
+        g->bad[s] = (unsigned char)triangle(mesh, positions, s, v, g->normal + 3 * (size_t)s);
+    }
     double hi[3], extent_sum = 0;
     for (int c = 0; c < 3; c++) { g->lo[c] = INFINITY; hi[c] = -INFINITY; }
     for (uint32_t s = 0; s < ns; s++) {
-        if (bad[s]) continue;
-        double tlo[3] = { INFINITY, INFINITY, INFINITY }, thi[3] = { -INFINITY, -INFINITY, -INFINITY }, ext = 0;
-        for (int k = 0; k < 3; k++)
-            for (int c = 0; c < 3; c++) {
-                double v = aligned[3 * (size_t)source->triangles[3 * (size_t)s + k] + c];
-                tlo[c] = fmin(tlo[c], v);
-                thi[c] = fmax(thi[c], v);
-            }
+        if (g->bad[s]) continue;
+        double tlo[3], thi[3], ext = 0;
+        triangle_box(g, s, tlo, thi);
         for (int c = 0; c < 3; c++) {
             g->lo[c] = fmin(g->lo[c], tlo[c]);
             hi[c] = fmax(hi[c], thi[c]);
@@ -202,17 +212,12 @@ static mk_result build_grid(tri_grid *g, const mk_raw_mesh *source, const double
     }
     size_t cells = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
     g->first = mk_arena_array(arena, cells + 1, sizeof(uint32_t));
-    if (!g->first) return mk_error_oom(err, "transfer correspondence grid");
+    if (!g->first) return mk_error_oom(err, "triangle grid");
     for (int pass = 0; pass < 2; pass++) {
         for (uint32_t s = 0; s < ns; s++) {
-            if (bad[s]) continue;
-            double tlo[3] = { INFINITY, INFINITY, INFINITY }, thi[3] = { -INFINITY, -INFINITY, -INFINITY };
-            for (int k = 0; k < 3; k++)
-                for (int c = 0; c < 3; c++) {
-                    double v = aligned[3 * (size_t)source->triangles[3 * (size_t)s + k] + c];
-                    tlo[c] = fmin(tlo[c], v);
-                    thi[c] = fmax(thi[c], v);
-                }
+            if (g->bad[s]) continue;
+            double tlo[3], thi[3];
+            triangle_box(g, s, tlo, thi);
             int32_t a[3], b[3];
             cell_range(g, tlo, thi, a, b);
             for (int32_t z = a[2]; z <= b[2]; z++)
@@ -226,7 +231,7 @@ static mk_result build_grid(tri_grid *g, const mk_raw_mesh *source, const double
         if (pass == 0) {
             for (size_t c = 0; c < cells; c++) g->first[c + 1] += g->first[c];
             g->tris = mk_arena_array(arena, (size_t)g->first[cells] + 1, sizeof(uint32_t));
-            if (!g->tris) return mk_error_oom(err, "transfer correspondence grid");
+            if (!g->tris) return mk_error_oom(err, "triangle grid");
         } else {
             /* the fill advanced first[c] to first[c + 1]: shift back */
             for (size_t c = cells; c > 0; c--) g->first[c] = g->first[c - 1];
@@ -236,73 +241,76 @@ static mk_result build_grid(tri_grid *g, const mk_raw_mesh *source, const double
     return MK_OK;
 }
 
-mk_result bake_transfer_correspond(const mk_raw_mesh *source, const double *aligned, const mk_raw_mesh *target,
-                                   mk_arena *arena, uint32_t *match, double *barycentric, uint32_t *flipped,
-                                   uint32_t *unmatched, mk_error *err)
+uint32_t bake_tri_grid_closest(bake_tri_grid *g, const double p[3], const double n[3], double bary[3], double *d2,
+                               int *away_nearer)
 {
-    uint32_t ns = source->triangle_count;
-    double *normal = mk_arena_array(arena, 3 * (size_t)ns + 1, sizeof(double));
-    unsigned char *bad = mk_arena_array(arena, (size_t)ns + 1, 1);
-    uint32_t *seen = mk_arena_array(arena, (size_t)ns + 1, sizeof(uint32_t));  /* query stamp + 1 */
-    if (!normal || !bad || !seen) return mk_error_oom(err, "transfer correspondence");
-    for (uint32_t s = 0; s < ns; s++) {
-        double v[3][3];
-        bad[s] = (unsigned char)triangle(source, aligned, s, v, normal + 3 * (size_t)s);
+    uint32_t match = UINT32_MAX, stamp = ++g->stamp;
+    double best = INFINITY, best_away = INFINITY;
+    bary[0] = bary[1] = bary[2] = 0;
+    int32_t center[3];
+    cell_range(g, p, p, center, center);
+    /* rings of cells at Chebyshev distance k from p's cell, until no unvisited cell can hold
+     * a point nearer than the best compatible one */
+    for (int32_t k = 0;; k++) {
+        for (int32_t z = center[2] - k; z <= center[2] + k; z++)
+            for (int32_t y = center[1] - k; y <= center[1] + k; y++)
+                for (int32_t x = center[0] - k; x <= center[0] + k; x++) {
+                    if (x < 0 || y < 0 || z < 0 || x >= g->dims[0] || y >= g->dims[1] || z >= g->dims[2]) continue;
+                    if (abs(x - center[0]) != k && abs(y - center[1]) != k && abs(z - center[2]) != k) continue;
+                    size_t cell = cell_index(g, x, y, z);
+                    for (uint32_t q = g->first[cell]; q < g->first[cell + 1]; q++) {
+                        uint32_t s = g->tris[q];
+                        if (g->seen[s] == stamp) continue;
+                        g->seen[s] = stamp;
+                        const uint32_t *tri = g->mesh->triangles + 3 * (size_t)s;
+                        double b[3];
+                        double e2 = closest_on_triangle(p, g->positions + 3 * (size_t)tri[0], g->positions + 3 * (size_t)tri[1],
+                                                        g->positions + 3 * (size_t)tri[2], b);
+                        if (vec3_dot(n, g->normal + 3 * (size_t)s) > 0) {
+                            if (e2 < best || (e2 == best && s < match)) { best = e2; match = s; memcpy(bary, b, sizeof b); }
+                        } else if (e2 < best_away) best_away = e2;
+                    }
+                }
+        /* distance from p to the cells not visited yet (sides of the block with cells beyond) */
+        double bound = INFINITY;
+        int more = 0;
+        for (int c = 0; c < 3; c++) {
+            if (center[c] - k > 0) {
+                more = 1;
+                bound = fmin(bound, p[c] - (g->lo[c] + (center[c] - k) * g->h));
+            }
+            if (center[c] + k < g->dims[c] - 1) {
+                more = 1;
+                bound = fmin(bound, g->lo[c] + (center[c] + k + 1) * g->h - p[c]);
+            }
+        }
+        if (!more || (bound > 0 && bound * bound > best)) break;
     }
-    tri_grid g;
-    mk_result r = build_grid(&g, source, aligned, bad, arena, err);
+    if (d2) *d2 = best;
+    if (away_nearer) *away_nearer = best_away < best;
+    return match;
+}
+
+mk_result bake_transfer_correspond(const mk_raw_mesh *source, const double *aligned, const mk_raw_mesh *target,
+                                   const double *target_positions, mk_arena *arena, uint32_t *match,
+                                   double *barycentric, uint32_t *flipped, uint32_t *unmatched, mk_error *err)
+{
+    bake_tri_grid g;
+    mk_result r = bake_tri_grid_build(&g, source, aligned, arena, err);
     if (r != MK_OK) return r;
     *flipped = 0;
     *unmatched = 0;
     for (uint32_t t = 0; t < target->triangle_count; t++) {
         double v[3][3], n[3], p[3];
-        match[t] = UINT32_MAX;
         double *bary = barycentric + 3 * (size_t)t;
+        match[t] = UINT32_MAX;
         bary[0] = bary[1] = bary[2] = 0;
-        if (triangle(target, NULL, t, v, n)) { (*unmatched)++; continue; }
+        if (triangle(target, target_positions, t, v, n)) { (*unmatched)++; continue; }
         for (int c = 0; c < 3; c++) p[c] = (v[0][c] + v[1][c] + v[2][c]) / 3;
-        double best = INFINITY, best_away = INFINITY;
-        int32_t center[3];
-        cell_range(&g, p, p, center, center);
-        /* rings of cells at Chebyshev distance k from p's cell, until no unvisited cell can hold
-         * a point nearer than the best compatible one */
-        for (int32_t k = 0;; k++) {
-            for (int32_t z = center[2] - k; z <= center[2] + k; z++)
-                for (int32_t y = center[1] - k; y <= center[1] + k; y++)
-                    for (int32_t x = center[0] - k; x <= center[0] + k; x++) {
-                        if (x < 0 || y < 0 || z < 0 || x >= g.dims[0] || y >= g.dims[1] || z >= g.dims[2]) continue;
-                        if (abs(x - center[0]) != k && abs(y - center[1]) != k && abs(z - center[2]) != k) continue;
-                        size_t cell = cell_index(&g, x, y, z);
-                        for (uint32_t q = g.first[cell]; q < g.first[cell + 1]; q++) {
-                            uint32_t s = g.tris[q];
-                            if (seen[s] == t + 1) continue;
-                            seen[s] = t + 1;
-                            const uint32_t *tri = source->triangles + 3 * (size_t)s;
-                            double b[3];
-                            double d2 = closest_on_triangle(p, aligned + 3 * (size_t)tri[0], aligned + 3 * (size_t)tri[1],
-                                                            aligned + 3 * (size_t)tri[2], b);
-                            if (vec3_dot(n, normal + 3 * (size_t)s) > 0) {
-                                if (d2 < best || (d2 == best && s < match[t])) { best = d2; match[t] = s; memcpy(bary, b, sizeof b); }
-                            } else if (d2 < best_away) best_away = d2;
-                        }
-                    }
-            /* distance from p to the cells not visited yet (sides of the block with cells beyond) */
-            double bound = INFINITY;
-            int more = 0;
-            for (int c = 0; c < 3; c++) {
-                if (center[c] - k > 0) {
-                    more = 1;
-                    bound = fmin(bound, p[c] - (g.lo[c] + (center[c] - k) * g.h));
-                }
-                if (center[c] + k < g.dims[c] - 1) {
-                    more = 1;
-                    bound = fmin(bound, g.lo[c] + (center[c] + k + 1) * g.h - p[c]);
-                }
-            }
-            if (!more || (bound > 0 && bound * bound > best)) break;
-        }
+        int away_nearer = 0;
+        match[t] = bake_tri_grid_closest(&g, p, n, bary, NULL, &away_nearer);
         if (match[t] == UINT32_MAX) { (*unmatched)++; continue; }
-        if (best_away < best) (*flipped)++;
+        if (away_nearer) (*flipped)++;
     }
     return MK_OK;
 }

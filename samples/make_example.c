@@ -3,11 +3,18 @@
  * channel and a progressive "bend" channel (four in-betweens sampled from an exact bend, so
  * playback follows the curved path), normals computed from the targets, and a clip "wave"
  * animating both. With --ball, a closed icosphere "ball" (642 vertices, no channels) instead:
- * the mesh the shell sample recipe deflates. usage: make_example [--ball] OUT.morph */
+ * the mesh the shell sample recipe deflates. With --heads DIR, the deformation transfer sample
+ * between two characters: DIR/head_template.morph (a head made by code, offline/head.h, as a UV
+ * sphere of 48 rings with six expression channels), DIR/head_character.morph (the same surface
+ * with other proportions, as an icosphere of 2,562 vertices, no channels) and
+ * DIR/transfer_heads.json, the recipe with 12 marker pairs at the same features of both heads.
+ * usage: make_example [--ball] OUT.morph | make_example --heads DIR */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "blob_io.h"
+#include "head.h"
 #include "primitives.h"
 
 #define SEGMENTS 32
@@ -50,10 +57,86 @@ static int write_ball(const char *path)
     return status;
 }
 
+/* Directions of the sample's markers: nose tip, chin, brow centre, eyes, mouth corners, cheeks,
+ * crown and the sides. */
+static const double marker_dirs[12][3] = { { 0, -0.1, 1 }, { 0, -0.75, 0.66 }, { 0, 0.4, 0.92 }, { 0.3, 0.15, 0.94 },
+                                           { -0.3, 0.15, 0.94 }, { 0.35, -0.45, 0.82 }, { -0.35, -0.45, 0.82 },
+                                           { 0.6, -0.2, 0.77 }, { -0.6, -0.2, 0.77 }, { 0, 1, 0 }, { 1, 0, 0 },
+                                           { -1, 0, 0 } };
+
+static uint32_t nearest_dir(const double *dirs, uint32_t n, const double d[3])
+{
+    double best = -INFINITY;
+    uint32_t at = 0;
+    for (uint32_t v = 0; v < n; v++) {
+        double dot = dirs[3 * v] * d[0] + dirs[3 * v + 1] * d[1] + dirs[3 * v + 2] * d[2];
+        if (dot > best) { best = dot; at = v; }
+    }
+    return at;
+}
+
+static int write_asset(mk_raw_asset *raw, const char *path, mk_error *err)
+{
+    void *blob;
+    size_t size;
+    mk_write_report report;
+    return mk_write_blob(raw, NULL, &raw->arena, &blob, &size, &report, err) == MK_OK &&
+           mk_write_file(path, blob, size, err) == MK_OK;
+}
+
+/* The two heads and the recipe that carries the template's expressions onto the character. */
+static int write_heads(const char *dir)
+{
+    mk_raw_asset tpl, chr;
+    mk_raw_init(&tpl, NULL);
+    mk_raw_init(&chr, NULL);
+    double *tdir = NULL, *cdir = NULL;
+    mk_raw_mesh *tm = mk_raw_add_head(&tpl, "template", 48, 1, 0, 0, 1, &tdir);
+    mk_raw_mesh *cm = mk_raw_add_head(&chr, "character", 4, 0, 0.3, 1, 0, &cdir);
+    int ok = tm && cm;
+    char path[4096], json[2048];
+    int n = snprintf(json, sizeof json, "{\n  \"mesh\": \"character\",\n  \"channels\": [\n    { \"op\": \"transfer\", "
+                     "\"source\": \"head_template.morph\", \"prefix\": \"character_\",\n      \"markers\": [");
+    /* a marker pair is one feature on both heads: the template vertex nearest the marker's
+     * direction and the character vertex nearest to it, moved onto the same surface point */
+    for (int m = 0; ok && m < 12; m++) {
+        double l = sqrt(marker_dirs[m][0] * marker_dirs[m][0] + marker_dirs[m][1] * marker_dirs[m][1] +
+                        marker_dirs[m][2] * marker_dirs[m][2]), d[3], surf[3], q[3];
+        for (int c = 0; c < 3; c++) d[c] = marker_dirs[m][c] / l;
+        uint32_t s = nearest_dir(tdir, tm->vertex_count, d), t = nearest_dir(cdir, cm->vertex_count, tdir + 3 * (size_t)s);
+        mk_head_surface(tdir + 3 * (size_t)s, surf);
+        mk_head_warp(1, surf, q);
+        for (int c = 0; c < 3; c++) cm->positions[3 * (size_t)t + c] = (float)q[c];
+        n += snprintf(json + n, sizeof json - (size_t)n, "%s[%u, %u]", m ? ", " : "", s, t);
+    }
+    snprintf(json + n, sizeof json - (size_t)n, "] }\n  ]\n}\n");
+    mk_error err;
+    snprintf(path, sizeof path, "%s/head_template.morph", dir);
+    ok = ok && write_asset(&tpl, path, &err);
+    snprintf(path, sizeof path, "%s/head_character.morph", dir);
+    ok = ok && write_asset(&chr, path, &err);
+    snprintf(path, sizeof path, "%s/transfer_heads.json", dir);
+    ok = ok && mk_write_file(path, json, strlen(json), &err) == MK_OK;
+    if (ok)
+        printf("wrote %s: head_template.morph (%u vertices, %u expression channels), head_character.morph (%u "
+               "vertices), transfer_heads.json\n", dir, tm->vertex_count, (unsigned)MK_HEAD_EXPRESSIONS, cm->vertex_count);
+    else if (tm && cm) fprintf(stderr, "make_example: %s\n", err.message);
+    else fprintf(stderr, "make_example: out of memory\n");
+    free(tdir);
+    free(cdir);
+    mk_raw_free(&tpl);
+    mk_raw_free(&chr);
+    return ok ? 0 : 1;
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 3 && !strcmp(argv[1], "--ball")) return write_ball(argv[2]);
-    if (argc != 2 || argv[1][0] == '-') { fprintf(stderr, "usage: make_example [--ball] OUT.morph\n"); return 2; }
+    if (argc == 3 && !strcmp(argv[1], "--heads")) return write_heads(argv[2]);
+    if (argc != 2 || argv[1][0] == '-') {
+        fprintf(stderr, "usage: make_example [--ball] OUT.morph | make_example --heads DIR\n");
+        return 2;
+    }
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_raw_mesh *m = mk_raw_add_tube(&raw, "tube", SEGMENTS, RINGS);

@@ -176,6 +176,12 @@ static void on_channel(void *user, const mk_bake_channel_report *c)
     if (c->factorizations && !ui->quiet)
         printf("  solver: %u factorization (%.3f s), %u solves (%.4f s each)\n", c->factorizations, c->factor_seconds,
                c->solves, c->solves ? c->solve_seconds / c->solves : 0.0);
+    if (c->correspondence && !ui->quiet) {
+        if (!strcmp(c->correspondence, "iterative"))
+            printf("  correspondence: iterative, the fitted source %.3g (mean) and %.3g (max) x diagonal from the target\n",
+                   c->fit_mean, c->fit_max);
+        else printf("  correspondence: closest (the aligned meshes coincide)\n");
+    }
     if (c->iterations && !ui->quiet)
         printf("  arap: %u iterations (at most %u per evaluation%s), energy %.4g (initial guess %.4g)\n",
                c->iterations, c->max_iterations, c->unconverged ? ", some stopped by the cap" : "",

@@ -6,6 +6,7 @@
 #include <string.h>
 #include "fields.h"
 #include "transfer.h"
+#include "transfer_internal.h"
 
 typedef struct transfer_state {
     mk_raw_asset *source;         /* the loaded source asset (freed by release_transfer) */
@@ -16,7 +17,55 @@ typedef struct transfer_state {
     uint32_t (*markers)[2];
     char prefix[64];              /* prepended to the source channel names */
     int has_default_weight;
+    mk_transfer_correspondence correspondence;
+    uint32_t step_count;          /* the schedule's closest-point weights (0: the default) */
+    double *steps;
+    double fit_tolerance;         /* iterative: largest mean distance of the fit, x diagonal */
 } transfer_state;
+
+/* correspondence ("auto", "closest", "iterative"), schedule (the closest-point weights) and
+ * fit_tolerance (docs/baking.md). */
+static mk_result parse_correspondence(recipe_ctx *ctx, transfer_state *st, const cJSON *ch, const char *path)
+{
+    static const char *const modes[] = { "auto", "closest", "iterative" };
+    const cJSON *mode = cJSON_GetObjectItemCaseSensitive(ch, "correspondence");
+    st->correspondence = MK_TRANSFER_AUTO;
+    if (mode) {
+        int k = -1;
+        for (int i = 0; i < 3 && cJSON_IsString(mode); i++)
+            if (!strcmp(mode->valuestring, modes[i])) k = i;
+        if (k < 0) return recipe_field_error(ctx, path, "correspondence", "must be \"auto\", \"closest\" or \"iterative\"%s", NULL);
+        st->correspondence = (mk_transfer_correspondence)k;
+    }
+    const cJSON *schedule = cJSON_GetObjectItemCaseSensitive(ch, "schedule");
+    if (schedule) {
+        int count = cJSON_IsArray(schedule) ? cJSON_GetArraySize(schedule) : 0;
+        if (count < 1 || count > 16)
+            return recipe_field_error(ctx, path, "schedule", "must be an array of 1..16 closest-point weights%s", NULL);
+        st->steps = mk_arena_array(ctx->scratch, (size_t)count, sizeof(double));
+        if (!st->steps) return mk_error_oom(ctx->err, "schedule");
+        int k = 0;
+        for (const cJSON *e = schedule->child; e; e = e->next, k++) {
+            double v = e->valuedouble;
+            if (!cJSON_IsNumber(e) || !isfinite(v) || !(v > 0) || v > 1e12 || (k > 0 && !(v > st->steps[k - 1]))) {
+                char msg[120];
+                snprintf(msg, sizeof msg, "entry %d must be a weight in (0, 1e12], larger than the previous entry", k);
+                return recipe_field_error(ctx, path, "schedule", "%s", msg);
+            }
+            st->steps[k] = v;
+        }
+        st->step_count = (uint32_t)count;
+    }
+    st->fit_tolerance = TRANSFER_FIT_TOLERANCE;
+    mk_result r = recipe_get_number(ctx, ch, path, "fit_tolerance", &st->fit_tolerance, 0);
+    if (r != MK_OK) return r;
+    if (!(st->fit_tolerance > 0 && st->fit_tolerance < 1))
+        return recipe_field_error(ctx, path, "fit_tolerance", "must be in (0, 1): a fraction of the target's diagonal%s", NULL);
+    if (st->correspondence == MK_TRANSFER_CLOSEST && (schedule || cJSON_HasObjectItem(ch, "fit_tolerance")))
+        return recipe_field_error(ctx, path, schedule ? "schedule" : "fit_tolerance",
+                                  "applies to the iterative correspondence only (correspondence is \"closest\")%s", NULL);
+    return MK_OK;
+}
 
 /* transfer: load the source asset through options.load_asset, pick its mesh and channels, read
  * the markers. The source stays loaded until the bake ends (release_transfer). */
@@ -35,6 +84,8 @@ static mk_result parse_transfer(recipe_ctx *ctx, recipe_channel *plan, const cJS
     if (prefix && (!cJSON_IsString(prefix) || strlen(prefix->valuestring) >= sizeof st->prefix))
         return recipe_field_error(ctx, path, "prefix", "must be a string under 64 bytes%s", NULL);
     if (prefix) snprintf(st->prefix, sizeof st->prefix, "%s", prefix->valuestring);
+    mk_result r = parse_correspondence(ctx, st, ch, path);
+    if (r != MK_OK) return r;
 
     if (recipe_untrusted(ctx)) return recipe_field_error(ctx, path, "source", "files are not read for untrusted recipes%s", NULL);
     const cJSON *item = cJSON_GetObjectItemCaseSensitive(ch, "source");
@@ -57,7 +108,6 @@ static mk_result parse_transfer(recipe_ctx *ctx, recipe_channel *plan, const cJS
     const mk_raw_asset *src = st->source;
     st->source_mesh = 0;
     const cJSON *sm = cJSON_GetObjectItemCaseSensitive(ch, "source_mesh");
-    mk_result r;
     if (sm && (r = recipe_resolve_mesh(ctx, src, sm, path, "source_mesh", &st->source_mesh)) != MK_OK) return r;
     if (st->source_mesh >= src->mesh_count)
         return recipe_field_error(ctx, path, "source", "the asset has no mesh%s", NULL);
@@ -150,11 +200,23 @@ static mk_result bake_transfer(recipe_ctx *ctx, recipe_channel *plan, int index,
     const mk_raw_mesh *smesh = &st->source->meshes[st->source_mesh];
     double t0 = bake_now();
     if (o && o->progress) o->progress(o->user, "transfer: matching triangles", 0);
-    mk_transfer_params tp = { smesh, &raw->meshes[plan->mesh], st->marker_count,
-                              (const uint32_t (*)[2])st->markers };
+    mk_transfer_params tp = { smesh, &raw->meshes[plan->mesh], st->marker_count, (const uint32_t (*)[2])st->markers,
+                              st->correspondence, st->step_count, st->steps };
     mk_transfer *x = NULL;
     mk_error inner;
     mk_result r = mk_transfer_create(&tp, &raw->arena.allocator, &x, &inner);
+    mk_transfer_stats fit;
+    if (r == MK_OK) {
+        mk_transfer_stats_get(x, &fit);
+        if (fit.iterative && fit.fit_mean > st->fit_tolerance) {
+            mk_transfer_destroy(x);
+            return mk_error_set(ctx->err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
+                                "channels[%d].schedule: the fit did not converge: the fitted source lies %.3g of the "
+                                "target's diagonal from it on average (max %.3g; fit_tolerance %.3g): give markers "
+                                "where the meshes differ most, or a larger last weight", index, fit.fit_mean,
+                                fit.fit_max, st->fit_tolerance);
+        }
+    }
     uint32_t solves_before = 0;
     double solve_seconds_before = 0;
     for (uint32_t k = 0; r == MK_OK && k < st->source_channel_count; k++) {
@@ -178,6 +240,11 @@ static mk_result bake_transfer(recipe_ctx *ctx, recipe_channel *plan, int index,
         /* the one factorization is reported with the first channel, each channel its own solves */
         cr.factorizations = k == 0;
         cr.factor_seconds = k == 0 ? st.factor_seconds : 0;
+        if (k == 0) {
+            cr.correspondence = st.iterative ? "iterative" : "closest";
+            cr.fit_mean = st.fit_mean;
+            cr.fit_max = st.fit_max;
+        }
         cr.solves = st.solves - solves_before;
         cr.solve_seconds = st.solve_seconds - solve_seconds_before;
         solves_before = st.solves;
@@ -207,7 +274,8 @@ static void release_transfer(recipe_channel *plan)
     if (st && st->source) mk_raw_free(st->source);
 }
 
-static const char *const transfer_fields[] = { "source", "source_mesh", "channels", "markers", "prefix", NULL };
+static const char *const transfer_fields[] = { "source", "source_mesh", "channels", "markers", "prefix",
+                                               "correspondence", "schedule", "fit_tolerance", NULL };
 
 const recipe_op recipe_op_transfer = { .name = "transfer", .fields = transfer_fields, .parse = parse_transfer,
                                        .bake = bake_transfer, .release = release_transfer };

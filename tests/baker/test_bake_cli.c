@@ -81,6 +81,38 @@ static void transfer_sample_reads_its_source(void)
     mk_arena_free_all(&arena);
 }
 
+/* The transfer sample between two characters (make_example --heads): the template's six expressions
+ * carried onto the character through the iterative correspondence, which the report names. */
+static void heads_sample_carries_the_expressions(void)
+{
+    char dir[1024], in[1100], out[1100], recipe[1100], report[1100];
+    snprintf(dir, sizeof dir, "%s/heads", work);
+    snprintf(in, sizeof in, "%s/head_character.morph", dir);
+    snprintf(out, sizeof out, "%s/character_expressions.morph", dir);
+    snprintf(recipe, sizeof recipe, "%s/transfer_heads.json", dir);
+    snprintf(report, sizeof report, "%s/report.txt", dir);
+    CHECK(run("mkdir -p \"%s\" && \"%s\" --heads \"%s\" > /dev/null", dir, make_example, dir, "") == 0);
+    char cmd[6000];
+    snprintf(cmd, sizeof cmd, "\"%s\" bake \"%s\" --recipe \"%s\" -o \"%s\" > \"%s\"", morphkit, in, recipe, out, report);
+    CHECK(system(cmd) == 0);
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    void *data = NULL, *text = NULL;
+    size_t size = 0, text_size = 0;
+    mk_error err;
+    mk_asset asset;
+    mk_result r = mk_read_file(&arena, out, 1 << 28, &data, &size, &err);
+    if (r == MK_OK) r = mk_asset_open(data, size, &asset, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    if (r == MK_OK) {
+        CHECK_EQ_INT(asset.channel_count, 6);
+        CHECK(mk_find_channel(&asset, "character_jaw_open") >= 0 && mk_find_channel(&asset, "character_nose_wrinkle") >= 0);
+    }
+    CHECK(mk_read_file(&arena, report, 1 << 20, &text, &text_size, &err) == MK_OK &&
+          strstr(text, "correspondence: iterative") != NULL);
+    mk_arena_free_all(&arena);
+}
+
 /* The solver bakes (Laplacian, ARAP: CHOLMOD on the BLAS) give the same bytes on every run. */
 static void solver_bakes_repeat_to_the_byte(void)
 {
@@ -118,6 +150,7 @@ int main(int argc, char **argv)
     if (argc < 5) { fprintf(stderr, "usage: test_bake_cli MORPHKIT MAKE_EXAMPLE RECIPES_DIR WORK_DIR\n"); return 2; }
     morphkit = argv[1]; make_example = argv[2]; recipes = argv[3]; work = argv[4];
     static const check_case cases[] = { CASE(bake_sample_and_open_it), CASE(transfer_sample_reads_its_source),
+                                        CASE(heads_sample_carries_the_expressions),
                                         CASE(solver_bakes_repeat_to_the_byte), CASE(bad_recipe_writes_nothing) };
-    return check_run(cases, 4, 1, argv);
+    return check_run(cases, (int)(sizeof cases / sizeof cases[0]), 1, argv);
 }

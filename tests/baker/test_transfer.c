@@ -106,7 +106,7 @@ static void make_source(mk_raw_asset *src)
 static double transfer_error(const mk_raw_asset *src, const mk_raw_mesh *tg, const uint32_t (*markers)[2],
                              uint32_t marker_count, const double A[9], const double t[3], mk_transfer_stats *st)
 {
-    mk_transfer_params p = { &src->meshes[0], tg, marker_count, markers };
+    mk_transfer_params p = { .source = &src->meshes[0], .target = tg, .marker_count = marker_count, .markers = markers };
     mk_transfer *x = NULL;
     mk_error err;
     mk_result r = mk_transfer_create(&p, NULL, &x, &err);
@@ -225,7 +225,7 @@ static double remeshed_sheet_error(uint32_t n, double *seconds)
         q[0] = a; q[1] = b; q[2] = c; q[3] = b; q[4] = d; q[5] = c;
     }
     double t0 = bake_now();
-    mk_transfer_params p = { &src.meshes[0], tg, 0, NULL };
+    mk_transfer_params p = { .source = &src.meshes[0], .target = tg, .marker_count = 0, .markers = NULL };
     mk_transfer *x = NULL;
     mk_error err;
     mk_result r = mk_transfer_create(&p, NULL, &x, &err);
@@ -283,7 +283,7 @@ static void correspondence_skips_triangles_facing_away(void)
         sm->positions[3 * v + 2] *= 0.05f;
         tg->positions[3 * v + 2] = tg->positions[3 * v + 2] * 0.05f - 0.06f;
     }
-    mk_transfer_params p = { sm, tg, 0, NULL };
+    mk_transfer_params p = { .source = sm, .target = tg, .correspondence = MK_TRANSFER_CLOSEST };  /* the one pass */
     mk_transfer *x = NULL;
     mk_error err;
     mk_result r = mk_transfer_create(&p, NULL, &x, &err);
@@ -375,7 +375,7 @@ static void correspondence_matches_the_exhaustive_search(void)
         p[1] = 0.6f * x + 0.8f * y - 0.2f;
         p[2] += 0.25f;
     }
-    mk_transfer_params prm = { sm, tg, 0, NULL };
+    mk_transfer_params prm = { .source = sm, .target = tg, .correspondence = MK_TRANSFER_CLOSEST };  /* the one pass */
     mk_transfer *x = NULL;
     mk_error err;
     mk_result r = mk_transfer_create(&prm, NULL, &x, &err);
@@ -598,6 +598,19 @@ static void bad_transfer_recipes_name_the_field(void)
     expect_transfer_error(f, "channels[0].prefix: must be a string", 1);
     snprintf(f, sizeof f, "%s, \"sauce\": 3", s);
     expect_transfer_error(f, "channels[0].sauce: unknown field", 1);
+    snprintf(f, sizeof f, "%s, \"correspondence\": \"sideways\"", s);
+    expect_transfer_error(f, "channels[0].correspondence: must be \"auto\", \"closest\" or \"iterative\"", 1);
+    snprintf(f, sizeof f, "%s, \"schedule\": []", s);
+    expect_transfer_error(f, "channels[0].schedule: must be an array of 1..16 closest-point weights", 1);
+    snprintf(f, sizeof f, "%s, \"schedule\": [5, 1]", s);
+    expect_transfer_error(f, "channels[0].schedule: entry 1 must be a weight in (0, 1e12], larger than the previous", 1);
+    snprintf(f, sizeof f, "%s, \"fit_tolerance\": 2", s);
+    expect_transfer_error(f, "channels[0].fit_tolerance: must be in (0, 1)", 1);
+    snprintf(f, sizeof f, "%s, \"correspondence\": \"closest\", \"schedule\": [1]", s);
+    expect_transfer_error(f, "channels[0].schedule: applies to the iterative correspondence only", 1);
+    /* a fit held far from the target: one tiny closest-point weight */
+    snprintf(f, sizeof f, "%s, \"correspondence\": \"iterative\", \"schedule\": [1e-9], \"fit_tolerance\": 1e-9", s);
+    expect_transfer_error(f, "channels[0].schedule: the fit did not converge", 1);
 }
 
 CHECK_MAIN(CASE(transfer_onto_a_copy_reproduces_the_targets),
