@@ -6,12 +6,13 @@
 #include <string.h>
 #include "bake.h"
 #include "cli.h"
+#include "json_write.h"
 #include "pictures.h"
 #include "render.h"
 
 typedef struct bake_args {
     const char *input, *output, *recipe, *depfile, *plot;
-    int precision, quiet, all_meshes;
+    int precision, quiet, all_meshes, json;
     uint64_t threads;
 } bake_args;
 
@@ -42,6 +43,10 @@ static const cli_option options[] = {
       NULL, NULL, 0, 0, 0, 0 },
     { "--quiet", NULL, CLI_FLAG, offsetof(bake_args, quiet),
       "No progress lines and no solver details (results are still printed).", NULL, NULL, 0, 0, 0, 0 },
+    { "--json", NULL, CLI_FLAG, offsetof(bake_args, json),
+      "Print one JSON object instead of the text report: per baked channel its name, op, mesh, targets, evaluations, "
+      "max_error, moved_vertices and seconds (solver ops: factorizations and solves; transfer: correspondence, fit_mean "
+      "and fit_max), then the totals and the blob's bytes and max_position_error.", NULL, NULL, 0, 0, 0, 0 },
 };
 
 const cli_verb cli_verb_bake = {
@@ -76,8 +81,17 @@ typedef struct plot_channel {
     const uint32_t *key_frames;
 } plot_channel;
 
+/* What --json reports of one baked channel. */
+typedef struct json_channel {
+    char name[128], op[32], correspondence[16];
+    uint32_t mesh, targets, evaluations, moved_vertices, factorizations, solves;
+    double max_error, seconds, fit_mean, fit_max;
+} json_channel;
+
 typedef struct bake_ui {
-    int quiet;
+    int quiet, json;
+    json_channel *reports;         /* --json: every baked channel */
+    uint32_t report_count;
     cli_progress progress;
     cli_depfile deps;
     int plot;                      /* keep the curves */
@@ -165,10 +179,75 @@ static void on_progress(void *user, const char *stage, double fraction)
     cli_progress_update(&ui->progress, stage, fraction);
 }
 
+static void keep_report(bake_ui *ui, const mk_bake_channel_report *c)
+{
+    json_channel *grown = realloc(ui->reports, (ui->report_count + 1) * sizeof *grown);
+    if (!grown) { ui->out_of_memory = 1; return; }
+    ui->reports = grown;
+    json_channel *j = &ui->reports[ui->report_count++];
+    memset(j, 0, sizeof *j);
+    snprintf(j->name, sizeof j->name, "%s", c->name);
+    snprintf(j->op, sizeof j->op, "%s", c->op);
+    snprintf(j->correspondence, sizeof j->correspondence, "%s", c->correspondence ? c->correspondence : "");
+    j->mesh = c->mesh;
+    j->targets = c->targets;
+    j->evaluations = c->evaluations;
+    j->moved_vertices = c->moved_vertices;
+    j->factorizations = c->factorizations;
+    j->solves = c->solves;
+    j->max_error = c->max_error;
+    j->seconds = c->seconds;
+    j->fit_mean = c->fit_mean;
+    j->fit_max = c->fit_max;
+}
+
+static void print_json(const bake_ui *ui, const bake_args *a, const mk_bake_report *report, const mk_write_report *wr,
+                       size_t size)
+{
+    json_writer w;
+    json_begin(&w, stdout, 1);
+    json_object(&w, NULL);
+    json_string(&w, "input", a->input);
+    json_string(&w, "output", a->output);
+    json_array(&w, "channels");
+    for (uint32_t i = 0; i < ui->report_count; i++) {
+        const json_channel *j = &ui->reports[i];
+        json_object(&w, NULL);
+        json_string(&w, "name", j->name);
+        json_string(&w, "op", j->op);
+        json_int(&w, "mesh", j->mesh);
+        json_int(&w, "targets", j->targets);
+        json_int(&w, "evaluations", j->evaluations);
+        json_number(&w, "max_error", j->max_error);
+        json_int(&w, "moved_vertices", j->moved_vertices);
+        json_number(&w, "seconds", j->seconds);
+        if (j->factorizations || j->solves) {
+            json_int(&w, "factorizations", j->factorizations);
+            json_int(&w, "solves", j->solves);
+        }
+        if (j->correspondence[0]) {
+            json_string(&w, "correspondence", j->correspondence);
+            if (!strcmp(j->correspondence, "iterative")) {
+                json_number(&w, "fit_mean", j->fit_mean);
+                json_number(&w, "fit_max", j->fit_max);
+            }
+        }
+        json_end_object(&w);
+    }
+    json_end_array(&w);
+    json_int(&w, "channels_added", report->channels_added);
+    json_int(&w, "targets_added", report->targets_added);
+    json_number(&w, "max_error", report->max_error);
+    json_int(&w, "bytes", (long long)size);
+    json_number(&w, "max_position_error", wr->max_position_error);
+    json_end_object(&w);
+}
+
 static void on_channel(void *user, const mk_bake_channel_report *c)
 {
     bake_ui *ui = user;
     if (ui->plot) keep_curve(ui, c);
+    if (ui->json) { keep_report(ui, c); return; }
     printf("channel \"%s\" (%s, mesh %u): %u target%s, %u evaluations, playback error %.3g x diagonal%s, "
            "%u vertices moved, %.3f s\n",
            c->name, c->op, c->mesh, c->targets, c->targets == 1 ? "" : "s", c->evaluations, c->max_error,
@@ -228,7 +307,7 @@ static int run_bake(void *p)
             return status;
     }
 
-    bake_ui ui = { .quiet = a->quiet, .plot = a->plot != NULL };
+    bake_ui ui = { .quiet = a->quiet, .json = a->json, .plot = a->plot != NULL };
     mkr_image img = { 0 };
     mkr_png png = { 0 };
     cli_progress_init(&ui.progress, a->quiet);
@@ -267,12 +346,13 @@ static int run_bake(void *p)
         outs[depfile_out].file.data = dep_text;
         if (!dep_text) { fprintf(stderr, "morphkit bake: out of memory\n"); status = CLI_EXIT_FAILURE; goto done; }
     }
+    if (ui.out_of_memory) { fprintf(stderr, "morphkit bake: out of memory for the report\n"); status = CLI_EXIT_FAILURE; goto done; }
     if (a->plot) {
-        if (ui.out_of_memory) { fprintf(stderr, "morphkit bake: out of memory for --plot\n"); status = CLI_EXIT_FAILURE; goto done; }
         if ((status = draw_plot(verb, &ui, &img, &png, &outs[plot_out])) >= 0) goto done;
     }
     status = cli_write_outputs(verb, outs, out_count);
-    if (status == 0) {
+    if (status == 0 && a->json) print_json(&ui, a, &report, &wr, size);
+    else if (status == 0) {
         printf("%s -> %s: %u channels baked, %u targets, max playback error %.3g x diagonal, %zu bytes\n", a->input,
                a->output, report.channels_added, report.targets_added, report.max_error, size);
         cli_print_write_report(&wr);
@@ -280,6 +360,7 @@ static int run_bake(void *p)
 done:
     free(dep_text);
     free(ui.channels);
+    free(ui.reports);
     mkr_png_free(&png);
     mkr_image_destroy(&img);
     cli_depfile_free(&ui.deps);

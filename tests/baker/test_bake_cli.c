@@ -110,6 +110,13 @@ static void heads_sample_carries_the_expressions(void)
     }
     CHECK(mk_read_file(&arena, report, 1 << 20, &text, &text_size, &err) == MK_OK &&
           strstr(text, "correspondence: iterative") != NULL);
+    /* the same in --json: the correspondence and the fit's residual of the entry's first channel */
+    snprintf(cmd, sizeof cmd, "\"%s\" bake \"%s\" --recipe \"%s\" -o \"%s\" --json > \"%s\"", morphkit, in, recipe, out,
+             report);
+    CHECK(system(cmd) == 0);
+    CHECK(mk_read_file(&arena, report, 1 << 20, &text, &text_size, &err) == MK_OK &&
+          strstr(text, "\"correspondence\": \"iterative\"") != NULL && strstr(text, "\"fit_mean\": ") != NULL &&
+          strstr(text, "\"channels_added\": 6") != NULL);
     mk_arena_free_all(&arena);
 }
 
