@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Bernstein basis, 3x3 solve and damped Newton iteration for the extended FFD lattices.
+/* 3x3 solve and damped Newton iteration for the extended FFD lattices.
  *
  * Newton on a rest map F (Coquillart's extended FFD: a block whose rest shape is not affine has
  * no closed-form local coordinates): q <- q - lambda J(q)^-1 (F(q) - p), lambda = 1, 1/2, 1/4 ...
@@ -9,23 +9,6 @@
 #include <string.h>
 #include "lattice_newton.h"
 #include "bake_util.h"
-
-double bake_bernstein_value(int n, int i, double x)
-{
-    if (i < 0 || i > n) return 0;
-    double binomial = 1;
-    for (int k = 1; k <= i; k++) binomial = binomial * (n - i + k) / k;
-    return binomial * pow(x, i) * pow(1 - x, n - i);
-}
-
-void bake_bernstein(uint32_t points, double x, double *w, double *dw)
-{
-    int deg = (int)points - 1;
-    for (int i = 0; i <= deg; i++) {
-        w[i] = bake_bernstein_value(deg, i, x);
-        dw[i] = deg * (bake_bernstein_value(deg - 1, i - 1, x) - bake_bernstein_value(deg - 1, i, x));
-    }
-}
 
 int bake_solve3(const double J[9], const double b[3], double x[3])
 {
