@@ -72,6 +72,17 @@ static inline void mat3_cofactor(double out[9], const double m[9])
     c[6] = m[1] * m[5] - m[2] * m[4]; c[7] = m[2] * m[3] - m[0] * m[5]; c[8] = m[0] * m[4] - m[1] * m[3];
     for (int i = 0; i < 9; i++) out[i] = c[i];
 }
+/* The inverse cof(m)^T / det m, when |det m| > min_det and det m is finite; else 0 and out
+ * untouched. */
+static inline int mat3_inverse(double out[9], const double m[9], double min_det)
+{
+    double det = mat3_det(m), cof[9];
+    if (!(fabs(det) > min_det) || !isfinite(det)) return 0;
+    mat3_cofactor(cof, m);
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) out[3 * r + c] = cof[3 * c + r] / det;
+    return 1;
+}
 /* Rotation matrix about a unit axis by angle (radians), right-hand rule. */
 static inline void mat3_rotation(double out[9], const double axis[3], double angle)
 {

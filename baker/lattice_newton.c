@@ -12,12 +12,10 @@
 
 int bake_solve3(const double J[9], const double b[3], double x[3])
 {
-    double det = mat3_det(J), size = 0;
+    double size = 0, inverse[9];
     for (int i = 0; i < 9; i++) size = fmax(size, fabs(J[i]));
-    if (!(fabs(det) > 1e-14 * size * size * size)) return 0;
-    double cof[9];
-    mat3_cofactor(cof, J);  /* cof(J) = det(J) J^-T */
-    for (int r = 0; r < 3; r++) x[r] = (cof[r] * b[0] + cof[3 + r] * b[1] + cof[6 + r] * b[2]) / det;
+    if (!mat3_inverse(inverse, J, 1e-14 * size * size * size)) return 0;
+    mat3_mul_vec(x, inverse, b);
     return 1;
 }
 

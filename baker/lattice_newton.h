@@ -8,8 +8,10 @@
 #include <stdint.h>
 #include "raw.h"
 
-/* Solves J x = b for a 3x3 row-major J by Cramer's rule; 0 when J is singular relative to its
- * size (|det J| <= 1e-14 max|J_ij|^3). */
+/* Solves J x = b for a 3x3 row-major J: x = J^-1 b (mat3_inverse, bake_util.h); 0 when J is
+ * singular relative to its size (|det J| <= 1e-14 max|J_ij|^3), where a Newton step would be
+ * huge and the caller holds a coordinate instead. Deformation transfer inverts its edge matrices
+ * with no such cut on purpose (transfer.c). */
 int bake_solve3(const double J[9], const double b[3], double x[3]);
 
 /* A block's rest map F(q) and, when J is not NULL, its Jacobian (row-major, column c = dF/dq_c). */

@@ -49,16 +49,12 @@ struct mk_transfer {
     mk_transfer_stats stats;
 };
 
-/* Inverse of a 3x3 matrix from its cofactors; 0 when singular. */
-static int mat3_inverse(double out[9], const double m[9])
-{
-    double det = mat3_det(m), cof[9];
-    if (!(fabs(det) > 0) || !isfinite(det)) return 0;
-    mat3_cofactor(cof, m);
-    for (int r = 0; r < 3; r++)
-        for (int c = 0; c < 3; c++) out[3 * r + c] = cof[3 * c + r] / det;
-    return 1;
-}
+/* Edge matrices are inverted whenever their determinant is finite and nonzero (mat3_inverse's
+ * min_det 0), not with the lattices' relative cut (bake_solve3): det V = |n|^(3/2), so a cut at
+ * 1e-14 max|V_ij|^3 would call singular the triangles between TRANSFER_DEGENERATE (1e-12 of the
+ * longest edge squared, where the correspondence stops) and about 4.6e-10, and such a source
+ * triangle would hand a zero gradient to the target triangles matched to it. */
+#define EDGE_MATRIX_MIN_DET 0
 
 /* Edge matrix [v2 - v1, v3 - v1, v4 - v1] (columns, row-major storage) with the fourth vertex
  * v4 = v1 + n / sqrt(|n|), n = (v2 - v1) x (v3 - v1) (v4 = v1 for a collapsed triangle). */
@@ -111,7 +107,7 @@ static mk_result build_system(mk_transfer *x, mk_error *err)
         double a3[3], b3[3], c3[3], V[9], W[9];
         corner(a3, tg, x->used[u], 0); corner(b3, tg, x->used[u], 1); corner(c3, tg, x->used[u], 2);
         edge_matrix(V, a3, b3, c3);
-        if (!mat3_inverse(W, V))
+        if (!mat3_inverse(W, V, EDGE_MATRIX_MIN_DET))
             return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "target triangle %u is degenerate", x->used[u]);
         for (int c = 0; c < 3; c++) {
             double *k = x->coef + 12 * (size_t)u + 4 * c;
@@ -189,7 +185,7 @@ mk_result mk_transfer_create(const mk_transfer_params *params, const mk_allocato
                                  &x->stats.alignment_residual, err)) != MK_OK) goto fail;
     memcpy(x->stats.alignment, x->A, sizeof x->A);
     memcpy(x->stats.alignment + 9, x->t, sizeof x->t);
-    if (!mat3_inverse(x->A_inv, x->A)) FAIL(mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "markers: singular alignment"));
+    if (!mat3_inverse(x->A_inv, x->A, 0)) FAIL(mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "markers: singular alignment"));
     x->aligned = mk_arena_array(&x->arena, 3 * (size_t)src->vertex_count + 1, sizeof(double));
     x->source_inverse = mk_arena_array(&x->arena, 9 * (size_t)src->triangle_count + 1, sizeof(double));
     x->gradient = mk_arena_array(&x->arena, 9 * (size_t)src->triangle_count + 1, sizeof(double));
@@ -207,7 +203,7 @@ mk_result mk_transfer_create(const mk_transfer_params *params, const mk_allocato
         double a[3], b[3], c[3], V[9];
         corner(a, src, s, 0); corner(b, src, s, 1); corner(c, src, s, 2);
         edge_matrix(V, a, b, c);
-        if (!mat3_inverse(x->source_inverse + 9 * (size_t)s, V)) memset(x->source_inverse + 9 * (size_t)s, 0, 9 * sizeof(double));
+        if (!mat3_inverse(x->source_inverse + 9 * (size_t)s, V, EDGE_MATRIX_MIN_DET)) memset(x->source_inverse + 9 * (size_t)s, 0, 9 * sizeof(double));
     }
     if ((r = bake_transfer_correspond(src, x->aligned, tg, &x->arena, x->match, x->barycentric, &x->stats.flipped,
                                       &x->stats.unmatched, err)) != MK_OK) goto fail;
