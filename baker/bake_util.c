@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Shared baker helpers: bounds, welding, normals from a deformed surface, the point-map
- * evaluator used by FFD and Barr, timing.
+ * evaluator used by FFD and Barr, the lattices' Bernstein basis, timing.
  *
  * Conventions fixed here:
  * - Normal transform N' = normalize(cof(J) N), cof(J) = det(J) J^-T, never dividing by det J;
@@ -25,6 +25,25 @@ double bake_jacobian_quality(const double J[9])
     if (!(f2 > 0)) return 0;
     double s = sqrt(f2 / 3.0);
     return mat3_det(J) / (s * s * s);
+}
+
+void bake_bernstein(uint32_t points, double x, double *w, double *dw)
+{
+    /* B_i^deg by the triangle recursion B_i^d = (1 - x) B_i^(d-1) + x B_(i-1)^(d-1): no powers,
+     * no binomials, stable for x in [0, 1]; the degree deg-1 values give the derivative. */
+    const int deg = (int)points - 1;
+    double low[BAKE_BERNSTEIN_MAX_POINTS];
+    for (int i = 0; i <= deg; i++) w[i] = 0;
+    w[0] = 1;
+    for (int d = 1; d <= deg; d++) {
+        if (d == deg)
+            for (int i = 0; i < d; i++) low[i] = w[i];
+        for (int i = d; i >= 0; i--)
+            w[i] = (i < d ? (1 - x) * w[i] : 0) + (i > 0 ? x * w[i - 1] : 0);
+    }
+    if (deg == 0) { dw[0] = 0; return; }
+    for (int i = 0; i <= deg; i++)
+        dw[i] = deg * ((i > 0 ? low[i - 1] : 0) - (i < deg ? low[i] : 0));
 }
 
 void bake_bounds(const mk_raw_mesh *mesh, double min[3], double max[3], double *diagonal)

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Small shared pieces of the bakers: 3-vector / 3x3 helpers (double precision, row-major
- * 3x3 as m[3*row + col]), mesh bounding box, and normals recomputed from a deformed surface.
+ * 3x3 as m[3*row + col]), the lattices' Bernstein basis, mesh bounding box, and normals
+ * recomputed from a deformed surface.
  * Internal to baker/ (not installed). */
 #ifndef BAKE_UTIL_H
 #define BAKE_UTIL_H
@@ -97,6 +98,12 @@ static inline void mat3_rotation(double out[9], const double axis[3], double ang
  * deformed surface instead of cof(J) n (docs/baking.md, "Normals"). */
 #define BAKE_DEGENERATE_R 1e-6
 double bake_jacobian_quality(const double J[9]);
+
+/* Bernstein weights B_i^deg(x), deg = points - 1, into w[0 .. points) and their derivatives
+ * d/dx = deg (B_(i-1)^(deg-1) - B_i^(deg-1)) into dw: the basis of every FFD lattice axis that
+ * is not a B-spline (ffd.c, ffd_cylinder.c, ffd_prism.c). 1 <= points <= BAKE_BERNSTEIN_MAX_POINTS. */
+#define BAKE_BERNSTEIN_MAX_POINTS 64
+void bake_bernstein(uint32_t points, double x, double *w, double *dw);
 
 /* Axis-aligned bounds of the mesh's base positions and the diagonal length (> 0 is not
  * guaranteed: a single point has diagonal 0). */

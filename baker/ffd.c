@@ -28,6 +28,7 @@
 #include "bake_util.h"
 
 #define MAX_DIM 64
+_Static_assert(MAX_DIM <= BAKE_BERNSTEIN_MAX_POINTS, "bake_bernstein takes every lattice axis");
 
 void mk_ffd_control_point(const mk_ffd_lattice *f, uint32_t i, uint32_t j, uint32_t k, double out[3])
 {
@@ -79,24 +80,6 @@ void mk_ffd_parameters(const mk_ffd_lattice *f, const double p[3], double stu[3]
     mat3_mul_vec(stu, f->inverse, d);
 }
 
-/* Bernstein basis of degree `deg` at s and its derivative. */
-static void bernstein(int deg, double s, double *B, double *dB)
-{
-    /* B_i^deg by the triangle recursion (stable for s in [0, 1]). */
-    double low[MAX_DIM];
-    for (int i = 0; i <= deg; i++) B[i] = 0;
-    B[0] = 1;
-    for (int d = 1; d <= deg; d++) {
-        if (d == deg)
-            for (int i = 0; i < d; i++) low[i] = B[i];  /* degree deg-1 values */
-        for (int i = d; i >= 0; i--)
-            B[i] = (i < d ? (1 - s) * B[i] : 0) + (i > 0 ? s * B[i - 1] : 0);
-    }
-    if (deg == 0) { dB[0] = 0; return; }
-    for (int i = 0; i <= deg; i++)
-        dB[i] = deg * ((i > 0 ? low[i - 1] : 0) - (i < deg ? low[i] : 0));
-}
-
 /* Uniform cubic B-spline weights of the 4 taps floor(g)-1 .. floor(g)+2 and derivatives
  * (d/dg). */
 static void bspline(double t, double w[4], double dw[4])
@@ -129,9 +112,8 @@ void mk_ffd_map(const void *user, double amplitude, const double p[3], double ou
         for (int a = 0; a < 3; a++)
             if (!(stu[a] >= 0 && stu[a] <= 1)) return;  /* outside: unchanged */
         for (int a = 0; a < 3; a++) {
-            int deg = (int)f->dims[a] - 1;
-            bernstein(deg, stu[a], w[a], dw[a]);
-            taps[a] = deg + 1;
+            bake_bernstein(f->dims[a], stu[a], w[a], dw[a]);
+            taps[a] = (int)f->dims[a];
             first[a] = 0;
             for (int i = 0; i < taps[a]; i++) idx[a][i] = i;
         }

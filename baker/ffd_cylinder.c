@@ -31,6 +31,7 @@
 
 #define PI 3.14159265358979323846
 #define MAX_DIM 64
+_Static_assert(MAX_DIM <= BAKE_BERNSTEIN_MAX_POINTS, "bake_bernstein takes every lattice axis");
 
 mk_result mk_cylinder_prepare(mk_cylinder_lattice *c, mk_error *err)
 {

@@ -39,6 +39,7 @@
 #define MAX_SIDES 64
 #define MAX_DEGREE 16
 #define MAX_LAYERS 64
+_Static_assert(MAX_LAYERS <= BAKE_BERNSTEIN_MAX_POINTS, "bake_bernstein takes every layer count");
 
 mk_result mk_prism_prepare(mk_prism_lattice *c, mk_error *err)
 {

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Bernstein basis, 3x3 solve and damped Newton iteration for the extended FFD lattices.
+/* 3x3 solve and damped Newton iteration for the extended FFD lattices.
  *
  * Newton on a rest map F (Coquillart's extended FFD: a block whose rest shape is not affine has
  * no closed-form local coordinates): q <- q - lambda J(q)^-1 (F(q) - p), lambda = 1, 1/2, 1/4 ...
@@ -10,31 +10,12 @@
 #include "lattice_newton.h"
 #include "bake_util.h"
 
-double bake_bernstein_value(int n, int i, double x)
-{
-    if (i < 0 || i > n) return 0;
-    double binomial = 1;
-    for (int k = 1; k <= i; k++) binomial = binomial * (n - i + k) / k;
-    return binomial * pow(x, i) * pow(1 - x, n - i);
-}
-
-void bake_bernstein(uint32_t points, double x, double *w, double *dw)
-{
-    int deg = (int)points - 1;
-    for (int i = 0; i <= deg; i++) {
-        w[i] = bake_bernstein_value(deg, i, x);
-        dw[i] = deg * (bake_bernstein_value(deg - 1, i - 1, x) - bake_bernstein_value(deg - 1, i, x));
-    }
-}
-
 int bake_solve3(const double J[9], const double b[3], double x[3])
 {
-    double det = mat3_det(J), size = 0;
+    double size = 0, inverse[9];
     for (int i = 0; i < 9; i++) size = fmax(size, fabs(J[i]));
-    if (!(fabs(det) > 1e-14 * size * size * size)) return 0;
-    double cof[9];
-    mat3_cofactor(cof, J);  /* cof(J) = det(J) J^-T */
-    for (int r = 0; r < 3; r++) x[r] = (cof[r] * b[0] + cof[3 + r] * b[1] + cof[6 + r] * b[2]) / det;
+    if (!mat3_inverse(inverse, J, 1e-14 * size * size * size)) return 0;
+    mat3_mul_vec(x, inverse, b);
     return 1;
 }
 

@@ -1,22 +1,17 @@
 /* SPDX-License-Identifier: MIT */
-/* Pieces shared by the extended FFD lattices (ffd_cylinder.c, ffd_prism.c): the Bernstein basis
- * with its derivative, a 3x3 solve, and the damped Newton iteration that inverts a lattice
- * block's rest map. Internal to baker/. */
+/* Pieces shared by the extended FFD lattices (ffd_cylinder.c, ffd_prism.c): a 3x3 solve, and the
+ * damped Newton iteration that inverts a lattice block's rest map (the Bernstein basis they share
+ * with ffd.c is bake_bernstein, bake_util.h). Internal to baker/. */
 #ifndef BAKE_LATTICE_NEWTON_H
 #define BAKE_LATTICE_NEWTON_H
 
 #include <stdint.h>
 #include "raw.h"
 
-/* Bernstein weights of degree points-1 at x (w[0..points-1]) and their derivatives d/dx,
- * deg (B_{i-1}^{deg-1} - B_i^{deg-1}). */
-void bake_bernstein(uint32_t points, double x, double *w, double *dw);
-
-/* Bernstein polynomial C(n, i) x^i (1 - x)^(n - i); 0 for i outside 0..n. */
-double bake_bernstein_value(int n, int i, double x);
-
-/* Solves J x = b for a 3x3 row-major J by Cramer's rule; 0 when J is singular relative to its
- * size (|det J| <= 1e-14 max|J_ij|^3). */
+/* Solves J x = b for a 3x3 row-major J: x = J^-1 b (mat3_inverse, bake_util.h); 0 when J is
+ * singular relative to its size (|det J| <= 1e-14 max|J_ij|^3), where a Newton step would be
+ * huge and the caller holds a coordinate instead. Deformation transfer inverts its edge matrices
+ * with no such cut on purpose (transfer.c). */
 int bake_solve3(const double J[9], const double b[3], double x[3]);
 
 /* A block's rest map F(q) and, when J is not NULL, its Jacobian (row-major, column c = dF/dq_c). */

@@ -22,6 +22,7 @@
 #include <string.h>
 #include "transfer_internal.h"
 #include "bake_util.h"
+#include "mesh_groups.h"
 #include "rotation_fit.h"
 
 static void load(double out[3], const float *p)
@@ -125,7 +126,8 @@ static double closest_on_triangle(const double p[3], const double a[3], const do
 }
 
 /* Corners of triangle t (positions: 3 doubles per vertex, or the mesh's floats when NULL), its
- * unnormalized normal, and whether it is degenerate. */
+ * unnormalized normal (mk_face_normal's, from the corners already loaded), and whether it is
+ * degenerate. */
 static int triangle(const mk_raw_mesh *mesh, const double *positions, uint32_t t, double v[3][3], double n[3])
 {
     double longest = 0;
@@ -136,7 +138,7 @@ static int triangle(const mk_raw_mesh *mesh, const double *positions, uint32_t t
     }
     double e1[3], e2[3], e3[3];
     vec3_sub(e1, v[1], v[0]); vec3_sub(e2, v[2], v[0]); vec3_sub(e3, v[2], v[1]);
-    vec3_cross(n, e1, e2);
+    mk_triangle_normal(v[0], v[1], v[2], n);
     longest = fmax(vec3_dot(e1, e1), fmax(vec3_dot(e2, e2), vec3_dot(e3, e3)));
     return !(vec3_length(n) > TRANSFER_DEGENERATE * longest);
 }

@@ -5,13 +5,14 @@
 #include <math.h>
 #include "transfer_internal.h"
 #include "bake_util.h"
+#include "mesh_groups.h"
 
 void bake_transfer_edge_matrix(double V[9], const double a[3], const double b[3], const double c[3])
 {
     double e1[3], e2[3], n[3];
     vec3_sub(e1, b, a);
     vec3_sub(e2, c, a);
-    vec3_cross(n, e1, e2);
+    mk_triangle_normal(a, b, c, n);
     double l = vec3_length(n), s = l > 0 ? 1 / sqrt(l) : 0;
     for (int r = 0; r < 3; r++) {
         V[3 * r] = e1[r];

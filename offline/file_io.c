@@ -414,7 +414,7 @@ mk_result mk_write_outputs(mk_output *outs, uint32_t count, mk_error *err)
             r = io_error(err, o->path, "cannot open", errno);
             break;
         }
-        int failed = mk_write_fd(fd, o->data, o->size, NULL) != 0;
+        int failed = mk_write_fd(fd, o->data, o->size) != 0;
         int e = errno;
         if (close(fd) != 0 && !failed) {
             failed = 1;

@@ -1,6 +1,9 @@
 /* SPDX-License-Identifier: MIT */
-/* Writing a file's bytes. The tools flush every output to disk before renaming it into place
- * (file_io.c), so a large output's bytes must reach the device before the command ends anyway.
+/* Writing an output's bytes: a regular file's at given offsets (mk_write_fd_at; every file
+ * output goes this way, from file_io.c and output_stream.c), a device's or FIFO's in order
+ * through plain writes (mk_write_fd). The tools flush every file output to disk before renaming
+ * it into place (file_io.c), so a large output's bytes must reach the device before the command
+ * ends anyway.
  * Written through the page cache they are first copied into freshly allocated cache pages, and
  * first use of fresh memory is what such a write mostly costs on a virtual machine whose host
  * backs guest memory lazily (a 48 MB blob: up to 0.26 s of copying, then 0.03 s of flushing;
@@ -75,15 +78,9 @@ static int write_direct(int fd, const uint8_t *data, size_t size, uint64_t at, s
     return 0;
 }
 
-int mk_write_fd(int fd, const void *data, size_t size, size_t *direct_bytes)
+int mk_write_fd(int fd, const void *data, size_t size)
 {
-    const uint8_t *p = data;
-    size_t done = 0;
-    const off_t at = lseek(fd, 0, SEEK_CUR);   /* fails (ESPIPE) on a pipe: no direct part */
-    int r = at < 0 ? 0 : write_direct(fd, p, size, (uint64_t)at, &done);
-    if (direct_bytes) *direct_bytes = done;
-    if (r == 0 && done && lseek(fd, at + (off_t)done, SEEK_SET) < 0) r = -1;
-    return r != 0 ? -1 : write_buffered(fd, p + done, size - done, -1);
+    return write_buffered(fd, data, size, -1);
 }
 
 int mk_write_fd_at(int fd, const void *data, size_t size, uint64_t offset, size_t *direct_bytes)

@@ -130,11 +130,7 @@ void mk_face_normal(const mk_raw_mesh *m, const double *positions, uint32_t t, d
     for (int q = 0; q < 3; q++)
         for (int d = 0; d < 3; d++)
             p[q][d] = positions ? positions[3u * tri[q] + (uint32_t)d] : m->positions[3u * tri[q] + (uint32_t)d];
-    double e1[3] = { p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2] };
-    double e2[3] = { p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2] };
-    out[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    out[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    out[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    mk_triangle_normal(p[0], p[1], p[2], out);
 }
 
 mk_result mk_normal_groups_smooth(const mk_normal_groups *g, const mk_raw_mesh *m, const double *positions,

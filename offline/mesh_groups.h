@@ -39,8 +39,20 @@ uint32_t *mk_mesh_weld(const mk_raw_mesh *mesh, mk_arena *arena, uint32_t *welde
 mk_result mk_normal_groups_build(const mk_raw_mesh *mesh, mk_grouping grouping, mk_arena *arena, mk_normal_groups *out,
                                  mk_error *err);
 
-/* Area-weighted face normal (cross product, length = 2 x area) of triangle t of the mesh at
- * positions (3 doubles per vertex; NULL: the base positions). */
+/* The face normal of triangle (a, b, c): (b - a) x (c - a), not normalized (length = 2 x area),
+ * facing the side from which a, b, c run counterclockwise: the one definition of a face normal
+ * for the offline code and the bakers. Inline, so each caller's floating-point rules apply (the
+ * bakers contract nothing). */
+static inline void mk_triangle_normal(const double a[3], const double b[3], const double c[3], double out[3])
+{
+    const double e1[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] }, e2[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+    out[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    out[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    out[2] = e1[0] * e2[1] - e1[1] * e2[0];
+}
+
+/* mk_triangle_normal of triangle t of the mesh at positions (3 doubles per vertex; NULL: the
+ * base positions). */
 void mk_face_normal(const mk_raw_mesh *mesh, const double *positions, uint32_t t, double out[3]);
 
 /* Unit normals of the mesh deformed to positions (3 doubles per vertex) into normals (3

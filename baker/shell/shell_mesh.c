@@ -67,10 +67,8 @@ void shell_vertex_normals(const shell_mesh *m, const double *x, double *normals)
     memset(normals, 0, 3 * (size_t)m->n * sizeof(double));
     for (uint32_t t = 0; t < m->tri_count; t++) {
         const uint32_t *tri = m->tris + 3 * (size_t)t;
-        double e1[3], e2[3], n[3];
-        vec3_sub(e1, x + 3 * (size_t)tri[1], x + 3 * (size_t)tri[0]);
-        vec3_sub(e2, x + 3 * (size_t)tri[2], x + 3 * (size_t)tri[0]);
-        vec3_cross(n, e1, e2);
+        double n[3];
+        mk_triangle_normal(x + 3 * (size_t)tri[0], x + 3 * (size_t)tri[1], x + 3 * (size_t)tri[2], n);
         for (int k = 0; k < 3; k++)
             for (int c = 0; c < 3; c++) normals[3 * (size_t)tri[k] + c] += n[c];
     }
@@ -108,7 +106,7 @@ mk_result shell_mesh_build(const mk_raw_mesh *mesh, double density, mk_arena *ar
         double d1[3], d2[3], n[3];
         vec3_sub(d1, x1, x0);
         vec3_sub(d2, x2, x0);
-        vec3_cross(n, d1, d2);
+        mk_triangle_normal(x0, x1, x2, n);
         double twice = vec3_normalize(n), l1 = vec3_length(d1);
         if (!(twice > 1e-12 * l1 * l1) || tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
             return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "triangle %u is degenerate (zero area)", t);

@@ -11,6 +11,7 @@
 #include <string.h>
 #include "shell.h"
 #include "bake_util.h"
+#include "mesh_groups.h"
 #include "parallel.h"
 
 typedef struct shell_state {
@@ -246,10 +247,8 @@ static void update_signs(shell_state *s, const double *x, const double *normals)
     const shell_mesh *m = s->m;
     for (uint32_t i = 0; i < s->aniso_count; i++) {
         const uint32_t *tri = m->tris + 3 * (size_t)s->aniso_tris[i];
-        double d1[3], d2[3], n[3], ref[3] = { 0, 0, 0 };
-        vec3_sub(d1, x + 3 * (size_t)tri[1], x + 3 * (size_t)tri[0]);
-        vec3_sub(d2, x + 3 * (size_t)tri[2], x + 3 * (size_t)tri[0]);
-        vec3_cross(n, d1, d2);
+        double n[3], ref[3] = { 0, 0, 0 };
+        mk_triangle_normal(x + 3 * (size_t)tri[0], x + 3 * (size_t)tri[1], x + 3 * (size_t)tri[2], n);
         for (int k = 0; k < 3; k++)
             for (int c = 0; c < 3; c++) ref[c] += normals[3 * (size_t)tri[k] + c];
         s->sign[i] = vec3_dot(n, ref) < 0 ? -1 : 1;

@@ -1,9 +1,10 @@
 /* SPDX-License-Identifier: MIT */
-/* mk_write_fd: every byte arrives, in order, for sizes around the direct-write threshold and the
- * 4096-byte block, from unaligned memory, on the build folder's file system and on tmpfs; large
- * outputs to a regular file go around the page cache where the file system allows it, and the
- * descriptor's flags are left as they were; devices take the ordinary path and their errors
- * come back with errno. mk_write_fd_at: parts at any offsets, in any order, make the file. */
+/* mk_write_fd_at (every file output's way): every byte arrives for sizes around the direct-write
+ * threshold and the 4096-byte block, from unaligned memory, at aligned and unaligned offsets,
+ * on the build folder's file system and on tmpfs; large parts go around the page cache where the
+ * file system allows it, the descriptor's flags and offset are left as they were; parts at any
+ * offsets, in any order, make the file; errors come back with errno. mk_write_fd (devices and
+ * FIFOs): the bytes in order, and a device's error with errno. */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
@@ -82,7 +83,7 @@ static void write_and_compare(const char *dir)
     snprintf(path, sizeof path, "%s/mk_file_write_test.%ld", dir, (long)getpid());
     for (size_t k = 0; k < sizeof sizes / sizeof *sizes; k++)
         for (size_t prefix = 0; prefix <= 2; prefix += 2) {
-            /* With a 2-byte prefix the offset is not aligned: everything goes the ordinary way. */
+            /* After a 2-byte prefix the offset is not aligned: everything goes the ordinary way. */
             const size_t size = sizes[k];
             int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
             CHECK(fd >= 0);
@@ -90,9 +91,9 @@ static void write_and_compare(const char *dir)
             CHECK(write(fd, "ab", prefix) == (ssize_t)prefix);
             size_t went_direct = 99;
             const int flags_before = fcntl(fd, F_GETFL);
-            CHECK_EQ_INT(mk_write_fd(fd, data, size, &went_direct), 0);
+            CHECK_EQ_INT(mk_write_fd_at(fd, data, size, prefix, &went_direct), 0);
             CHECK_EQ_INT(fcntl(fd, F_GETFL), flags_before);
-            CHECK_EQ_INT(lseek(fd, 0, SEEK_CUR), (long long)(size + prefix));
+            CHECK_EQ_INT(lseek(fd, 0, SEEK_CUR), (long long)prefix);
             size_t expect = direct && !prefix && size >= MK_WRITE_DIRECT_MIN ? size & ~(size_t)4095 : 0;
             CHECK_MSG(went_direct == expect, "%s, %zu bytes after %zu: %zu direct, expected %zu", dir, size, prefix,
                       went_direct, expect);
@@ -133,20 +134,47 @@ static void errors_come_back(void)
     CHECK(data != NULL);
     if (!data) return;
     int fd = open("/dev/full", O_WRONLY);
-    if (fd >= 0) {   /* a device: the ordinary path, and its error */
+    if (fd >= 0) {   /* a device: written in place, and its error comes back */
         errno = 0;
-        CHECK_EQ_INT(mk_write_fd(fd, data, size, &went_direct), -1);
+        CHECK_EQ_INT(mk_write_fd(fd, data, size), -1);
         CHECK_EQ_INT(errno, ENOSPC);
-        CHECK_EQ_INT(went_direct, 0);
         close(fd);
     }
     fd = open(".", O_RDONLY);   /* not open for writing */
     CHECK(fd >= 0);
     errno = 0;
-    CHECK_EQ_INT(mk_write_fd(fd, data, size, NULL), -1);
+    CHECK_EQ_INT(mk_write_fd(fd, data, size), -1);
     CHECK(errno != 0);
     close(fd);
+    /* a regular file open for reading only: the direct write is refused, the ordinary one fails */
+    char path[512];
+    snprintf(path, sizeof path, "./mk_file_write_ro.%ld", (long)getpid());
+    fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    CHECK(fd >= 0 && close(fd) == 0);
+    fd = open(path, O_RDONLY);
+    CHECK(fd >= 0);
+    errno = 0;
+    CHECK_EQ_INT(mk_write_fd_at(fd, data, size, 0, &went_direct), -1);
+    CHECK_EQ_INT(errno, EBADF);
+    CHECK_EQ_INT(went_direct, 0);
+    close(fd);
+    unlink(path);
     free(data);
+}
+
+/* mk_write_fd: the bytes in order at the descriptor's offset (the way of a FIFO). */
+static void bytes_in_order_through_a_pipe(void)
+{
+    int p[2];
+    CHECK(pipe(p) == 0);
+    static const char first[] = "first ", second[] = "second";
+    CHECK_EQ_INT(mk_write_fd(p[1], first, 6), 0);
+    CHECK_EQ_INT(mk_write_fd(p[1], second, 6), 0);
+    close(p[1]);
+    char got[16] = { 0 };
+    CHECK_EQ_INT(read(p[0], got, sizeof got), 12);
+    CHECK(memcmp(got, "first second", 12) == 0);
+    close(p[0]);
 }
 
 /* mk_write_fd_at: parts written out of order, at aligned and unaligned offsets, make the file;
@@ -186,4 +214,5 @@ static void parts_at_offsets(void)
     free(data);
 }
 
-CHECK_MAIN(CASE(every_byte_arrives_in_order), CASE(errors_come_back), CASE(parts_at_offsets))
+CHECK_MAIN(CASE(every_byte_arrives_in_order), CASE(errors_come_back), CASE(bytes_in_order_through_a_pipe),
+           CASE(parts_at_offsets))

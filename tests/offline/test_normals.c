@@ -1,11 +1,42 @@
 /* SPDX-License-Identifier: MIT */
 /* Target normals computed from target positions: they equal normals computed from scratch
  * on the deformed mesh (property), UV-seam duplicates smooth together, hard edges stay hard,
- * tangents stay orthogonal to the new normals, and any thread count gives the same bytes. */
+ * tangents stay orthogonal to the new normals, and any thread count gives the same bytes. The
+ * face normal they and the bakers build on faces the counterclockwise side, twice the area long. */
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
 #include "fixtures.h"
+#include "mesh_groups.h"
+
+/* mk_triangle_normal: (b - a) x (c - a); mk_face_normal: the same of a mesh's triangle, from
+ * its floats or from given doubles. */
+static void test_face_normal_faces_the_counterclockwise_side(void)
+{
+    const double a[3] = { 1, 1, 1 }, b[3] = { 3, 1, 1 }, c[3] = { 1, 4, 1 };
+    double n[3];
+    mk_triangle_normal(a, b, c, n);
+    CHECK(n[0] == 0 && n[1] == 0 && n[2] == 6);   /* +z, twice the area 3 */
+    mk_triangle_normal(a, c, b, n);
+    CHECK(n[0] == 0 && n[1] == 0 && n[2] == -6);
+    const double p[3] = { 0.1, -0.2, 0.3 }, q[3] = { 0.7, 0.4, -0.5 }, r[3] = { -0.3, 0.9, 0.2 };
+    mk_triangle_normal(p, q, r, n);
+    const double e1[3] = { q[0] - p[0], q[1] - p[1], q[2] - p[2] }, e2[3] = { r[0] - p[0], r[1] - p[1], r[2] - p[2] };
+    CHECK(n[0] == e1[1] * e2[2] - e1[2] * e2[1] && n[1] == e1[2] * e2[0] - e1[0] * e2[2] &&
+          n[2] == e1[0] * e2[1] - e1[1] * e2[0]);
+    static float positions[] = { 0, 0, 0, 0, 1, 0, 1, 0, 0 };
+    static uint32_t triangles[] = { 0, 1, 2 };
+    mk_raw_mesh m = { 0 };
+    m.vertex_count = 3;
+    m.positions = positions;
+    m.triangle_count = 1;
+    m.triangles = triangles;
+    mk_face_normal(&m, NULL, 0, n);
+    CHECK(n[0] == 0 && n[1] == 0 && n[2] == -1);   /* clockwise seen from +z */
+    const double moved[9] = { 0, 0, 0, 0, 2, 0, 0, 0, 2 };
+    mk_face_normal(&m, moved, 0, n);
+    CHECK(n[0] == 4 && n[1] == 0 && n[2] == 0);
+}
 
 
 /* A flat 5x5 grid (normals +z, tangents +x) whose centre control point is duplicated for a
@@ -233,7 +264,7 @@ static void test_same_result_for_any_thread_count(void)
     mk_raw_free(&replacing);
 }
 
-CHECK_MAIN(CASE(test_matches_recomputed_normals), CASE(test_authored_tangents_follow_their_vertex),
+CHECK_MAIN(CASE(test_face_normal_faces_the_counterclockwise_side), CASE(test_matches_recomputed_normals), CASE(test_authored_tangents_follow_their_vertex),
            CASE(test_targets_in_turn_on_one_thread),
            CASE(test_hard_edge_stays_hard),
            CASE(test_same_result_for_any_thread_count))
