@@ -6,14 +6,18 @@
  * - Unknowns: the position-welded target vertices (render vertices with bit-identical positions
  *   are one vertex, so seams do not tear) and one fourth vertex per matched target triangle;
  *   the three coordinates share the matrix and are solved as three right-hand sides.
- * - Energy: sum over matched target triangles of |T_j - S'_m(j)|_F^2, unweighted as in the
- *   paper, with T_j = V~_j V_j^-1 (V_j: the target's rest edge matrix, fourth vertex included)
- *   and S'_m = A S_m A^-1 the source triangle's gradient conjugated by the alignment A.
+ * - Energy: sum over the (target triangle j, source triangle m) pairs of |T_j - S'_m|_F^2,
+ *   unweighted as in the paper, with T_j = V~_j V_j^-1 (V_j: the target's rest edge matrix,
+ *   fourth vertex included) and S'_m = A S_m A^-1 the source triangle's gradient conjugated by
+ *   the alignment A. The pairs: every target triangle with its match, and with the iterative
+ *   correspondence also every source triangle with the target triangle nearest its fitted
+ *   centroid (transfer_register.c fits the source first).
  * - The energy only sees differences of positions: each connected component's translation is
  *   free. One vertex per component (its first welded vertex) is fixed at 0 to make the matrix
  *   definite; after the solve the component is translated so that its triangles' centroids move
  *   on average as the source moves at their matched points (mapped by the alignment A).
- * - Target vertices in no matched triangle (loose or only in degenerate triangles) stay at rest.
+ * - Target vertices in no paired triangle (loose or only in degenerate triangles) stay at rest,
+ *   and so does a component paired from the source's side only (its translation is unknown).
  */
 #include <math.h>
 #include <stdio.h>
@@ -31,6 +35,8 @@ struct mk_transfer {
     double A[9], A_inv[9], t[3];
     double *aligned;            /* source rest positions aligned to the target, 3 per vertex */
     double *fitted;             /* iterative: the aligned source fitted to the target, 3 per vertex */
+    unsigned char *rest_degenerate; /* per source triangle: no area at rest (aligned), so no gradient */
+    bake_tri_grid target_grid;  /* iterative: the target's triangles, for the fit and the pairing */
     double *source_inverse;     /* 9 per source triangle: V^-1 at rest (zeros when degenerate) */
     double *gradient;           /* 9 per source triangle: A S A^-1 of the current shape */
     uint32_t *match;            /* per target triangle: source triangle or UINT32_MAX */
@@ -136,15 +142,18 @@ static mk_result build_system(mk_transfer *x, mk_error *err)
     return r;
 }
 
-/* Whether the aligned source and the target coincide: every target triangle matched, its centroid
- * within TRANSFER_COINCIDE of the diagonal from its match. */
+/* Whether the aligned source and the target coincide: every target triangle with an area matched,
+ * its centroid within TRANSFER_COINCIDE of the diagonal from its match. */
 static int coincide(const mk_transfer *x, const double *positions)
 {
     const mk_raw_mesh *src = x->source, *tg = x->target;
     double lo[3], hi[3], diagonal;
     bake_bounds(tg, lo, hi, &diagonal);
-    if (x->stats.unmatched) return 0;
     for (uint32_t t = 0; t < tg->triangle_count; t++) {
+        if (x->match[t] == UINT32_MAX) {
+            if (bake_triangle_degenerate(tg, NULL, t)) continue;  /* no equation either way */
+            return 0;
+        }
         const uint32_t *tt = tg->triangles + 3 * (size_t)t, *st = src->triangles + 3 * (size_t)x->match[t];
         const double *b = x->barycentric + 3 * (size_t)t;
         double d[3];
@@ -170,40 +179,37 @@ static mk_result register_source(mk_transfer *x, const mk_transfer_params *param
     x->fitted = mk_arena_array(&x->arena, 3 * (size_t)src->vertex_count + 1, sizeof(double));
     if (!x->fitted) return mk_error_oom(err, "transfer registration");
     memcpy(x->fitted, x->aligned, 3 * (size_t)src->vertex_count * sizeof(double));
-    bake_register_params rp = { src, tg, params->marker_count, params->markers,
+    bake_register_params rp = { src, tg, &x->target_grid, params->marker_count, params->markers,
                                 params->step_count ? params->step_count : sizeof default_steps / sizeof default_steps[0],
                                 params->step_count ? params->steps : default_steps, 1.0, 0.001 };
     bake_register_stats rs;
-    mk_result r = bake_transfer_register(&rp, x->fitted, &x->arena, &rs, err);
+    mk_result r = bake_transfer_register(&rp, x->fitted, &x->arena.allocator, &rs, err);
     if (r != MK_OK) return r;
     x->stats.fit_mean = rs.mean_distance;
     x->stats.fit_max = rs.max_distance;
     x->stats.marker_distance = rs.marker_distance;
     x->stats.register_seconds = rs.seconds;
     x->stats.register_solves = rs.solves;
-    return bake_transfer_correspond(src, x->fitted, tg, NULL, &x->arena, x->match, x->barycentric, &x->stats.flipped,
-                                    &x->stats.unmatched, err);
+    /* source triangles without an area at rest have no gradient: they match nothing */
+    return bake_transfer_correspond(src, x->fitted, x->rest_degenerate, tg, NULL, &x->arena, x->match, x->barycentric,
+                                    &x->stats.flipped, &x->stats.unmatched, err);
 }
 
 /* The other direction: every source triangle paired with the target triangle nearest its centroid
  * among those facing its way, at the fitted positions (unless that pair is a target's match). */
 static mk_result pair_source_triangles(mk_transfer *x, mk_error *err)
 {
-    const mk_raw_mesh *src = x->source, *tg = x->target;
-    double *target_pos = mk_arena_array(&x->arena, 3 * (size_t)tg->vertex_count + 1, sizeof(double));
-    if (!target_pos) return mk_error_oom(err, "transfer pairs");
-    for (size_t i = 0; i < 3 * (size_t)tg->vertex_count; i++) target_pos[i] = tg->positions[i];
-    bake_tri_grid grid;
-    mk_result r = bake_tri_grid_build(&grid, tg, target_pos, &x->arena, err);
-    if (r != MK_OK) return r;
+    const mk_raw_mesh *src = x->source;
+    (void)err;
     for (uint32_t s = 0; s < src->triangle_count; s++) {
         double n[3], c[3] = { 0, 0, 0 }, b[3];
         const uint32_t *st = src->triangles + 3 * (size_t)s;
+        if (x->rest_degenerate[s]) continue;
         mk_face_normal(src, x->fitted, s, n);
         if (!(vec3_length(n) > 0)) continue;
         for (int k = 0; k < 3; k++)
             for (int q = 0; q < 3; q++) c[q] += x->fitted[3 * (size_t)st[k] + q] / 3.0;
-        uint32_t t = bake_tri_grid_closest(&grid, c, n, b, NULL, NULL);
+        uint32_t t = bake_tri_grid_closest(&x->target_grid, c, n, b, NULL, NULL);
         if (t == UINT32_MAX || x->match[t] == s) continue;
         if (x->slot[t] == UINT32_MAX) {
             x->slot[t] = x->used_count;
@@ -212,6 +218,25 @@ static mk_result pair_source_triangles(mk_transfer *x, mk_error *err)
         x->pairs[x->pair_count][0] = x->slot[t];
         x->pairs[x->pair_count++][1] = s;
     }
+    return MK_OK;
+}
+
+/* The grid over the target's triangles that the fit and the pairing search. */
+static mk_result build_target_grid(mk_transfer *x, mk_error *err)
+{
+    const mk_raw_mesh *tg = x->target;
+    double *target_pos = mk_arena_array(&x->arena, 3 * (size_t)tg->vertex_count + 1, sizeof(double));
+    if (!target_pos) return mk_error_oom(err, "transfer target grid");
+    for (size_t i = 0; i < 3 * (size_t)tg->vertex_count; i++) target_pos[i] = tg->positions[i];
+    return bake_tri_grid_build(&x->target_grid, tg, target_pos, NULL, &x->arena, err);
+}
+
+/* Positions must be finite (the searches and the solves assume it). */
+static mk_result check_finite(const mk_raw_mesh *mesh, const char *which, mk_error *err)
+{
+    for (size_t i = 0; i < 3 * (size_t)mesh->vertex_count; i++)
+        if (!isfinite(mesh->positions[i]))
+            return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX, "%s vertex %zu: position is not finite", which, i / 3);
     return MK_OK;
 }
 
@@ -225,6 +250,9 @@ mk_result mk_transfer_create(const mk_transfer_params *params, const mk_allocato
             return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
                                 "markers[%u]: vertex out of range (source has %u, target %u vertices)", i,
                                 src->vertex_count, tg->vertex_count);
+    mk_result r0 = check_finite(src, "source", err);
+    if (r0 == MK_OK) r0 = check_finite(tg, "target", err);
+    if (r0 != MK_OK) return r0;
     mk_arena arena;
     mk_arena_init(&arena, allocator);
     mk_transfer *x = mk_arena_alloc(&arena, sizeof *x);
@@ -250,8 +278,9 @@ mk_result mk_transfer_create(const mk_transfer_params *params, const mk_allocato
     x->used = mk_arena_array(&x->arena, nt + 1, sizeof(uint32_t));
     x->slot = mk_arena_array(&x->arena, nt + 1, sizeof(uint32_t));
     x->pairs = mk_arena_array(&x->arena, nt + ns + 1, sizeof *x->pairs);
+    x->rest_degenerate = mk_arena_array(&x->arena, ns + 1, 1);
     if (!x->aligned || !x->source_inverse || !x->gradient || !x->match || !x->barycentric || !x->used || !x->slot ||
-        !x->pairs)
+        !x->pairs || !x->rest_degenerate)
         FAIL(mk_error_oom(err, "transfer"));
     for (uint32_t v = 0; v < src->vertex_count; v++) {
         double p[3] = { src->positions[3 * (size_t)v], src->positions[3 * (size_t)v + 1], src->positions[3 * (size_t)v + 2] };
@@ -260,17 +289,18 @@ mk_result mk_transfer_create(const mk_transfer_params *params, const mk_allocato
     }
     for (uint32_t s = 0; s < src->triangle_count; s++) {
         double a[3], b[3], c[3], V[9];
+        x->rest_degenerate[s] = (unsigned char)bake_triangle_degenerate(src, x->aligned, s);
         corner(a, src, s, 0); corner(b, src, s, 1); corner(c, src, s, 2);
         bake_transfer_edge_matrix(V, a, b, c);
         if (!mat3_inverse(x->source_inverse + 9 * (size_t)s, V, TRANSFER_EDGE_MIN_DET))
             memset(x->source_inverse + 9 * (size_t)s, 0, 9 * sizeof(double));
     }
-    if ((r = bake_transfer_correspond(src, x->aligned, tg, NULL, &x->arena, x->match, x->barycentric, &x->stats.flipped,
-                                      &x->stats.unmatched, err)) != MK_OK) goto fail;
+    if ((r = bake_transfer_correspond(src, x->aligned, NULL, tg, NULL, &x->arena, x->match, x->barycentric,
+                                      &x->stats.flipped, &x->stats.unmatched, err)) != MK_OK) goto fail;
     int iterative = params->correspondence == MK_TRANSFER_ITERATIVE ||
                     (params->correspondence == MK_TRANSFER_AUTO && !coincide(x, x->aligned));
     x->stats.iterative = iterative;
-    if (iterative && (r = register_source(x, params, err)) != MK_OK) goto fail;
+    if (iterative && ((r = build_target_grid(x, err)) != MK_OK || (r = register_source(x, params, err)) != MK_OK)) goto fail;
     /* pairs: every target triangle with its match, then (iterative) every source triangle with the
      * target triangle nearest its centroid at the fitted positions */
     for (uint32_t t = 0; t < tg->triangle_count; t++) {

@@ -7,11 +7,10 @@
  *   rotation maximizes sum (q_i - mean q) . R (p_i - mean p) (Horn), the scale is Umeyama's
  *   s = sum (q_i - mean q) . R (p_i - mean p) / sum |p_i - mean p|^2. Collinear markers leave the
  *   rotation about their line undetermined (the fit returns one of them).
- * - The match is the closest-point correspondence of one pass (not the paper's iterative
- *   closest-valid-point deformation of the source onto the target): for the centroid c of each
- *   target triangle, the aligned source triangle with the nearest closest point to c, among the
- *   source triangles whose normal makes an angle below 90 degrees with the target triangle's;
- *   ties go to the lower source triangle index.
+ * - The match (of the one pass, and of the iterative correspondence at the fitted positions,
+ *   transfer_register.c): for the centroid c of each target triangle, the source triangle with
+ *   the nearest closest point to c, among the source triangles whose normal makes an angle below
+ *   90 degrees with the target triangle's; ties go to the lower source triangle index.
  * - The search visits a uniform grid over the source triangles' bounding boxes (cells about
  *   twice a triangle's extent, at most about 8 cells per triangle) ring by ring around the
  *   centroid's cell, and stops when the cells not visited yet are all farther than the best
@@ -168,8 +167,14 @@ static void triangle_box(const bake_tri_grid *g, uint32_t s, double lo[3], doubl
         }
 }
 
-mk_result bake_tri_grid_build(bake_tri_grid *g, const mk_raw_mesh *mesh, const double *positions, mk_arena *arena,
-                              mk_error *err)
+int bake_triangle_degenerate(const mk_raw_mesh *mesh, const double *positions, uint32_t t)
+{
+    double v[3][3], n[3];
+    return triangle(mesh, positions, t, v, n);
+}
+
+mk_result bake_tri_grid_build(bake_tri_grid *g, const mk_raw_mesh *mesh, const double *positions,
+                              const unsigned char *exclude, mk_arena *arena, mk_error *err)
 {
     uint32_t ns = mesh->triangle_count, live = 0;
     memset(g, 0, sizeof *g);
@@ -181,7 +186,7 @@ mk_result bake_tri_grid_build(bake_tri_grid *g, const mk_raw_mesh *mesh, const d
     if (!g->normal || !g->bad || !g->seen) return mk_error_oom(err, "triangle grid");
     for (uint32_t s = 0; s < ns; s++) {
         double v[3][3];
-        g->bad[s] = (unsigned char)triangle(mesh, positions, s, v, g->normal + 3 * (size_t)s);
+        g->bad[s] = (unsigned char)(triangle(mesh, positions, s, v, g->normal + 3 * (size_t)s) || (exclude && exclude[s]));
     }
     double hi[3], extent_sum = 0;
     for (int c = 0; c < 3; c++) { g->lo[c] = INFINITY; hi[c] = -INFINITY; }
@@ -249,6 +254,9 @@ uint32_t bake_tri_grid_closest(bake_tri_grid *g, const double p[3], const double
     uint32_t match = UINT32_MAX, stamp = ++g->stamp;
     double best = INFINITY, best_away = INFINITY;
     bary[0] = bary[1] = bary[2] = 0;
+    if (d2) *d2 = INFINITY;
+    if (away_nearer) *away_nearer = 0;
+    if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) return UINT32_MAX;
     int32_t center[3];
     cell_range(g, p, p, center, center);
     /* rings of cells at Chebyshev distance k from p's cell, until no unvisited cell can hold
@@ -293,12 +301,13 @@ uint32_t bake_tri_grid_closest(bake_tri_grid *g, const double p[3], const double
     return match;
 }
 
-mk_result bake_transfer_correspond(const mk_raw_mesh *source, const double *aligned, const mk_raw_mesh *target,
-                                   const double *target_positions, mk_arena *arena, uint32_t *match,
-                                   double *barycentric, uint32_t *flipped, uint32_t *unmatched, mk_error *err)
+mk_result bake_transfer_correspond(const mk_raw_mesh *source, const double *aligned, const unsigned char *exclude,
+                                   const mk_raw_mesh *target, const double *target_positions, mk_arena *arena,
+                                   uint32_t *match, double *barycentric, uint32_t *flipped, uint32_t *unmatched,
+                                   mk_error *err)
 {
     bake_tri_grid g;
-    mk_result r = bake_tri_grid_build(&g, source, aligned, arena, err);
+    mk_result r = bake_tri_grid_build(&g, source, aligned, exclude, arena, err);
     if (r != MK_OK) return r;
     *flipped = 0;
     *unmatched = 0;

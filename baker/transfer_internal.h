@@ -26,25 +26,31 @@ typedef struct bake_tri_grid {
     int32_t dims[3];
     uint32_t *first, *tris;    /* CSR: cell -> triangles */
 } bake_tri_grid;
-mk_result bake_tri_grid_build(bake_tri_grid *g, const mk_raw_mesh *mesh, const double *positions, mk_arena *arena,
-                              mk_error *err);
+/* exclude (may be NULL): triangles to leave out as well (1 each). */
+mk_result bake_tri_grid_build(bake_tri_grid *g, const mk_raw_mesh *mesh, const double *positions,
+                              const unsigned char *exclude, mk_arena *arena, mk_error *err);
+/* Whether triangle t of mesh at positions (NULL: the mesh's own) is degenerate: twice its area
+ * at most TRANSFER_DEGENERATE of its longest edge squared. */
+int bake_triangle_degenerate(const mk_raw_mesh *mesh, const double *positions, uint32_t t);
 /* The triangle whose closest point to p is nearest among those whose normal makes a positive dot
  * product with n (ties: the lower index), the barycentric coordinates of that point and its
  * squared distance (d2 may be NULL); UINT32_MAX when none faces n's way. *away_nearer (may be
  * NULL): whether a triangle facing away was nearer. The same answer as trying every triangle:
- * rings of cells around p's cell until the cells not visited are all farther than the best. */
+ * rings of cells around p's cell until the cells not visited are all farther than the best. A
+ * point that is not finite matches nothing. */
 uint32_t bake_tri_grid_closest(bake_tri_grid *g, const double p[3], const double n[3], double bary[3], double *d2,
                                int *away_nearer);
 
 /* Per target triangle: the source triangle (at the positions `aligned`, 3 doubles per source
- * vertex) whose closest point to the target triangle's centroid is nearest among those facing the
+ * vertex; those with exclude[s] set left out, exclude may be NULL) whose closest point to the target triangle's centroid is nearest among those facing the
  * same way (normals with a positive dot product), and the barycentric coordinates of that closest
  * point. match[t] = UINT32_MAX for a degenerate target triangle or when no source triangle faces
  * its way (counted in *unmatched); *flipped counts triangles whose nearest source triangle overall
  * faced away. target_positions: 3 doubles per target vertex, NULL for the mesh's own. */
-mk_result bake_transfer_correspond(const mk_raw_mesh *source, const double *aligned, const mk_raw_mesh *target,
-                                   const double *target_positions, mk_arena *arena, uint32_t *match,
-                                   double *barycentric, uint32_t *flipped, uint32_t *unmatched, mk_error *err);
+mk_result bake_transfer_correspond(const mk_raw_mesh *source, const double *aligned, const unsigned char *exclude,
+                                   const mk_raw_mesh *target, const double *target_positions, mk_arena *arena,
+                                   uint32_t *match, double *barycentric, uint32_t *flipped, uint32_t *unmatched,
+                                   mk_error *err);
 
 /* The correspondence phase of Sumner & Popovic (2004), section 5 (transfer_register.c): the source,
  * starting at `deformed` (its aligned rest positions, 3 doubles per source vertex), is deformed
@@ -53,10 +59,12 @@ mk_result bake_transfer_correspond(const mk_raw_mesh *source, const double *alig
  * E_I = sum of |T_i - I|_F^2 (identity), E_C = sum over vertices of |v_i - c_i|^2 / L^2 (c_i the
  * closest point of the target whose triangle faces the vertex normal's way, L the target's
  * bounding-box diagonal), the marker vertices held at their target vertices. One solve with
- * w_C = 0, then one per weight of the schedule (closest points found again before each), all
- * with one symbolic factorization. On return `deformed` holds the fitted source. */
+ * w_C = 0 (components without a marker held where they are), then one per weight of the schedule
+ * (closest points found again before each), all with one symbolic factorization; working memory
+ * from allocator, freed before returning. On return `deformed` holds the fitted source. */
 typedef struct bake_register_params {
     const mk_raw_mesh *source, *target;
+    bake_tri_grid *target_grid;    /* over the target's triangles at its positions */
     uint32_t marker_count;
     const uint32_t (*markers)[2];
     uint32_t step_count;           /* closest-point weights w_C, increasing */
@@ -69,7 +77,7 @@ typedef struct bake_register_stats {
     uint32_t solves, factorizations;
     double seconds;
 } bake_register_stats;
-mk_result bake_transfer_register(const bake_register_params *params, double *deformed, mk_arena *arena,
+mk_result bake_transfer_register(const bake_register_params *params, double *deformed, const mk_allocator *allocator,
                                  bake_register_stats *stats, mk_error *err);
 
 /* Edge matrix [v2 - v1, v3 - v1, v4 - v1] (columns, row-major storage) with the fourth vertex

@@ -120,17 +120,20 @@ static void vertex_normals(const reg *g, double *render, double *normals)
     }
 }
 
-mk_result bake_transfer_register(const bake_register_params *p, double *deformed, mk_arena *arena,
+mk_result bake_transfer_register(const bake_register_params *p, double *deformed, const mk_allocator *allocator,
                                  bake_register_stats *stats, mk_error *err)
 {
     const mk_raw_mesh *src = p->source, *tg = p->target;
     double t0 = bake_now();
     memset(stats, 0, sizeof *stats);
+    mk_arena scratch;
+    mk_arena_init(&scratch, allocator);
+    mk_arena *arena = &scratch;
     reg g;
     memset(&g, 0, sizeof g);
     g.p = p;
     g.weld = mk_mesh_weld(src, arena, &g.welded);
-    if (!g.weld) return mk_error_oom(err, "registration");
+    if (!g.weld) { mk_arena_free_all(&scratch); return mk_error_oom(err, "registration"); }
     size_t nw = g.welded, ns = src->triangle_count;
     g.var = mk_arena_array(arena, nw + 1, sizeof(uint32_t));
     g.fixed = mk_arena_array(arena, 3 * nw + 1, sizeof(double));
@@ -139,20 +142,15 @@ mk_result bake_transfer_register(const bake_register_params *p, double *deformed
     g.coef = mk_arena_array(arena, 12 * ns + 1, sizeof(double));
     double *normals = mk_arena_array(arena, 3 * nw + 1, sizeof(double));
     double *closest = mk_arena_array(arena, 3 * nw + 1, sizeof(double));
-    double *target_pos = mk_arena_array(arena, 3 * (size_t)tg->vertex_count + 1, sizeof(double));
-    if (!g.var || !g.fixed || !g.pos || !g.tri || !g.coef || !normals || !closest || !target_pos)
+    uint32_t *parent = mk_arena_array(arena, nw + 1, sizeof(uint32_t));
+    unsigned char *anchored = mk_arena_array(arena, nw + 1, 1);  /* per welded root: the component has a marker */
+    const double *target_pos = p->target_grid->positions;
+    if (!g.var || !g.fixed || !g.pos || !g.tri || !g.coef || !normals || !closest || !parent || !anchored) {
+        mk_arena_free_all(&scratch);
         return mk_error_oom(err, "registration");
+    }
     for (uint32_t v = 0; v < src->vertex_count; v++)
         memcpy(g.pos + 3 * (size_t)g.weld[v], deformed + 3 * (size_t)v, 3 * sizeof(double));
-    for (size_t i = 0; i < 3 * (size_t)tg->vertex_count; i++) target_pos[i] = tg->positions[i];
-    for (size_t w = 0; w < nw; w++) g.var[w] = 0;
-    for (uint32_t m = 0; m < p->marker_count; m++) {
-        uint32_t w = g.weld[p->markers[m][0]];
-        g.var[w] = UINT32_MAX;
-        memcpy(g.fixed + 3 * (size_t)w, target_pos + 3 * (size_t)p->markers[m][1], 3 * sizeof(double));
-    }
-    for (size_t w = 0; w < nw; w++)
-        if (g.var[w] != UINT32_MAX) g.var[w] = g.free_count++;
     /* live triangles and the coefficients of T = V~ V^-1 at the start */
     for (uint32_t s = 0; s < ns; s++) {
         const uint32_t *t = src->triangles + 3 * (size_t)s;
@@ -161,11 +159,33 @@ mk_result bake_transfer_register(const bake_register_params *p, double *deformed
                                         deformed + 3 * (size_t)t[1], deformed + 3 * (size_t)t[2])) continue;
         g.tri[g.live++] = s;
     }
-    if (g.live == 0) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "source mesh has no triangle with an area");
+    /* held: the markers' vertices (at their target vertices) and the vertices in no live triangle
+     * (where they are); the components (over live triangles) that hold a marker */
+    for (size_t w = 0; w < nw; w++) { g.var[w] = UINT32_MAX; parent[w] = (uint32_t)w; }
+    memcpy(g.fixed, g.pos, 3 * nw * sizeof(double));
+    for (uint32_t u = 0; u < g.live; u++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t a = bake_find_root(parent, corner_welded(&g, u, k)), b = bake_find_root(parent, corner_welded(&g, u, (k + 1) % 3));
+            if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+            g.var[corner_welded(&g, u, k)] = 0;
+        }
+    memset(anchored, 0, nw);
+    for (uint32_t m = 0; m < p->marker_count; m++) {
+        uint32_t w = g.weld[p->markers[m][0]];
+        g.var[w] = UINT32_MAX;
+        memcpy(g.fixed + 3 * (size_t)w, target_pos + 3 * (size_t)p->markers[m][1], 3 * sizeof(double));
+        anchored[bake_find_root(parent, w)] = 1;
+    }
+    for (size_t w = 0; w < nw; w++)
+        if (g.var[w] != UINT32_MAX) g.var[w] = g.free_count++;
+    if (g.live == 0) {
+        mk_arena_free_all(&scratch);
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "source mesh has no triangle with an area");
+    }
     g.unknowns = g.free_count + g.live;
     /* smoothness pairs: triangles sharing a welded edge, adjacent in (edge, triangle) order */
     edge_ref *edges = mk_arena_array(arena, 3 * (size_t)g.live + 1, sizeof *edges);
-    if (!edges) return mk_error_oom(err, "registration");
+    if (!edges) { mk_arena_free_all(&scratch); return mk_error_oom(err, "registration"); }
     for (uint32_t u = 0; u < g.live; u++)
         for (int k = 0; k < 3; k++) {
             uint32_t a = corner_welded(&g, u, k), b = corner_welded(&g, u, (k + 1) % 3);
@@ -181,7 +201,8 @@ mk_result bake_transfer_register(const bake_register_params *p, double *deformed
     bake_spd spd;
     memset(&spd, 0, sizeof spd);
     bake_spd_start(&spd, 0, 1);
-    size_t cap = 30 * (size_t)g.live + 3 * 36 * pairs + g.free_count + 1;
+    /* identity: 10 entries (upper triangle of 4 unknowns) per column; smoothness: 21 (6 unknowns) */
+    size_t cap = 30 * (size_t)g.live + 3 * 21 * pairs + g.free_count + 1;
     cholmod_triplet *T = cholmod_allocate_triplet(g.unknowns, g.unknowns, cap, 1, CHOLMOD_REAL, &spd.cm);
     double *rhs_base = mk_arena_array(arena, 3 * (size_t)g.unknowns + 1, sizeof(double));
     mk_result r = MK_OK;
@@ -222,20 +243,19 @@ mk_result bake_transfer_register(const bake_register_params *p, double *deformed
             diag[v] = (size_t)q;
         }
     }
-    bake_tri_grid grid;
-    if ((r = bake_tri_grid_build(&grid, tg, target_pos, arena, err)) != MK_OK) goto done;
+    bake_tri_grid *grid = p->target_grid;
     double lo[3], hi[3], diagonal;
     bake_bounds(tg, lo, hi, &diagonal);
     if (!(diagonal > 0)) diagonal = 1;
     uint32_t first = p->marker_count ? 0 : 1;
     for (uint32_t level = first; level <= p->step_count; level++) {
-        double w = level == 0 ? 0 : p->steps[level - 1] / (diagonal * diagonal);
+        double w = level == 0 ? 0 : p->steps[level - 1] / (diagonal * diagonal), hold = 1 / (diagonal * diagonal);
         if (level > 0) {  /* closest valid points at the current positions */
             vertex_normals(&g, deformed, normals);
             for (size_t v = 0; v < nw; v++) {
                 double b[3];
                 uint32_t t = g.var[v] == UINT32_MAX ? UINT32_MAX
-                                                    : bake_tri_grid_closest(&grid, g.pos + 3 * v, normals + 3 * v, b, NULL, NULL);
+                                                    : bake_tri_grid_closest(grid, g.pos + 3 * v, normals + 3 * v, b, NULL, NULL);
                 if (t == UINT32_MAX) { memcpy(closest + 3 * v, g.pos + 3 * v, 3 * sizeof(double)); continue; }
                 const uint32_t *tt = tg->triangles + 3 * (size_t)t;
                 for (int c = 0; c < 3; c++)
@@ -246,14 +266,21 @@ mk_result bake_transfer_register(const bake_register_params *p, double *deformed
         /* the weight changed: factor again, with the first analysis (the same pattern) */
         if (!A && !(A = cholmod_copy_sparse(A0, &spd.cm))) { r = mk_error_oom(err, "registration system"); goto done; }
         memcpy(A->x, A0->x, (size_t)((const int *)A0->p)[A0->ncol] * sizeof(double));  /* packed: p[n] entries */
-        for (uint32_t v = 0; v < g.free_count; v++) ((double *)A->x)[diag[v]] += w;
+        /* at the first solve (w_C = 0) a component without a marker would be free to move: it is
+         * held where it is with the weight 1 / L^2 */
+        for (size_t v = 0; v < nw; v++)
+            if (g.var[v] != UINT32_MAX)
+                ((double *)A->x)[diag[g.var[v]]] += level == 0 && !anchored[bake_find_root(parent, (uint32_t)v)] ? hold : w;
         if ((r = level == first ? bake_spd_factor_matrix(&spd, A, 3, err) : bake_spd_refactor(&spd, A, err)) != MK_OK)
             goto done;
         double *b = spd.rhs->x;
         memcpy(b, rhs_base, 3 * (size_t)g.unknowns * sizeof(double));
-        for (size_t v = 0; v < nw; v++)
-            if (g.var[v] != UINT32_MAX)
-                for (int c = 0; c < 3; c++) b[(size_t)c * g.unknowns + g.var[v]] += w * closest[3 * v + c];
+        for (size_t v = 0; v < nw; v++) {
+            if (g.var[v] == UINT32_MAX) continue;
+            int held = level == 0 && !anchored[bake_find_root(parent, (uint32_t)v)];
+            for (int c = 0; c < 3; c++)
+                b[(size_t)c * g.unknowns + g.var[v]] += held ? hold * g.pos[3 * v + c] : w * closest[3 * v + c];
+        }
         if ((r = bake_spd_solve(&spd, err)) != MK_OK) goto done;
         const double *x = spd.x->x;
         for (size_t v = 0; v < nw; v++)
@@ -266,7 +293,7 @@ mk_result bake_transfer_register(const bake_register_params *p, double *deformed
     uint32_t counted = 0;
     for (size_t v = 0; v < nw; v++) {
         double b[3], d2;
-        if (bake_tri_grid_closest(&grid, g.pos + 3 * v, normals + 3 * v, b, &d2, NULL) == UINT32_MAX) continue;
+        if (bake_tri_grid_closest(grid, g.pos + 3 * v, normals + 3 * v, b, &d2, NULL) == UINT32_MAX) continue;
         double d = sqrt(d2) / diagonal;
         sum += d;
         counted++;
@@ -287,6 +314,7 @@ done:
     if (A0) cholmod_free_sparse(&A0, &spd.cm);
     if (T) cholmod_free_triplet(&T, &spd.cm);
     bake_spd_finish(&spd);
+    mk_arena_free_all(&scratch);
     stats->seconds = bake_now() - t0;
     return r;
 }

@@ -107,6 +107,39 @@ void mk_head_expression(uint32_t k, double w, const double p[3], double out[3])
     for (int c = 0; c < 3; c++) out[c] = p[c] + d[c];
 }
 
+static const double marker_dirs[12][3] = { { 0, -0.1, 1 }, { 0, -0.75, 0.66 }, { 0, 0.4, 0.92 }, { 0.3, 0.15, 0.94 },
+                                           { -0.3, 0.15, 0.94 }, { 0.35, -0.45, 0.82 }, { -0.35, -0.45, 0.82 },
+                                           { 0.6, -0.2, 0.77 }, { -0.6, -0.2, 0.77 }, { 0, 1, 0 }, { 1, 0, 0 },
+                                           { -1, 0, 0 } };
+
+static uint32_t nearest_dir(const double *dirs, uint32_t n, const double d[3])
+{
+    double best = -INFINITY, u[3] = { d[0], d[1], d[2] };
+    unit(u);
+    uint32_t at = 0;
+    for (uint32_t v = 0; v < n; v++) {
+        double dot = dirs[3 * v] * u[0] + dirs[3 * v + 1] * u[1] + dirs[3 * v + 2] * u[2];
+        if (dot > best) { best = dot; at = v; }
+    }
+    return at;
+}
+
+void mk_head_marker_pairs(const mk_raw_mesh *src, const double *sdir, mk_raw_mesh *dst, double *ddir, double warp,
+                          uint32_t count, uint32_t (*pairs)[2])
+{
+    for (uint32_t m = 0; m < count && m < 12; m++) {
+        uint32_t s = nearest_dir(sdir, src->vertex_count, marker_dirs[m]);
+        uint32_t t = nearest_dir(ddir, dst->vertex_count, sdir + 3 * (size_t)s);
+        double surf[3], q[3];
+        memcpy(ddir + 3 * (size_t)t, sdir + 3 * (size_t)s, 3 * sizeof(double));
+        mk_head_surface(ddir + 3 * (size_t)t, surf);
+        mk_head_warp(warp, surf, q);
+        for (int c = 0; c < 3; c++) dst->positions[3 * (size_t)t + c] = (float)q[c];
+        pairs[m][0] = s;
+        pairs[m][1] = t;
+    }
+}
+
 /* A UV sphere: poles on y (one vertex each), rings - 1 rows of 2 rings vertices. */
 static mk_raw_mesh *add_uv_sphere(mk_raw_asset *raw, const char *name, uint32_t rings)
 {

@@ -35,4 +35,12 @@ void mk_head_expression(uint32_t k, double w, const double p[3], double out[3]);
 mk_raw_mesh *mk_raw_add_head(mk_raw_asset *raw, const char *name, uint32_t levels, int uv, double turn, double warp,
                              int expressions, double **dirs);
 
+/* Up to 12 marker pairs between a head `src` and another head `dst` (their vertices' directions
+ * sdir, ddir as mk_raw_add_head gives them): at the nose tip, chin, brow centre, eyes, mouth
+ * corners, cheeks, crown and both sides, the src vertex nearest the feature's direction and the
+ * dst vertex nearest to it, which is moved (with its direction) onto the same surface point of
+ * dst's head, warped by `warp`: a pair is one feature on both, as an artist would pick it. */
+void mk_head_marker_pairs(const mk_raw_mesh *src, const double *sdir, mk_raw_mesh *dst, double *ddir, double warp,
+                          uint32_t count, uint32_t (*pairs)[2]);
+
 #endif

@@ -57,24 +57,6 @@ static int write_ball(const char *path)
     return status;
 }
 
-/* Directions of the sample's markers: nose tip, chin, brow centre, eyes, mouth corners, cheeks,
- * crown and the sides. */
-static const double marker_dirs[12][3] = { { 0, -0.1, 1 }, { 0, -0.75, 0.66 }, { 0, 0.4, 0.92 }, { 0.3, 0.15, 0.94 },
-                                           { -0.3, 0.15, 0.94 }, { 0.35, -0.45, 0.82 }, { -0.35, -0.45, 0.82 },
-                                           { 0.6, -0.2, 0.77 }, { -0.6, -0.2, 0.77 }, { 0, 1, 0 }, { 1, 0, 0 },
-                                           { -1, 0, 0 } };
-
-static uint32_t nearest_dir(const double *dirs, uint32_t n, const double d[3])
-{
-    double best = -INFINITY;
-    uint32_t at = 0;
-    for (uint32_t v = 0; v < n; v++) {
-        double dot = dirs[3 * v] * d[0] + dirs[3 * v + 1] * d[1] + dirs[3 * v + 2] * d[2];
-        if (dot > best) { best = dot; at = v; }
-    }
-    return at;
-}
-
 static int write_asset(mk_raw_asset *raw, const char *path, mk_error *err)
 {
     void *blob;
@@ -97,18 +79,10 @@ static int write_heads(const char *dir)
     char path[4096], json[2048];
     int n = snprintf(json, sizeof json, "{\n  \"mesh\": \"character\",\n  \"channels\": [\n    { \"op\": \"transfer\", "
                      "\"source\": \"head_template.morph\", \"prefix\": \"character_\",\n      \"markers\": [");
-    /* a marker pair is one feature on both heads: the template vertex nearest the marker's
-     * direction and the character vertex nearest to it, moved onto the same surface point */
-    for (int m = 0; ok && m < 12; m++) {
-        double l = sqrt(marker_dirs[m][0] * marker_dirs[m][0] + marker_dirs[m][1] * marker_dirs[m][1] +
-                        marker_dirs[m][2] * marker_dirs[m][2]), d[3], surf[3], q[3];
-        for (int c = 0; c < 3; c++) d[c] = marker_dirs[m][c] / l;
-        uint32_t s = nearest_dir(tdir, tm->vertex_count, d), t = nearest_dir(cdir, cm->vertex_count, tdir + 3 * (size_t)s);
-        mk_head_surface(tdir + 3 * (size_t)s, surf);
-        mk_head_warp(1, surf, q);
-        for (int c = 0; c < 3; c++) cm->positions[3 * (size_t)t + c] = (float)q[c];
-        n += snprintf(json + n, sizeof json - (size_t)n, "%s[%u, %u]", m ? ", " : "", s, t);
-    }
+    /* a marker pair is one feature on both heads (mk_head_marker_pairs) */
+    uint32_t pairs[12][2];
+    if (ok) mk_head_marker_pairs(tm, tdir, cm, cdir, 1, 12, pairs);
+    for (int m = 0; ok && m < 12; m++) n += snprintf(json + n, sizeof json - (size_t)n, "%s[%u, %u]", m ? ", " : "", pairs[m][0], pairs[m][1]);
     snprintf(json + n, sizeof json - (size_t)n, "] }\n  ]\n}\n");
     mk_error err;
     snprintf(path, sizeof path, "%s/head_template.morph", dir);

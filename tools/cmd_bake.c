@@ -259,7 +259,7 @@ static void on_channel(void *user, const mk_bake_channel_report *c)
         if (!strcmp(c->correspondence, "iterative"))
             printf("  correspondence: iterative, the fitted source %.3g (mean) and %.3g (max) x diagonal from the target\n",
                    c->fit_mean, c->fit_max);
-        else printf("  correspondence: closest (the aligned meshes coincide)\n");
+        else printf("  correspondence: closest (one pass)\n");
     }
     if (c->iterations && !ui->quiet)
         printf("  arap: %u iterations (at most %u per evaluation%s), energy %.4g (initial guess %.4g)\n",

@@ -227,8 +227,8 @@ static mk_result bake_transfer(recipe_ctx *ctx, recipe_channel *plan, int index,
         r = mk_transfer_channel(raw, plan->mesh, plan->name, plan->origin, x, smesh, sc, &moved, &inner);
         if (r != MK_OK) break;
         if (st->has_default_weight) raw->channels[raw->channel_count - 1].default_weight = plan->default_weight;
-        mk_transfer_stats st;
-        mk_transfer_stats_get(x, &st);
+        mk_transfer_stats ts;
+        mk_transfer_stats_get(x, &ts);
         mk_bake_channel_report cr;
         memset(&cr, 0, sizeof cr);
         cr.name = plan->name;
@@ -239,16 +239,16 @@ static mk_result bake_transfer(recipe_ctx *ctx, recipe_channel *plan, int index,
         cr.moved_vertices = moved;
         /* the one factorization is reported with the first channel, each channel its own solves */
         cr.factorizations = k == 0;
-        cr.factor_seconds = k == 0 ? st.factor_seconds : 0;
+        cr.factor_seconds = k == 0 ? ts.factor_seconds : 0;
         if (k == 0) {
-            cr.correspondence = st.iterative ? "iterative" : "closest";
-            cr.fit_mean = st.fit_mean;
-            cr.fit_max = st.fit_max;
+            cr.correspondence = ts.iterative ? "iterative" : "closest";
+            cr.fit_mean = ts.fit_mean;
+            cr.fit_max = ts.fit_max;
         }
-        cr.solves = st.solves - solves_before;
-        cr.solve_seconds = st.solve_seconds - solve_seconds_before;
-        solves_before = st.solves;
-        solve_seconds_before = st.solve_seconds;
+        cr.solves = ts.solves - solves_before;
+        cr.solve_seconds = ts.solve_seconds - solve_seconds_before;
+        solves_before = ts.solves;
+        solve_seconds_before = ts.solve_seconds;
         cr.seconds = bake_now() - t0;
         t0 = bake_now();
         if (o && o->channel_done) o->channel_done(o->user, &cr);
@@ -256,11 +256,12 @@ static mk_result bake_transfer(recipe_ctx *ctx, recipe_channel *plan, int index,
         report->targets_added += sc->target_count;
     }
     if (r == MK_OK) {
-        mk_transfer_stats st;
-        mk_transfer_stats_get(x, &st);
-        if (st.flipped || st.unmatched)
+        mk_transfer_stats ts;
+        mk_transfer_stats_get(x, &ts);
+        if (ts.flipped || ts.unmatched)
             mk_raw_warn(raw, "transfer channels[%d]: %u target triangles matched a farther source triangle facing "
-                        "their way, %u matched none (they follow their neighbors)", index, st.flipped, st.unmatched);
+                        "their way, %u matched none (they follow their neighbors%s)", index, ts.flipped, ts.unmatched,
+                        ts.iterative ? " unless a source triangle was paired with them" : "");
     }
     mk_transfer_destroy(x);
     if (r != MK_OK)

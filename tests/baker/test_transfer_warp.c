@@ -12,25 +12,9 @@
 #include <string.h>
 #include "check.h"
 #include "head.h"
+#include "primitives.h"
+#include "fixtures.h"
 #include "transfer.h"
-
-/* Directions of the markers: nose tip, chin, brow centre, eyes, mouth corners, cheeks, crown and
- * the sides. */
-static const double marker_dirs[12][3] = { { 0, -0.1, 1 }, { 0, -0.75, 0.66 }, { 0, 0.4, 0.92 }, { 0.3, 0.15, 0.94 },
-                                           { -0.3, 0.15, 0.94 }, { 0.35, -0.45, 0.82 }, { -0.35, -0.45, 0.82 },
-                                           { 0.6, -0.2, 0.77 }, { -0.6, -0.2, 0.77 }, { 0, 1, 0 }, { 1, 0, 0 },
-                                           { -1, 0, 0 } };
-
-static uint32_t nearest_dir(const double *dirs, uint32_t n, const double d[3])
-{
-    double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), best = -2;
-    uint32_t at = 0;
-    for (uint32_t v = 0; v < n; v++) {
-        double dot = (dirs[3 * v] * d[0] + dirs[3 * v + 1] * d[1] + dirs[3 * v + 2] * d[2]) / l;
-        if (dot > best) { best = dot; at = v; }
-    }
-    return at;
-}
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -58,17 +42,7 @@ static int run_case(double warp, mk_transfer_correspondence mode, uint32_t marke
     int ok = sm && tm;
     CHECK(ok);
     uint32_t pairs[12][2];
-    for (uint32_t m = 0; ok && m < markers; m++) {
-        /* the source vertex nearest the marker's direction, and the target vertex nearest to it
-         * moved onto the same surface point (a marker pair is one feature on both heads) */
-        pairs[m][0] = nearest_dir(sdir, sm->vertex_count, marker_dirs[m]);
-        uint32_t t = pairs[m][1] = nearest_dir(tdir, tm->vertex_count, sdir + 3 * (size_t)pairs[m][0]);
-        double surf[3], q[3];
-        memcpy(tdir + 3 * (size_t)t, sdir + 3 * (size_t)pairs[m][0], 3 * sizeof(double));
-        mk_head_surface(tdir + 3 * (size_t)t, surf);
-        mk_head_warp(warp, surf, q);
-        for (int c = 0; c < 3; c++) tm->positions[3 * (size_t)t + c] = (float)q[c];
-    }
+    if (ok) mk_head_marker_pairs(sm, sdir, tm, tdir, warp, markers, pairs);
     mk_transfer_params p = { .source = sm, .target = tm, .marker_count = markers, .markers = (const uint32_t (*)[2])pairs,
                              .correspondence = mode };
     mk_transfer *x = NULL;
@@ -200,5 +174,157 @@ static void smaller_warps_transfer_closer(void)
     CHECK(none_auto.stats.iterative);  /* other tessellations do not coincide */
 }
 
+/* A copy of mesh m of `from` into `to` with `extra_vertices` more vertices (positions given) and
+ * `extra_triangles` more triangles (given); NULL when memory runs out. */
+static mk_raw_mesh *copy_with(mk_raw_asset *to, const mk_raw_mesh *m, uint32_t extra_vertices, const float *positions,
+                              uint32_t extra_triangles, const uint32_t *triangles)
+{
+    mk_raw_mesh *c = mk_raw_add_meshes(to, 1);
+    if (!c) return NULL;
+    c->name = "copy";
+    c->vertex_count = m->vertex_count + extra_vertices;
+    c->triangle_count = m->triangle_count + extra_triangles;
+    c->positions = mk_arena_array(&to->arena, 3 * (size_t)c->vertex_count, sizeof(float));
+    c->triangles = mk_arena_array(&to->arena, 3 * (size_t)c->triangle_count, sizeof(uint32_t));
+    if (!c->positions || !c->triangles) return NULL;
+    memcpy(c->positions, m->positions, 3 * (size_t)m->vertex_count * sizeof(float));
+    memcpy(c->positions + 3 * (size_t)m->vertex_count, positions, 3 * (size_t)extra_vertices * sizeof(float));
+    memcpy(c->triangles, m->triangles, 3 * (size_t)m->triangle_count * sizeof(uint32_t));
+    memcpy(c->triangles + 3 * (size_t)m->triangle_count, triangles, 3 * (size_t)extra_triangles * sizeof(uint32_t));
+    return c;
+}
+
+/* Transfers the source at rest onto the target: the target's rest shape must come back. Returns
+ * the largest distance (x diagonal 3, about the heads'), or -1 when the transfer failed. */
+static double rest_back(const mk_raw_mesh *sm, const mk_raw_mesh *tm, uint32_t markers, const uint32_t (*pairs)[2],
+                        mk_transfer_correspondence mode, mk_transfer_stats *stats)
+{
+    mk_transfer_params p = { .source = sm, .target = tm, .marker_count = markers, .markers = pairs, .correspondence = mode };
+    mk_transfer *x = NULL;
+    mk_error err;
+    if (mk_transfer_create(&p, NULL, &x, &err) != MK_OK) {
+        printf("  create: %s\n", err.message);
+        return -1;
+    }
+    double *spos = malloc(3 * (size_t)sm->vertex_count * sizeof(double)), *tpos = malloc(3 * (size_t)tm->vertex_count * sizeof(double));
+    double worst = -1;
+    for (size_t i = 0; spos && i < 3 * (size_t)sm->vertex_count; i++) spos[i] = sm->positions[i];
+    if (spos && tpos && mk_transfer_apply(x, spos, tpos, &err) == MK_OK) {
+        worst = 0;
+        for (size_t i = 0; i < 3 * (size_t)tm->vertex_count; i++) worst = fmax(worst, fabs(tpos[i] - tm->positions[i]) / 3);
+    }
+    mk_transfer_stats_get(x, stats);
+    free(spos);
+    free(tpos);
+    mk_transfer_destroy(x);
+    return worst;
+}
+
+/* Sources as real files have them: a second component without markers (an eye), a vertex in no
+ * triangle, triangles without an area (collinear corners, which the fit could give an area and
+ * so a zero gradient), a position that is not finite; and a target copy with one degenerate
+ * triangle, which must still count as coinciding. */
+static void iterative_correspondence_takes_odd_sources(void)
+{
+    mk_raw_asset src, dst, eye;
+    mk_raw_init(&src, NULL);
+    mk_raw_init(&dst, NULL);
+    mk_raw_init(&eye, NULL);
+    double *sdir = NULL, *tdir = NULL;
+    mk_raw_mesh *head = mk_raw_add_head(&src, "template", 24, 1, 0, 0, 0, &sdir);
+    mk_raw_mesh *tm = mk_raw_add_head(&dst, "character", 3, 0, 0.3, 1, 0, &tdir);
+    mk_raw_mesh *ball = mk_raw_add_icosphere(&eye, "eye", 0.1f, 1);
+    CHECK(head && tm && ball);
+    if (!head || !tm || !ball) goto done;
+    uint32_t pairs[12][2];
+    mk_head_marker_pairs(head, sdir, tm, tdir, 1, 12, pairs);
+    uint32_t nh = head->vertex_count;
+    /* the eye (a second component), a loose vertex, a midpoint making a triangle without area */
+    uint32_t ne = ball->vertex_count, extra_v = ne + 2, extra_t = ball->triangle_count + 2;
+    float *ev = malloc(3 * (size_t)extra_v * sizeof(float));
+    uint32_t *et = malloc(3 * (size_t)extra_t * sizeof(uint32_t));
+    if (!ev || !et) { free(ev); free(et); goto done; }
+    for (uint32_t v = 0; v < ne; v++) {
+        ev[3 * v] = ball->positions[3 * v] + 0.3f;
+        ev[3 * v + 1] = ball->positions[3 * v + 1] + 0.15f;
+        ev[3 * v + 2] = ball->positions[3 * v + 2] + 0.6f;
+    }
+    const uint32_t *t0 = head->triangles;  /* the midpoint of the first triangle's first edge */
+    for (int c = 0; c < 3; c++) {
+        ev[3 * ne + c] = 5;  /* loose */
+        ev[3 * (ne + 1) + c] = 0.5f * (head->positions[3 * t0[0] + c] + head->positions[3 * t0[1] + c]);
+    }
+    for (uint32_t i = 0; i < 3 * ball->triangle_count; i++) et[i] = ball->triangles[i] + nh;
+    uint32_t *flat = et + 3 * ball->triangle_count;
+    flat[0] = t0[0]; flat[1] = nh + ne + 1; flat[2] = t0[1];
+    flat[3] = nh + ne + 1; flat[4] = t0[1]; flat[5] = t0[2];  /* so the midpoint moves with the fit */
+    mk_raw_mesh *odd = copy_with(&src, head, extra_v, ev, extra_t, et);
+    free(ev);
+    free(et);
+    CHECK(odd != NULL);
+    if (!odd) goto done;
+    mk_transfer_stats st;
+    double e = rest_back(odd, tm, 12, (const uint32_t (*)[2])pairs, MK_TRANSFER_ITERATIVE, &st);
+    printf("eye, loose vertex and a flat triangle in the source: rest gives back the target's rest within %.2g\n", e);
+    CHECK_MSG(e >= 0 && e < 1e-9, "rest came back %.3g off", e);
+    /* a position that is not finite is an error, not a crash */
+    float keep = odd->positions[3];
+    odd->positions[3] = NAN;
+    mk_transfer_params bad = { .source = odd, .target = tm, .marker_count = 12, .markers = (const uint32_t (*)[2])pairs,
+                               .correspondence = MK_TRANSFER_ITERATIVE };
+    mk_transfer *x = NULL;
+    mk_error err;
+    CHECK(mk_transfer_create(&bad, NULL, &x, &err) == MK_ERROR_NOT_FINITE && x == NULL);
+    odd->positions[3] = keep;
+    /* a copy of the target with one triangle without area still coincides: auto takes the one pass */
+    uint32_t degenerate[3] = { tm->triangles[0], tm->triangles[0], tm->triangles[1] };
+    mk_raw_mesh *copy = copy_with(&dst, tm, 0, NULL, 1, degenerate);
+    tm = &dst.meshes[0];
+    CHECK(copy != NULL);
+    if (copy) {
+        uint32_t same[3][2] = { { 0, 0 }, { 5, 5 }, { 9, 9 } };
+        e = rest_back(tm, copy, 3, (const uint32_t (*)[2])same, MK_TRANSFER_AUTO, &st);
+        CHECK_MSG(e >= 0 && !st.iterative, "auto on a copy with a degenerate triangle: iterative %d", st.iterative);
+    }
+done:
+    free(sdir);
+    free(tdir);
+    mk_raw_free(&src);
+    mk_raw_free(&dst);
+    mk_raw_free(&eye);
+}
+
+/* Source triangles without an area at rest (three corners on one row of a flat sheet) get an
+ * area once the sheet is fitted to a bumped one; they have no gradient to give and must not be
+ * paired (the rest source must give back the rest target). */
+static void flat_source_triangles_are_not_paired(void)
+{
+    mk_raw_asset src, dst;
+    mk_raw_init(&src, NULL);
+    mk_raw_init(&dst, NULL);
+    mk_raw_mesh *sheet = fixture_grid(&src, "sheet", 2, 2, 12, 12), *tm = fixture_grid(&dst, "bumped", 2, 2, 17, 13);
+    for (uint32_t v = 0; v < tm->vertex_count; v++) {
+        float x = tm->positions[3 * v] - 1, y = tm->positions[3 * v + 1] - 1;
+        tm->positions[3 * v + 2] = 0.3f * expf(-(x * x + y * y) / 0.3f);
+    }
+    uint32_t row[12 * 11 * 3], n = 0;
+    for (uint32_t j = 0; j <= 12; j += 2)
+        for (uint32_t i = 0; i + 2 <= 12; i++) {
+            row[3 * n] = j * 13 + i; row[3 * n + 1] = j * 13 + i + 1; row[3 * n + 2] = j * 13 + i + 2;
+            n++;
+        }
+    mk_raw_mesh *flat = copy_with(&src, sheet, 0, NULL, n, row);
+    CHECK(flat != NULL);
+    uint32_t corners[4][2] = { { 0, 0 }, { 12, 17 }, { 13 * 12, 18 * 13 }, { 13 * 13 - 1, 18 * 14 - 1 } };
+    mk_transfer_stats st;
+    double e = flat ? rest_back(flat, &dst.meshes[0], 4, (const uint32_t (*)[2])corners, MK_TRANSFER_ITERATIVE, &st) : -1;
+    printf("flat source triangles onto a bumped sheet: rest gives back the target's rest within %.2g\n", e);
+    CHECK_MSG(e >= 0 && e < 1e-9, "rest came back %.3g off", e);
+    mk_raw_free(&src);
+    mk_raw_free(&dst);
+}
+
 CHECK_MAIN(CASE(iterative_correspondence_follows_a_warped_remeshed_head),
-           CASE(smaller_warps_transfer_closer))
+           CASE(smaller_warps_transfer_closer),
+           CASE(iterative_correspondence_takes_odd_sources),
+           CASE(flat_source_triangles_are_not_paired))
