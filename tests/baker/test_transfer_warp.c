@@ -179,6 +179,8 @@ static void smaller_warps_transfer_closer(void)
 static mk_raw_mesh *copy_with(mk_raw_asset *to, const mk_raw_mesh *m, uint32_t extra_vertices, const float *positions,
                               uint32_t extra_triangles, const uint32_t *triangles)
 {
+    const mk_raw_mesh from = *m;  /* m may live in to's mesh array, which adding a mesh moves */
+    m = &from;
     mk_raw_mesh *c = mk_raw_add_meshes(to, 1);
     if (!c) return NULL;
     c->name = "copy";
@@ -188,7 +190,7 @@ static mk_raw_mesh *copy_with(mk_raw_asset *to, const mk_raw_mesh *m, uint32_t e
     c->triangles = mk_arena_array(&to->arena, 3 * (size_t)c->triangle_count, sizeof(uint32_t));
     if (!c->positions || !c->triangles) return NULL;
     memcpy(c->positions, m->positions, 3 * (size_t)m->vertex_count * sizeof(float));
-    memcpy(c->positions + 3 * (size_t)m->vertex_count, positions, 3 * (size_t)extra_vertices * sizeof(float));
+    if (extra_vertices) memcpy(c->positions + 3 * (size_t)m->vertex_count, positions, 3 * (size_t)extra_vertices * sizeof(float));
     memcpy(c->triangles, m->triangles, 3 * (size_t)m->triangle_count * sizeof(uint32_t));
     memcpy(c->triangles + 3 * (size_t)m->triangle_count, triangles, 3 * (size_t)extra_triangles * sizeof(uint32_t));
     return c;
