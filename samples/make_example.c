@@ -3,16 +3,19 @@
  * channel and a progressive "bend" channel (four in-betweens sampled from an exact bend, so
  * playback follows the curved path), normals computed from the targets, and a clip "wave"
  * animating both. With --ball, a closed icosphere "ball" (642 vertices, no channels) instead:
- * the mesh the shell sample recipe deflates. With --heads DIR, the deformation transfer sample
- * between two characters: DIR/head_template.morph (a head made by code, offline/head.h, as a UV
- * sphere of 48 rings with six expression channels), DIR/head_character.morph (the same surface
+ * the mesh the shell sample recipe deflates. With --heads DIR (created when missing), the
+ * deformation transfer sample between two characters: DIR/head_template.morph (a head made by
+ * code, offline/head.h, as a UV sphere of 48 rings with six expression channels),
+ * DIR/head_character.morph (the same surface
  * with other proportions, as an icosphere of 2,562 vertices, no channels) and
  * DIR/transfer_heads.json, the recipe with 12 marker pairs at the same features of both heads.
  * usage: make_example [--ball] OUT.morph | make_example --heads DIR */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include "blob_io.h"
 #include "head.h"
 #include "primitives.h"
@@ -69,6 +72,10 @@ static int write_asset(mk_raw_asset *raw, const char *path, mk_error *err)
 /* The two heads and the recipe that carries the template's expressions onto the character. */
 static int write_heads(const char *dir)
 {
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {  /* the folder, when it is not there yet */
+        fprintf(stderr, "make_example: cannot create the folder %s: %s\n", dir, strerror(errno));
+        return 1;
+    }
     mk_raw_asset tpl, chr;
     mk_raw_init(&tpl, NULL);
     mk_raw_init(&chr, NULL);
