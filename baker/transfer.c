@@ -48,6 +48,8 @@ struct mk_transfer {
     uint32_t *slot;             /* per target triangle: its index in used, UINT32_MAX when in no pair */
     uint32_t pair_count;        /* (target triangle, source triangle) pairs: every match, both ways */
     uint32_t (*pairs)[2];       /* used index, source triangle */
+    unsigned char *paired;      /* per source triangle: in a pair */
+    uint32_t source_count, *sources; /* the source triangles in a pair, each once */
     double *coef;               /* 12 per used triangle: column c, corner q at [4 c + q] */
     uint32_t *unknown;          /* welded -> unknown row, UINT32_MAX when pinned or unused */
     uint32_t *component;        /* welded -> component, UINT32_MAX when in no matched triangle */
@@ -197,10 +199,9 @@ static mk_result register_source(mk_transfer *x, const mk_transfer_params *param
 
 /* The other direction: every source triangle paired with the target triangle nearest its centroid
  * among those facing its way, at the fitted positions (unless that pair is a target's match). */
-static mk_result pair_source_triangles(mk_transfer *x, mk_error *err)
+static void pair_source_triangles(mk_transfer *x)
 {
     const mk_raw_mesh *src = x->source;
-    (void)err;
     for (uint32_t s = 0; s < src->triangle_count; s++) {
         double n[3], c[3] = { 0, 0, 0 }, b[3];
         const uint32_t *st = src->triangles + 3 * (size_t)s;
@@ -218,7 +219,6 @@ static mk_result pair_source_triangles(mk_transfer *x, mk_error *err)
         x->pairs[x->pair_count][0] = x->slot[t];
         x->pairs[x->pair_count++][1] = s;
     }
-    return MK_OK;
 }
 
 /* The grid over the target's triangles that the fit and the pairing search. */
@@ -279,8 +279,10 @@ mk_result mk_transfer_create(const mk_transfer_params *params, const mk_allocato
     x->slot = mk_arena_array(&x->arena, nt + 1, sizeof(uint32_t));
     x->pairs = mk_arena_array(&x->arena, nt + ns + 1, sizeof *x->pairs);
     x->rest_degenerate = mk_arena_array(&x->arena, ns + 1, 1);
+    x->paired = mk_arena_array(&x->arena, ns + 1, 1);
+    x->sources = mk_arena_array(&x->arena, ns + 1, sizeof(uint32_t));
     if (!x->aligned || !x->source_inverse || !x->gradient || !x->match || !x->barycentric || !x->used || !x->slot ||
-        !x->pairs || !x->rest_degenerate)
+        !x->pairs || !x->rest_degenerate || !x->paired || !x->sources)
         FAIL(mk_error_oom(err, "transfer"));
     for (uint32_t v = 0; v < src->vertex_count; v++) {
         double p[3] = { src->positions[3 * (size_t)v], src->positions[3 * (size_t)v + 1], src->positions[3 * (size_t)v + 2] };
@@ -311,7 +313,13 @@ mk_result mk_transfer_create(const mk_transfer_params *params, const mk_allocato
         x->pairs[x->pair_count++][1] = x->match[t];
         x->used[x->used_count++] = t;
     }
-    if (iterative && (r = pair_source_triangles(x, err)) != MK_OK) goto fail;
+    if (iterative) pair_source_triangles(x);
+    /* the source triangles in a pair, each once: their gradients are computed per key */
+    for (uint32_t pr = 0; pr < x->pair_count; pr++) {
+        uint32_t s = x->pairs[pr][1];
+        if (!x->paired[s]) x->sources[x->source_count++] = s;
+        x->paired[s] = 1;
+    }
     x->stats.pairs = x->pair_count;
     if (x->used_count == 0)
         FAIL(mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
@@ -336,8 +344,8 @@ mk_result mk_transfer_apply(mk_transfer *x, const double *source_positions, doub
         if (!isfinite(source_positions[i]))
             return mk_error_set(err, MK_ERROR_NOT_FINITE, UINT64_MAX, "source vertex %zu: position is not finite", i / 3);
     /* gradients of the paired source triangles, conjugated by the alignment */
-    for (uint32_t pr = 0; pr < x->pair_count; pr++) {
-        uint32_t s = x->pairs[pr][1];
+    for (uint32_t i = 0; i < x->source_count; i++) {
+        uint32_t s = x->sources[i];
         const uint32_t *tri = src->triangles + 3 * (size_t)s;
         double V[9], S[9];
         bake_transfer_edge_matrix(V, source_positions + 3 * (size_t)tri[0], source_positions + 3 * (size_t)tri[1],

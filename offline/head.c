@@ -241,7 +241,6 @@ mk_raw_mesh *mk_raw_add_head(mk_raw_asset *raw, const char *name, uint32_t level
     free(acc);
     for (uint32_t k = 0; ok && expressions && k < MK_HEAD_EXPRESSIONS; k++) {
         mk_raw_channel *ch = mk_raw_add_channels(raw, 1);
-        m = &raw->meshes[mesh_index];  /* channels live apart from meshes, but stay safe */
         ok = ch != NULL;
         if (!ok) break;
         ch->name = mk_arena_strdup(&raw->arena, mk_head_expression_name(k));

@@ -67,57 +67,31 @@ const cli_verb cli_verb_bake = {
     .run = run_bake,
 };
 
-/* One channel's error curve, kept for --plot (the arrays live in the raw asset). */
-typedef struct plot_channel {
-    char title[160];
-    const double *curve;
-    const float *keys;
-    uint32_t samples, key_count;
-    double tolerance;
-    char name[128];                /* shell channels: the volume curve (else volume_frames 0) */
-    const double *volume_ratios;
-    uint32_t volume_frames;
-    double frame_seconds;
-    const uint32_t *key_frames;
-} plot_channel;
-
-/* What --json reports of one baked channel. */
-typedef struct json_channel {
-    char name[128], op[32], correspondence[16];
-    uint32_t mesh, targets, evaluations, moved_vertices, factorizations, solves;
-    double max_error, seconds, fit_mean, fit_max;
-} json_channel;
+/* A baked channel's report, kept for --plot and --json (its arrays live in the raw asset; its
+ * name buffer is the baker's, reused for the next channel, so the name is copied). */
+typedef struct kept_channel {
+    mk_bake_channel_report r;
+    char name[128];
+} kept_channel;
 
 typedef struct bake_ui {
     int quiet, json;
-    json_channel *reports;         /* --json: every baked channel */
-    uint32_t report_count;
     cli_progress progress;
     cli_depfile deps;
-    int plot;                      /* keep the curves */
-    plot_channel *channels;
+    int plot;                      /* --plot: draw the kept reports */
+    kept_channel *channels;
     uint32_t channel_count;
     int out_of_memory;
 } bake_ui;
 
-static void keep_curve(bake_ui *ui, const mk_bake_channel_report *c)
+static void keep_channel(bake_ui *ui, const mk_bake_channel_report *c)
 {
-    plot_channel *grown = realloc(ui->channels, (ui->channel_count + 1) * sizeof *grown);
+    kept_channel *grown = realloc(ui->channels, (ui->channel_count + 1) * sizeof *grown);
     if (!grown) { ui->out_of_memory = 1; return; }
     ui->channels = grown;
-    plot_channel *pc = &ui->channels[ui->channel_count++];
-    snprintf(pc->title, sizeof pc->title, "%s (%s, mesh %u): %u target%s, max %.3g%% of the diagonal", c->name, c->op,
-             c->mesh, c->targets, c->targets == 1 ? "" : "s", 100 * c->max_error);
-    pc->curve = c->error_curve;
-    pc->keys = c->key_weights;
-    pc->samples = c->curve_samples;
-    pc->key_count = c->key_weights ? c->targets : 0;
-    pc->tolerance = c->tolerance;
-    snprintf(pc->name, sizeof pc->name, "%s", c->name);
-    pc->volume_ratios = c->volume_ratios;
-    pc->volume_frames = c->volume_ratios ? c->volume_frames : 0;
-    pc->frame_seconds = c->frame_seconds;
-    pc->key_frames = c->key_frames;
+    kept_channel *k = &ui->channels[ui->channel_count++];
+    k->r = *c;
+    snprintf(k->name, sizeof k->name, "%s", c->name);
 }
 
 /* The volume ratio of every shell channel over its frames, on one chart (VOLUME_PANEL high). */
@@ -128,10 +102,11 @@ static void draw_volumes(const bake_ui *ui, mkr_image *img)
     uint32_t count = 0;
     double seconds = 0;
     for (uint32_t i = 0; i < ui->channel_count && count < 6; i++) {
-        const plot_channel *pc = &ui->channels[i];
-        if (!pc->volume_frames) continue;
-        series[count++] = (mkr_series){ pc->volume_ratios, pc->volume_frames, pc->name, pc->key_frames, pc->key_count };
-        seconds = count == 1 || seconds == pc->frame_seconds ? pc->frame_seconds : -1;  /* -1: time steps differ */
+        const kept_channel *k = &ui->channels[i];
+        if (!k->r.volume_ratios) continue;
+        series[count++] = (mkr_series){ k->r.volume_ratios, k->r.volume_frames, k->name, k->r.key_frames,
+                                        k->r.key_weights ? k->r.targets : 0 };
+        seconds = count == 1 || seconds == k->r.frame_seconds ? k->r.frame_seconds : -1;  /* -1: time steps differ */
     }
     mkr_lines lines = { .title = "shell: enclosed volume / rest volume per frame (dots: the frames baked as targets)",
                         .x_label = seconds > 0 ? "simulated time (s)" : "frame", .y_label = "V/V0",
@@ -147,7 +122,7 @@ static int draw_plot(const cli_verb *verb, const bake_ui *ui, mkr_image *img, mk
     mk_error err;
     uint32_t n = ui->channel_count ? ui->channel_count : 1, shells = 0;
     if (n > 80) n = 80;   /* a picture people can read; more channels are left out (said below) */
-    for (uint32_t i = 0; i < ui->channel_count; i++) shells += ui->channels[i].volume_frames > 0;
+    for (uint32_t i = 0; i < ui->channel_count; i++) shells += ui->channels[i].r.volume_ratios != NULL;
     const int top = shells ? VOLUME_PANEL : 0;
     if (mkr_image_create(img, 720, top + 200 * (int)n, &err) != MK_OK) return cli_fail(verb->name, &err);
     static const uint8_t background[4] = { 20, 20, 24, 255 };
@@ -155,9 +130,12 @@ static int draw_plot(const cli_verb *verb, const bake_ui *ui, mkr_image *img, mk
     if (shells) draw_volumes(ui, img);
     if (shells > 6) fprintf(stderr, "morphkit bake: --plot draws the volumes of the first 6 of %u shell channels\n", shells);
     for (uint32_t i = 0; i < n && i < ui->channel_count; i++) {
-        const plot_channel *pc = &ui->channels[i];
-        mkr_plot plot = { .title = pc->title, .values = pc->curve, .count = pc->curve ? pc->samples + 1 : 0,
-                          .limit = pc->tolerance, .marks = pc->keys, .mark_count = pc->key_count,
+        const mk_bake_channel_report *r = &ui->channels[i].r;
+        char title[200];
+        snprintf(title, sizeof title, "%s (%s, mesh %u): %u target%s, max %.3g%% of the diagonal", ui->channels[i].name,
+                 r->op, r->mesh, r->targets, r->targets == 1 ? "" : "s", 100 * r->max_error);
+        mkr_plot plot = { .title = title, .values = r->error_curve, .count = r->error_curve ? r->curve_samples + 1 : 0,
+                          .limit = r->tolerance, .marks = r->key_weights, .mark_count = r->key_weights ? r->targets : 0,
                           .label_scale = 100, .unit = "%",
                           .note = "no error curve: a fixed count of an expensive deformer is checked at span midpoints" };
         mkr_plot_draw(img, 0, top + 200 * (int)i, 720, 198, &plot);
@@ -179,28 +157,6 @@ static void on_progress(void *user, const char *stage, double fraction)
     cli_progress_update(&ui->progress, stage, fraction);
 }
 
-static void keep_report(bake_ui *ui, const mk_bake_channel_report *c)
-{
-    json_channel *grown = realloc(ui->reports, (ui->report_count + 1) * sizeof *grown);
-    if (!grown) { ui->out_of_memory = 1; return; }
-    ui->reports = grown;
-    json_channel *j = &ui->reports[ui->report_count++];
-    memset(j, 0, sizeof *j);
-    snprintf(j->name, sizeof j->name, "%s", c->name);
-    snprintf(j->op, sizeof j->op, "%s", c->op);
-    snprintf(j->correspondence, sizeof j->correspondence, "%s", c->correspondence ? c->correspondence : "");
-    j->mesh = c->mesh;
-    j->targets = c->targets;
-    j->evaluations = c->evaluations;
-    j->moved_vertices = c->moved_vertices;
-    j->factorizations = c->factorizations;
-    j->solves = c->solves;
-    j->max_error = c->max_error;
-    j->seconds = c->seconds;
-    j->fit_mean = c->fit_mean;
-    j->fit_max = c->fit_max;
-}
-
 static void print_json(const bake_ui *ui, const bake_args *a, const mk_bake_report *report, const mk_write_report *wr,
                        size_t size)
 {
@@ -210,10 +166,10 @@ static void print_json(const bake_ui *ui, const bake_args *a, const mk_bake_repo
     json_string(&w, "input", a->input);
     json_string(&w, "output", a->output);
     json_array(&w, "channels");
-    for (uint32_t i = 0; i < ui->report_count; i++) {
-        const json_channel *j = &ui->reports[i];
+    for (uint32_t i = 0; i < ui->channel_count; i++) {
+        const mk_bake_channel_report *j = &ui->channels[i].r;
         json_object(&w, NULL);
-        json_string(&w, "name", j->name);
+        json_string(&w, "name", ui->channels[i].name);
         json_string(&w, "op", j->op);
         json_int(&w, "mesh", j->mesh);
         json_int(&w, "targets", j->targets);
@@ -225,7 +181,7 @@ static void print_json(const bake_ui *ui, const bake_args *a, const mk_bake_repo
             json_int(&w, "factorizations", j->factorizations);
             json_int(&w, "solves", j->solves);
         }
-        if (j->correspondence[0]) {
+        if (j->correspondence) {
             json_string(&w, "correspondence", j->correspondence);
             if (!strcmp(j->correspondence, "iterative")) {
                 json_number(&w, "fit_mean", j->fit_mean);
@@ -246,8 +202,8 @@ static void print_json(const bake_ui *ui, const bake_args *a, const mk_bake_repo
 static void on_channel(void *user, const mk_bake_channel_report *c)
 {
     bake_ui *ui = user;
-    if (ui->plot) keep_curve(ui, c);
-    if (ui->json) { keep_report(ui, c); return; }
+    if (ui->plot || ui->json) keep_channel(ui, c);
+    if (ui->json) return;
     printf("channel \"%s\" (%s, mesh %u): %u target%s, %u evaluations, playback error %.3g x diagonal%s, "
            "%u vertices moved, %.3f s\n",
            c->name, c->op, c->mesh, c->targets, c->targets == 1 ? "" : "s", c->evaluations, c->max_error,
@@ -360,7 +316,6 @@ static int run_bake(void *p)
 done:
     free(dep_text);
     free(ui.channels);
-    free(ui.reports);
     mkr_png_free(&png);
     mkr_image_destroy(&img);
     cli_depfile_free(&ui.deps);
