@@ -45,6 +45,7 @@ typedef struct mk_raw_mesh {
     uint32_t *control_points;  /* per render vertex: source control point (FBX) / vertex (glTF) */
     float world[16];           /* column-major world transform of the node at rest */
     int32_t gltf_node, gltf_mesh, gltf_primitive; /* -1 when not glTF */
+    int64_t fbx_geometry;      /* FBX 7.x: id of the source Geometry object (write-back finds it); 0 otherwise */
     mk_stacking stacking;      /* MK_STACKING_ADDITIVE or MK_STACKING_SEQUENTIAL */
 } mk_raw_mesh;
 

@@ -6,6 +6,7 @@
 #include <string.h>
 #include "bake.h"
 #include "cli.h"
+#include "fbx_write_back.h"
 #include "json_write.h"
 #include "pictures.h"
 #include "render.h"
@@ -23,7 +24,8 @@ static const cli_option options[] = {
       "The bake recipe: which deformers make which channels (docs/baking.md). Paths in it are relative to its folder.",
       NULL, NULL, 0, 0, 1, 0 },
     { "-o", "OUT.morph", CLI_STRING, offsetof(bake_args, output),
-      "The blob to write (a path ending in .morph, or a device/FIFO).", NULL, NULL, 0, 0, 1, 0 },
+      "The blob to write (a path ending in .morph, or a device/FIFO); or, for an FBX input, OUT.fbx: the input file "
+      "with the baked channels added (docs/baking.md, \"Baking into your own file\").", NULL, NULL, 0, 0, 1, 0 },
     { "--precision", "P", CLI_CHOICE, offsetof(bake_args, precision),
       "How deltas are stored (as for 'morphkit import').", "q16", "q16|float", 0, 0, 0, 0 },
     { "--all-meshes", NULL, CLI_FLAG, offsetof(bake_args, all_meshes),
@@ -51,7 +53,7 @@ static const cli_option options[] = {
 
 const cli_verb cli_verb_bake = {
     .name = "bake",
-    .usage = "IN --recipe RECIPE.json -o OUT.morph [options]",
+    .usage = "IN --recipe RECIPE.json -o OUT.morph|OUT.fbx [options]",
     .summary = "bake deformers (FFD, bend, cage, Laplacian, ...) into channels",
     .description =
         "Reads IN (meshes with or without morph targets), applies the recipe's deformers and writes the asset with the "
@@ -240,16 +242,37 @@ static void dir_of(const char *path, char *out, size_t size)
     out[n] = 0;
 }
 
+/* -o OUT.fbx: the input FBX file with the baked channels added. */
+static mk_result write_back_fbx(const bake_args *a, mk_raw_asset *raw, void **out, size_t *size, mk_error *err)
+{
+    if (strncmp(raw->source_format, "fbx", 3) != 0)
+        return mk_error_set(err, MK_ERROR_UNSUPPORTED, UINT64_MAX,
+                            "-o %s: an .fbx output is the FBX input with the baked channels added, and %s is %s",
+                            a->output, a->input, raw->source_format[0] ? raw->source_format : "not an FBX file");
+    void *input = NULL;
+    size_t input_size = 0;
+    mk_fbx_write_back_report rep;
+    mk_result r = mk_read_file(&raw->arena, a->input, SIZE_MAX, &input, &input_size, err);
+    if (r == MK_OK) r = mk_fbx_write_back(input, input_size, raw, &raw->arena, out, size, &rep, err);
+    mk_arena_release(&raw->arena, input);
+    if (r == MK_OK && !a->json)
+        printf("FBX: %u channel%s with %u shape%s on %u mesh%s (%u new BlendShape deformer%s), %u clip%s as animation stacks\n",
+               rep.channels, rep.channels == 1 ? "" : "s", rep.shapes, rep.shapes == 1 ? "" : "s", rep.meshes,
+               rep.meshes == 1 ? "" : "es", rep.blend_shapes, rep.blend_shapes == 1 ? "" : "s", rep.clips,
+               rep.clips == 1 ? "" : "s");
+    return r;
+}
+
 static int run_bake(void *p)
 {
     bake_args *a = p;
     const cli_verb *verb = &cli_verb_bake;
-    static const char *const extensions[] = { ".morph", NULL };
+    static const char *const extensions[] = { ".morph", ".fbx", NULL };
     const char *inputs[] = { a->input, a->recipe };
     static const char *const png_extensions[] = { ".png", NULL };
     cli_output outs[3];
     uint32_t out_count = 1, depfile_out = 0, plot_out = 0;
-    int status = cli_output_check(verb, &outs[0], "-o", a->output, extensions, "a .morph blob", 0, inputs, 2);
+    int status = cli_output_check(verb, &outs[0], "-o", a->output, extensions, "a .morph blob or an FBX file", 0, inputs, 2);
     if (status >= 0) return status;
     if (a->depfile) {
         depfile_out = out_count++;
@@ -286,11 +309,15 @@ static int run_bake(void *p)
                            .threads = (uint32_t)a->threads };
     mk_bake_report report;
     if (r == MK_OK) r = mk_bake_recipe(&raw, recipe, recipe_size, &bo, &report, &err);
-    if (r == MK_OK && !a->all_meshes) mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");
+    const int to_fbx = mk_path_has_extension(a->output, ".fbx");
+    if (r == MK_OK && !a->all_meshes && !to_fbx)
+        mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");
     cli_print_warnings(&raw);
     mk_write_report wr;
+    memset(&wr, 0, sizeof wr);
     mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16 };
-    if (r == MK_OK) r = mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &wr, &err);
+    if (r == MK_OK) r = to_fbx ? write_back_fbx(a, &raw, &blob, &size, &err)
+                               : mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &wr, &err);
     if (r != MK_OK) {
         status = cli_fail(verb->name, &err);
         goto done;
@@ -311,7 +338,7 @@ static int run_bake(void *p)
     else if (status == 0) {
         printf("%s -> %s: %u channels baked, %u targets, max playback error %.3g x diagonal, %zu bytes\n", a->input,
                a->output, report.channels_added, report.targets_added, report.max_error, size);
-        cli_print_write_report(&wr);
+        if (!to_fbx) cli_print_write_report(&wr);
     }
 done:
     free(dep_text);

@@ -321,6 +321,7 @@ static mk_result parse_children(ascii_parser *p, fbx_node *node, uint32_t depth,
         if (p->text[p->pos] == '}') {
             if (top_level) return perr(p, p->pos, "unexpected '}'");
             p->pos++;
+            node->end = p->pos;
             break;
         }
         mk_result r = parse_node(p, depth);
@@ -442,6 +443,7 @@ static mk_result parse_node(ascii_parser *p, uint32_t depth)
         node.value_count = (uint32_t)value_count;
         p->value_top = first_value;
     }
+    node.end = p->pos;
     if (opens_children) {
         mk_result r = parse_children(p, &node, depth + 1, 0);
         if (r != MK_OK) return r;

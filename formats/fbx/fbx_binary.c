@@ -237,6 +237,7 @@ static mk_result parse_node(bin_parser *p, uint64_t *pos, uint64_t limit, uint32
     fbx_node node;
     memset(&node, 0, sizeof node);
     node.offset = at;
+    node.end = end;
     node.depth = depth;
     node.name = (const char *)p->data + body;
     node.name_length = name_length;

@@ -522,3 +522,17 @@ int fbx_prop_int64(fbx_props props, const char *name, int64_t *out)
     return fbx_value_int(&p->values[at], out);
 }
 
+mk_result fbx_doc_parse(fbx_doc *doc, mk_arena *arena, const void *data, size_t size, mk_error *err)
+{
+    memset(doc, 0, sizeof *doc);
+    doc->arena = arena;
+    doc->data = data;
+    doc->size = size;
+    doc->err = err;
+    doc->binary = fbx_is_binary(data, size);
+    mk_result r = doc->binary ? fbx_parse_binary(doc) : fbx_parse_ascii(doc);
+    if (r == MK_OK && doc->root.child_count == 0)
+        r = mk_error_set(err, MK_ERROR_PARSE, 0, "not an FBX file: no nodes found (%zu bytes)", size);
+    if (r == MK_OK) fbx_link_parents(&doc->root);
+    return r;
+}

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* mk_import_fbx: binary or ASCII FBX from memory into the raw model.
  *
- * Steps: parse the file into a node tree (fbx_binary.c / fbx_ascii.c, with limits against
- * hostile input), then interpret it (fbx_scene.c: objects, connections, meshes, blend shapes,
+ * Steps: parse the file into a node tree (fbx_doc_parse: fbx_binary.c / fbx_ascii.c, with limits
+ * against hostile input), then interpret it (fbx_scene.c: objects, connections, meshes, blend shapes,
  * curves), then compute the target normals the file does not store (fbx_normals.c). All parse
  * memory comes from a scratch arena on the same allocator as the raw model and is released
  * before the normals are computed, on success and on error; so are the input bytes when the
@@ -25,22 +25,11 @@ mk_result mk_import_fbx(const void *data, size_t size, const mk_import_options *
     mk_arena scratch;
     mk_arena_init(&scratch, &out->arena.allocator);
     fbx_doc doc;
-    memset(&doc, 0, sizeof doc);
-    doc.arena = &scratch;
-    doc.data = data;
-    doc.size = size;
-    doc.err = err;
-    doc.threads = options->threads;
-    doc.binary = fbx_is_binary(data, size);
     const uint32_t first_mesh = out->mesh_count;
-    r = doc.binary ? fbx_parse_binary(&doc) : fbx_parse_ascii(&doc);
-    if (r == MK_OK && doc.root.child_count == 0)
-        r = mk_error_set(err, MK_ERROR_PARSE, 0, "not an FBX file: no nodes found (%zu bytes)", size);
+    r = fbx_doc_parse(&doc, &scratch, data, size, err);
+    doc.threads = options->threads;
     mk_phase_log_mark(options->phases, "parse");
-    if (r == MK_OK) {
-        fbx_link_parents(&doc.root);
-        r = fbx_convert(&doc, options, out);
-    }
+    if (r == MK_OK) r = fbx_convert(&doc, options, out);
     fbx_doc_free(&doc);
     mk_arena_free_all(&scratch);
     if (options->input_done) options->input_done(options->input_done_user);  /* data is not read again */

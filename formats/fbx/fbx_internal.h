@@ -54,6 +54,8 @@ struct fbx_node {
     fbx_node *children;
     const fbx_node *parent;
     uint64_t offset;        /* byte offset of the record / line start */
+    uint64_t end;           /* byte after the record (binary EndOffset) / after the closing '}' (ASCII; for a
+                             * node without children, the end of its value list) */
 };
 
 typedef struct fbx_doc {
@@ -74,6 +76,9 @@ typedef struct fbx_doc {
 } fbx_doc;
 
 void fbx_doc_free(fbx_doc *doc);
+/* Parses data (binary or ASCII, told apart by the magic) into doc, its tree in `arena`, errors
+ * into err, parents linked. A file without nodes is an error. Free with fbx_doc_free (fbx_dom.c). */
+mk_result fbx_doc_parse(fbx_doc *doc, mk_arena *arena, const void *data, size_t size, mk_error *err);
 
 /* Parsers (fbx_binary.c, fbx_ascii.c). Fill doc->root; errors carry offsets. */
 mk_result fbx_parse_binary(fbx_doc *doc);

@@ -846,6 +846,7 @@ static mk_result convert_meshes(scene *s)
             return transform_not_finite(s, o, mesh->name);
         }
         s->objects[o].raw_mesh = (int32_t)mesh_index;
+        if (!s->legacy_ids) mesh->fbx_geometry = s->objects[geometry_object].id;
         r = mesh_channels(s, geometry, geometry_object, o, mesh_index, &map);
         fbx_mesh_map_free(doc, &map);
         mk_phase_log_mark(s->options->phases, "shapes");

@@ -1,6 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /* libFuzzer target for the FBX importer (binary and ASCII): any input must give an error or
  * a raw model that passes mk_raw_validate, never a crash, hang or out-of-bounds access.
+ * An accepted file is then written back (formats/fbx_write) with one made-up baked channel per
+ * mesh (control point 0 moved), and a written file must import again, valid, with those
+ * channels added; a refusal must say why.
  * tests/fbx/test_fbx_hostile.c links this same function and runs it over every truncation and
  * random byte flips of the corpus files and of writer-made fixtures. Seeds: the corpus FBX
  * files and `test_fbx_writer --write-seeds DIR`. */
@@ -9,7 +12,72 @@
 #include <stdlib.h>
 #include <string.h>
 #include "fbx_import.h"
+#include "fbx_write_back.h"
 #include "import.h"
+
+/* One baked channel per mesh that moves the render vertices of control point 0. Returns the
+ * number added. */
+static uint32_t add_baked_channels(mk_raw_asset *raw)
+{
+    uint32_t added = 0;
+    for (uint32_t m = 0; m < raw->mesh_count; m++) {
+        uint32_t count = 0;
+        for (uint32_t v = 0; v < raw->meshes[m].vertex_count; v++) count += raw->meshes[m].control_points[v] == 0;
+        if (!count) continue;
+        mk_raw_channel *ch = mk_raw_add_channels(raw, 1);
+        if (!ch) break;
+        ch->name = "fuzz_written";
+        ch->origin = "{}";
+        ch->mesh = m;
+        mk_raw_target *t = mk_raw_add_targets(raw, ch, 1);
+        if (!t) { raw->channel_count--; break; }
+        t->name = "fuzz_written";
+        t->full_weight = 1;
+        t->count = count;
+        t->indices = mk_arena_array(&raw->arena, count, sizeof *t->indices);
+        t->positions = mk_arena_array(&raw->arena, count, 3 * sizeof *t->positions);
+        if (!t->indices || !t->positions) { raw->channel_count--; break; }
+        count = 0;
+        for (uint32_t v = 0; v < raw->meshes[m].vertex_count; v++) {
+            if (raw->meshes[m].control_points[v] != 0) continue;
+            t->indices[count] = v;
+            t->positions[3 * count] = 0.25f;
+            count++;
+        }
+        added++;
+    }
+    return added;
+}
+
+static void write_back(const uint8_t *data, size_t size, mk_raw_asset *raw)
+{
+    const uint32_t before = raw->channel_count;
+    const uint32_t added = add_baked_channels(raw);
+    mk_error err;
+    if (mk_raw_group_channels(raw, &err) != MK_OK) return;
+    void *out = NULL;
+    size_t out_size = 0;
+    if (mk_fbx_write_back(data, size, raw, &raw->arena, &out, &out_size, NULL, &err) != MK_OK) {
+        if (err.message[0] == 0) abort();  /* refusals say why */
+        return;
+    }
+    mk_raw_asset again;
+    mk_raw_init(&again, &raw->arena.allocator);
+    mk_import_options options;
+    memset(&options, 0, sizeof options);
+    options.keep_plain_meshes = 1;
+    mk_result r = mk_import_fbx(out, out_size, &options, &again, &err);
+    if (r == MK_OK) r = mk_raw_validate(&again, &err);
+    if (r != MK_OK && r != MK_ERROR_OUT_OF_MEMORY) {
+        fprintf(stderr, "fuzz_fbx: the written-back file does not import: %s\n", err.message);
+        abort();
+    }
+    if (r == MK_OK && again.channel_count != before + added) {
+        fprintf(stderr, "fuzz_fbx: written back with %u channels, imported %u\n", before + added, again.channel_count);
+        abort();
+    }
+    mk_raw_free(&again);
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -24,11 +92,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     mk_error err;
     mk_import_options options;
     memset(&options, 0, sizeof options);
+    options.keep_plain_meshes = 1;  /* as `morphkit bake` imports */
     if (mk_import_fbx(data, size, &options, &raw, &err) == MK_OK) {
         if (mk_raw_validate(&raw, &err) != MK_OK) {  /* an accepted import must be valid */
             fprintf(stderr, "fuzz_fbx: import accepted an invalid model: %s\n", err.message);
             abort();
         }
+        write_back(data, size, &raw);
     } else if (err.message[0] == 0) {
         abort();  /* errors always say what went wrong */
     }

@@ -1,0 +1,34 @@
+/* SPDX-License-Identifier: MIT */
+/* FBX write-back: the artist's own FBX file with the channels a bake added (docs/baking.md,
+ * "Baking into your own file"). */
+#ifndef MK_FBX_WRITE_BACK_H
+#define MK_FBX_WRITE_BACK_H
+
+#include "raw.h"
+
+typedef struct mk_fbx_write_back_report {
+    uint32_t meshes;            /* meshes that got channels */
+    uint32_t channels;          /* BlendShapeChannel deformers added */
+    uint32_t shapes;            /* Shape geometries added (one per target) */
+    uint32_t blend_shapes;      /* BlendShape deformers added (meshes that had none) */
+    uint32_t clips;             /* animation stacks added */
+    uint32_t blender_weights;   /* one-target channels written with per-vertex FullWeights (Blender files) */
+} mk_fbx_write_back_report;
+
+/* `input` is the FBX file (binary little-endian or ASCII, FBX 7.2 or later) that `raw` was
+ * imported from (mk_import_memory / mk_import_file, which record each mesh's Geometry id) and
+ * then baked into. The output is the input with, for every channel whose `origin` is set (a
+ * baked channel), a BlendShapeChannel with one Shape per target (deltas on the geometry's
+ * control points), connected to the mesh's BlendShape deformer (the first one it has, else a
+ * new one), and, for every clip that animates only baked channels, an animation stack with
+ * DeformPercent curves. Binary in gives binary out, ASCII in gives ASCII out; every node of
+ * the input is kept, byte for byte apart from the record end offsets that move.
+ *
+ * Refused with a message naming the element, nothing written: FBX before 7.2 (shapes inside
+ * the geometry), big-endian files, a geometry shared by two models, a baked target whose
+ * render vertices of one control point moved differently (the file keeps one delta per control
+ * point), names a file cannot hold. The output lives in `arena`. */
+mk_result mk_fbx_write_back(const void *input, size_t input_size, const mk_raw_asset *raw, mk_arena *arena,
+                            void **out, size_t *out_size, mk_fbx_write_back_report *report, mk_error *err);
+
+#endif
