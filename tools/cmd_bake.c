@@ -7,6 +7,7 @@
 #include "bake.h"
 #include "cli.h"
 #include "fbx_write_back.h"
+#include "gltf_writeback.h"
 #include "json_write.h"
 #include "pictures.h"
 #include "render.h"
@@ -24,8 +25,10 @@ static const cli_option options[] = {
       "The bake recipe: which deformers make which channels (docs/baking.md). Paths in it are relative to its folder.",
       NULL, NULL, 0, 0, 1, 0 },
     { "-o", "OUT.morph", CLI_STRING, offsetof(bake_args, output),
-      "The blob to write (a path ending in .morph, or a device/FIFO); or, for an FBX input, OUT.fbx: the input file "
-      "with the baked channels added (docs/baking.md, \"Baking into your own file\").", NULL, NULL, 0, 0, 1, 0 },
+      "The blob to write (a path ending in .morph, or a device/FIFO); or the input's own format with the baked "
+      "channels added (docs/baking.md, \"Baking into your own file\"): OUT.fbx when IN is an FBX file, OUT.gltf/OUT.glb "
+      "(the same container) when IN is .gltf/.glb, with the channel sidecar OUT.channels.json beside it.",
+      NULL, NULL, 0, 0, 1, 0 },
     { "--precision", "P", CLI_CHOICE, offsetof(bake_args, precision),
       "How deltas are stored (as for 'morphkit import').", "q16", "q16|float", 0, 0, 0, 0 },
     { "--all-meshes", NULL, CLI_FLAG, offsetof(bake_args, all_meshes),
@@ -53,7 +56,7 @@ static const cli_option options[] = {
 
 const cli_verb cli_verb_bake = {
     .name = "bake",
-    .usage = "IN --recipe RECIPE.json -o OUT.morph|OUT.fbx [options]",
+    .usage = "IN --recipe RECIPE.json -o OUT.morph|OUT.fbx|OUT.gltf|OUT.glb [options]",
     .summary = "bake deformers (FFD, bend, cage, Laplacian, ...) into channels",
     .description =
         "Reads IN (meshes with or without morph targets), applies the recipe's deformers and writes the asset with the "
@@ -252,7 +255,7 @@ static mk_result write_back_fbx(const bake_args *a, mk_raw_asset *raw, void **ou
     void *input = NULL;
     size_t input_size = 0;
     mk_fbx_write_back_report rep;
-    mk_result r = mk_read_file(&raw->arena, a->input, SIZE_MAX, &input, &input_size, err);
+    mk_result r = mk_read_file(&raw->arena, a->input, MK_IMPORT_DEFAULT_MAX_INPUT, &input, &input_size, err);
     if (r == MK_OK) r = mk_fbx_write_back(input, input_size, raw, &raw->arena, out, size, &rep, err);
     mk_arena_release(&raw->arena, input);
     if (r == MK_OK && !a->json)
@@ -263,17 +266,63 @@ static mk_result write_back_fbx(const bake_args *a, mk_raw_asset *raw, void **ou
     return r;
 }
 
+/* -o OUT.gltf|OUT.glb: IN's own glTF with the baked channels appended as targets (formats/gltf_writeback),
+ * and the channel sidecar OUT.channels.json (outs[*count]) beside it. The raw asset still has
+ * its plain meshes. Returns -1 when outs[0] (and the sidecar) are filled, else the exit status. */
+static int write_back_gltf(const cli_verb *verb, const bake_args *a, mk_raw_asset *raw, cli_output *outs,
+                           uint32_t *count, size_t *size)
+{
+    static char sidecar_path[4200];
+    const char *dot = strrchr(a->output, '.');
+    snprintf(sidecar_path, sizeof sidecar_path, "%.*s.channels.json", (int)(dot - a->output), a->output);
+    static const char *const json_ext[] = { ".json", NULL };
+    const char *inputs[] = { a->input, a->recipe, a->output };
+    void *in = NULL, *out = NULL;
+    char *sidecar = NULL;
+    size_t in_size = 0, sidecar_size = 0;
+    mk_gltf_write_back_report rep;
+    mk_error err;
+    mk_result r = mk_read_file(&raw->arena, a->input, MK_IMPORT_DEFAULT_MAX_INPUT, &in, &in_size, &err);
+    if (r == MK_OK)
+        r = mk_gltf_write_back(in, in_size, a->input, a->output, raw, &raw->arena, &out, size, &sidecar, &sidecar_size,
+                               &rep, &err);
+    if (r != MK_OK) return cli_fail(verb->name, &err);
+    outs[0].file.data = out;
+    outs[0].file.size = *size;
+    if (sidecar) {
+        int status = cli_output_check(verb, &outs[*count], "-o", sidecar_path, json_ext, "a JSON channel sidecar", 0, inputs, 3);
+        if (status >= 0) return status;
+        outs[*count].file.data = sidecar;
+        outs[(*count)++].file.size = sidecar_size;
+    }
+    if (!a->json) {
+        printf("write-back: %u glTF meshes, %u channels as %u new targets (%u padding on other primitives), %u sparse and "
+               "%u dense accessors (%u quantized), %u weight samplers extended, %u animations added, %zu new bytes\n",
+               rep.meshes, rep.channels, rep.targets, rep.padding_targets, rep.sparse_accessors, rep.dense_accessors,
+               rep.quantized_accessors, rep.rewritten_samplers, rep.animations_added, rep.added_bytes);
+        for (uint32_t i = 0; i < rep.note_count && i < 8; i++) printf("note: %s\n", rep.notes[i]);
+        if (sidecar)
+            printf("channel sidecar: %s (re-import with: morphkit import %s --channels %s -o OUT.morph)\n", sidecar_path,
+                   a->output, sidecar_path);
+    }
+    return -1;
+}
+
 static int run_bake(void *p)
 {
     bake_args *a = p;
     const cli_verb *verb = &cli_verb_bake;
-    static const char *const extensions[] = { ".morph", ".fbx", NULL };
+    static const char *const extensions[] = { ".morph", ".fbx", ".gltf", ".glb", NULL };
     const char *inputs[] = { a->input, a->recipe };
     static const char *const png_extensions[] = { ".png", NULL };
-    cli_output outs[3];
+    cli_output outs[4];
     uint32_t out_count = 1, depfile_out = 0, plot_out = 0;
-    int status = cli_output_check(verb, &outs[0], "-o", a->output, extensions, "a .morph blob or an FBX file", 0, inputs, 2);
+    int status = cli_output_check(verb, &outs[0], "-o", a->output, extensions, "a .morph blob, or the input's own FBX or glTF", 0, inputs, 2);
     if (status >= 0) return status;
+    int write_back = mk_path_has_extension(a->output, ".gltf") || mk_path_has_extension(a->output, ".glb");
+    if (write_back && !mk_path_has_extension(a->input, mk_path_has_extension(a->output, ".gltf") ? ".gltf" : ".glb"))
+        return cli_usage_error(verb, "-o %s: a glTF output is IN itself with the baked channels added, so IN must be a %s",
+                               a->output, mk_path_has_extension(a->output, ".gltf") ? ".gltf" : ".glb");
     if (a->depfile) {
         depfile_out = out_count++;
         if ((status = cli_output_check(verb, &outs[depfile_out], "--depfile", a->depfile, NULL, "a depfile", 0, inputs, 2)) >= 0)
@@ -309,21 +358,25 @@ static int run_bake(void *p)
                            .threads = (uint32_t)a->threads };
     mk_bake_report report;
     if (r == MK_OK) r = mk_bake_recipe(&raw, recipe, recipe_size, &bo, &report, &err);
+    mk_write_report wr = { 0 };
     const int to_fbx = mk_path_has_extension(a->output, ".fbx");
-    if (r == MK_OK && !a->all_meshes && !to_fbx)
-        mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");
-    cli_print_warnings(&raw);
-    mk_write_report wr;
-    memset(&wr, 0, sizeof wr);
-    mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16 };
-    if (r == MK_OK) r = to_fbx ? write_back_fbx(a, &raw, &blob, &size, &err)
-                               : mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &wr, &err);
-    if (r != MK_OK) {
-        status = cli_fail(verb->name, &err);
-        goto done;
+    if (r == MK_OK && write_back) {
+        cli_print_warnings(&raw);
+        if ((status = write_back_gltf(verb, a, &raw, outs, &out_count, &size)) >= 0) goto done;
+    } else {
+        if (r == MK_OK && !a->all_meshes && !to_fbx)
+            mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");
+        cli_print_warnings(&raw);
+        mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16 };
+        if (r == MK_OK) r = to_fbx ? write_back_fbx(a, &raw, &blob, &size, &err)
+                                   : mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &wr, &err);
+        if (r != MK_OK) {
+            status = cli_fail(verb->name, &err);
+            goto done;
+        }
+        outs[0].file.data = blob;
+        outs[0].file.size = size;
     }
-    outs[0].file.data = blob;
-    outs[0].file.size = size;
     if (a->depfile) {
         dep_text = cli_depfile_text(&ui.deps, a->output, &outs[depfile_out].file.size);
         outs[depfile_out].file.data = dep_text;
@@ -338,7 +391,7 @@ static int run_bake(void *p)
     else if (status == 0) {
         printf("%s -> %s: %u channels baked, %u targets, max playback error %.3g x diagonal, %zu bytes\n", a->input,
                a->output, report.channels_added, report.targets_added, report.max_error, size);
-        if (!to_fbx) cli_print_write_report(&wr);
+        if (!write_back && !to_fbx) cli_print_write_report(&wr);
     }
 done:
     free(dep_text);
