@@ -6,7 +6,7 @@
 #include <string.h>
 #include "bake.h"
 #include "cli.h"
-#include "fbx_write_back.h"
+#include "fbx_write.h"
 #include "gltf_writeback.h"
 #include "json_write.h"
 #include "pictures.h"
@@ -254,7 +254,7 @@ static mk_result write_back_fbx(const bake_args *a, mk_raw_asset *raw, void **ou
                             a->output, a->input, raw->source_format[0] ? raw->source_format : "not an FBX file");
     void *input = NULL;
     size_t input_size = 0;
-    mk_fbx_write_back_report rep;
+    mk_fbx_write_report rep;
     mk_result r = mk_read_file(&raw->arena, a->input, MK_IMPORT_DEFAULT_MAX_INPUT, &input, &input_size, err);
     if (r == MK_OK) r = mk_fbx_write_back(input, input_size, raw, &raw->arena, out, size, &rep, err);
     mk_arena_release(&raw->arena, input);

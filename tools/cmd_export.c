@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli.h"
+#include "fbx_write.h"
 #include "gltf_export.h"
 
 typedef struct export_args {
@@ -17,8 +18,9 @@ typedef struct export_args {
 static int run_export(void *p);
 
 static const cli_option options[] = {
-    { "-o", "OUT.glb|OUT.gltf", CLI_STRING, offsetof(export_args, output),
-      "The glTF to write: .glb (binary) or .gltf (JSON with the buffer embedded).", NULL, NULL, 0, 0, 1, 0 },
+    { "-o", "OUT.glb|OUT.gltf|OUT.fbx", CLI_STRING, offsetof(export_args, output),
+      "The file to write: .glb (binary glTF), .gltf (JSON with the buffer embedded), or .fbx (binary FBX 7.4: "
+      "channels with their in-betweens, clips as animation stacks; no sidecar needed).", NULL, NULL, 0, 0, 1, 0 },
     { "--sidecar", "PATH", CLI_STRING, offsetof(export_args, sidecar),
       "Where to write the channel sidecar (JSON). Default: OUT without its extension + .channels.json.", NULL, NULL, 0,
       0, 0, 0 },
@@ -30,13 +32,15 @@ static const cli_option options[] = {
 
 const cli_verb cli_verb_export = {
     .name = "export",
-    .usage = "FILE -o OUT.glb|OUT.gltf [options]",
-    .summary = "write an asset as glTF 2.0 (plus a channel sidecar)",
+    .usage = "FILE -o OUT.glb|OUT.gltf|OUT.fbx [options]",
+    .summary = "write an asset as glTF 2.0 (plus a channel sidecar) or FBX",
     .description = "Writes FILE's meshes, morph targets and weight clips as glTF 2.0. A progressive channel becomes "
                    "one glTF target "
                    "per in-between with weight tracks that reproduce morphkit's playback; the channel sidecar records "
                    "the grouping so "
-                   "a re-import restores the channels. The glTF and the sidecar are written both or neither.",
+                   "a re-import restores the channels. The glTF and the sidecar are written both or neither. As .fbx, "
+                   "each mesh becomes a model with its geometry and blend shape channels, in-betweens as FBX "
+                   "in-between shapes (docs/importing-fbx.md, \"Export to FBX\").",
     .positional = "FILE",
     .positional_help = "A .morph blob, or any file 'morphkit import' reads.",
     .positional_offset = offsetof(export_args, input),
@@ -47,10 +51,45 @@ const cli_verb cli_verb_export = {
     .run = run_export,
 };
 
+/* -o OUT.fbx: the asset as a new binary FBX file. */
+static int export_fbx(const cli_verb *verb, const export_args *a)
+{
+    static const char *const fbx_ext[] = { ".fbx", NULL };
+    const char *inputs[] = { a->input, a->channels };
+    cli_output out;
+    int status = cli_output_check(verb, &out, "-o", a->output, fbx_ext, "an FBX file", 0, inputs, 2);
+    if (status >= 0) return status;
+    mk_import_options io = { .channels_sidecar = a->channels };
+    mk_raw_asset raw;
+    mk_raw_init(&raw, NULL);
+    mk_error err;
+    mk_fbx_write_report rep;
+    void *bytes = NULL;
+    mk_result r = mk_import_file(a->input, &io, &raw, &err);
+    cli_print_warnings(&raw);
+    if (r == MK_OK) r = mk_fbx_export(&raw, &raw.arena, &bytes, &out.file.size, &rep, &err);
+    out.file.data = bytes;
+    if (r != MK_OK) {
+        mk_raw_free(&raw);
+        return cli_fail(verb->name, &err);
+    }
+    status = cli_write_outputs(verb, &out, 1);
+    if (status == 0)
+        printf("%s -> %s: %u meshes, %u channels with %u shapes, %u clips as animation stacks, %zu bytes\n", a->input,
+               a->output, rep.meshes, rep.channels, rep.shapes, rep.clips, out.file.size);
+    mk_raw_free(&raw);
+    return status;
+}
+
 static int run_export(void *p)
 {
     export_args *a = p;
     const cli_verb *verb = &cli_verb_export;
+    if (mk_path_has_extension(a->output, ".fbx")) {
+        if (a->sidecar || a->no_sidecar)
+            return cli_usage_error(verb, "--sidecar and --no-sidecar are for glTF output (an FBX holds its channels)");
+        return export_fbx(verb, a);
+    }
     if (a->no_sidecar && a->sidecar) return cli_usage_error(verb, "--sidecar and --no-sidecar contradict each other");
     int gltf_input = mk_path_has_extension(a->input, ".gltf") || mk_path_has_extension(a->input, ".glb");
     if (a->channels && !gltf_input)

@@ -182,7 +182,7 @@ static void write_value(fbx_bytes *out, const fbx_wvalue *v)
         append_le(out, bits, 8);
         break;
     }
-    case 'S':
+    case 'S': case 'R':
         append_le(out, v->count, 4);
         fbx_bytes_append(out, v->u.s, v->count);
         break;

@@ -4,8 +4,8 @@
  * these; the document writer (fbx_doc_write.c) puts them into the copied file.
  *
  * A node has a name, typed values and children, all in one arena. Value types are the binary
- * type codes: 'I' int32, 'L' int64, 'D' double, 'S' string, and the arrays 'i' int32, 'l' int64,
- * 'f' float, 'd' double.
+ * type codes: 'I' int32, 'L' int64, 'D' double, 'S' string, 'R' raw bytes (binary only), and the
+ * arrays 'i' int32, 'l' int64, 'f' float, 'd' double.
  * An object name is the pair (class, name): binary files spell it "name\0\1class", ASCII files
  * "class::name" (fbx_wn_object_name).
  */
@@ -17,7 +17,7 @@
 #include "alloc.h"
 
 typedef struct fbx_wvalue {
-    char type;                 /* 'I', 'L', 'D', 'S', 'i', 'l', 'f', 'd' */
+    char type;                 /* 'I', 'L', 'D', 'S', 'R', 'i', 'l', 'f', 'd' */
     uint32_t count;            /* arrays: element count; strings: byte length */
     union {
         int64_t i;

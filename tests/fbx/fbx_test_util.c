@@ -1,6 +1,8 @@
 /* SPDX-License-Identifier: MIT */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "check.h"
 #include "fbx_test_util.h"
 #include "frame.h"
 
@@ -55,4 +57,11 @@ done:
     free(result);
     mk_arena_free_all(&arena);
     return status;
+}
+
+unsigned char *ft_read_corpus(const char *name, size_t *size)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/fbx/%s.fbx", check_corpus_dir(), name);
+    return check_read_file(path, size);
 }

@@ -18,6 +18,9 @@ mk_result ft_import(const void *data, size_t size, const mk_import_options *opti
 int ft_eval_control_points(const mk_raw_asset *raw, uint32_t mesh, int32_t clip, float time, const float *weights,
                            int world, float **out, uint32_t *control_point_count);
 
+/* The corpus file fbx/NAME.fbx read whole (malloc'ed), or NULL when the corpus is absent. */
+unsigned char *ft_read_corpus(const char *name, size_t *size);
+
 /* Mesh index by name, or -1. */
 int32_t ft_find_mesh(const mk_raw_asset *raw, const char *name);
 

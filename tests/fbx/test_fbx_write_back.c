@@ -13,7 +13,7 @@
 #include "check.h"
 #include "fbx_internal.h"
 #include "fbx_test_util.h"
-#include "fbx_write_back.h"
+#include "fbx_write.h"
 
 static const char *const corpus_files[] = {
     "maya_blend_inbetween_7500_ascii", "maya_blend_shape_cube_7700_binary", "maya_blend_shape_cube_7700_ascii",
@@ -36,13 +36,6 @@ static const char recipe[] = RECIPE("3");
 static const char recipe_flat[] = RECIPE("1");
 
 static int made_by_blender(const char *file) { return strncmp(file, "blender", 7) == 0; }
-
-static unsigned char *read_corpus(const char *name, size_t *size)
-{
-    char path[1024];
-    snprintf(path, sizeof path, "%s/fbx/%s.fbx", check_corpus_dir(), name);
-    return check_read_file(path, size);
-}
 
 static const mk_raw_channel *find_channel(const mk_raw_asset *raw, const char *name, uint32_t *index)
 {
@@ -112,7 +105,7 @@ static void test_nothing_baked_is_identity(void)
     int files = 0;
     for (size_t f = 0; f < sizeof corpus_files / sizeof *corpus_files; f++) {
         size_t size;
-        unsigned char *data = read_corpus(corpus_files[f], &size);
+        unsigned char *data = ft_read_corpus(corpus_files[f], &size);
         if (!data) SKIP("corpus not found at %s", check_corpus_dir());
         mk_raw_asset raw;
         mk_error err;
@@ -186,7 +179,7 @@ static void test_baked_round_trip(void)
     for (size_t f = 0; f < sizeof corpus_files / sizeof *corpus_files; f++) {
         const char *file = corpus_files[f];
         size_t size;
-        unsigned char *data = read_corpus(file, &size);
+        unsigned char *data = ft_read_corpus(file, &size);
         if (!data) SKIP("corpus not found at %s", check_corpus_dir());
         mk_raw_asset original, baked, back;
         mk_error err;
@@ -199,7 +192,7 @@ static void test_baked_round_trip(void)
         CHECK_MSG(r == MK_OK, "%s: bake: %s", file, err.message);
         void *out = NULL;
         size_t out_size = 0;
-        mk_fbx_write_back_report wr;
+        mk_fbx_write_report wr;
         if (r == MK_OK) r = mk_fbx_write_back(data, size, &baked, &baked.arena, &out, &out_size, &wr, &err);
         CHECK_MSG(r == MK_OK, "%s: write-back: %s", file, err.message);
         if (r != MK_OK) { mk_raw_free(&original); mk_raw_free(&baked); free(data); continue; }
@@ -273,7 +266,7 @@ static int message_has(const mk_error *err, const char *text) { return strstr(er
 static void test_refusals(void)
 {
     size_t size;
-    unsigned char *data = read_corpus("maya_blend_shape_cube_7700_binary", &size);
+    unsigned char *data = ft_read_corpus("maya_blend_shape_cube_7700_binary", &size);
     if (!data) SKIP("corpus not found at %s", check_corpus_dir());
     mk_raw_asset raw;
     mk_error err;
@@ -321,7 +314,7 @@ static void test_refusals(void)
     free(data);
 
     /* In-betweens in a file made by Blender: its readers cannot play them. */
-    data = read_corpus("blender440_shape_weight_anim_7400_binary", &size);
+    data = ft_read_corpus("blender440_shape_weight_anim_7400_binary", &size);
     CHECK(data != NULL);
     if (data) {
         CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
@@ -333,7 +326,7 @@ static void test_refusals(void)
     }
 
     /* FBX 7.1: shapes live inside the geometry; refused, naming the version. */
-    data = read_corpus("maya_blend_shape_cube_7100_binary", &size);
+    data = ft_read_corpus("maya_blend_shape_cube_7100_binary", &size);
     CHECK(data != NULL);
     if (data) {
         CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
@@ -349,7 +342,7 @@ static void test_refusals(void)
 static void test_ascii_name_refused(void)
 {
     size_t size;
-    unsigned char *data = read_corpus("maya_blend_inbetween_7500_ascii", &size);
+    unsigned char *data = ft_read_corpus("maya_blend_inbetween_7500_ascii", &size);
     if (!data) SKIP("corpus not found at %s", check_corpus_dir());
     mk_raw_asset raw;
     mk_error err;

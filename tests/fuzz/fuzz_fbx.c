@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "fbx_import.h"
-#include "fbx_write_back.h"
+#include "fbx_write.h"
 #include "import.h"
 
 /* One baked channel per mesh that moves the render vertices of control point 0. Returns the
