@@ -250,8 +250,9 @@ static mk_result write_back_fbx(const bake_args *a, mk_raw_asset *raw, void **ou
 {
     if (strncmp(raw->source_format, "fbx", 3) != 0)
         return mk_error_set(err, MK_ERROR_UNSUPPORTED, UINT64_MAX,
-                            "-o %s: an .fbx output is the FBX input with the baked channels added, and %s is %s",
-                            a->output, a->input, raw->source_format[0] ? raw->source_format : "not an FBX file");
+                            "-o %s: an .fbx output is the FBX input with the baked channels added, and %s is not FBX (%s); "
+                            "write a .morph, or export it as FBX first (morphkit export IN -o IN.fbx)",
+                            a->output, a->input, raw->source_format[0] ? raw->source_format : "unknown");
     void *input = NULL;
     size_t input_size = 0;
     mk_fbx_write_report rep;

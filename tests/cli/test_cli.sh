@@ -1,9 +1,10 @@
 #!/bin/sh
 # The CLI end to end on the generated example: info (text and JSON), play (JSON, OBJ,
 # weights, stacking, normals, spaces), conform with forced weights, bench, import errors,
-# usage errors, atomic outputs.
+# usage errors, atomic outputs, FBX export and write-back.
 # usage: test_cli.sh MORPHKIT MAKE_EXAMPLE
 mk="$1"; make_example="$2"
+src=$(cd "$(dirname "$0")/../.." && pwd)
 dir=$(mktemp -d); trap 'rm -rf "$dir"' EXIT
 passed=0; failed=0
 ok() { passed=$((passed+1)); echo "ok   $1"; }
@@ -49,6 +50,16 @@ check "no output after failed import" test ! -e "$dir/y.morph"
 check "import of a .morph rewrites it" "$mk" import "$dir/ex.morph" -o "$dir/re.morph" --precision float
 check "the rewritten file is the same asset in float" sh -c "'$mk' info '$dir/re.morph' --json | python3 -c 'import json,sys; d=json.load(sys.stdin); m=d[\"meshes\"][0]; assert d[\"float_targets\"] == 5 and d[\"quantized_targets\"] == 0 and [c[\"name\"] for c in m[\"channels\"]] == [\"bulge\", \"bend\"], d'"
 check "no temporary files left" sh -c "! ls '$dir' | grep -q '\.tmp\.'"
+# FBX: export writes the asset as FBX that plays as the blob; bake writes back into an FBX input.
+check "export to fbx" "$mk" export "$dir/ex.morph" -o "$dir/ex.fbx"
+check "the fbx plays as the blob (per control point)" sh -c "'$mk' play '$dir/ex.morph' --clip wave --time 1 -o '$dir/pm.json' && '$mk' play '$dir/ex.fbx' --clip wave --time 1 -o '$dir/pf.json' && python3 -c 'import json; m=[json.load(open(f))[\"meshes\"][0] for f in (\"$dir/pm.json\", \"$dir/pf.json\")]; p=[{c: x[\"positions\"][3*v:3*v+3] for v, c in enumerate(x[\"control_points\"])} for x in m]; assert p[0].keys() == p[1].keys() and max(abs(a-b) for c in p[0] for a,b in zip(p[0][c], p[1][c])) < 1e-5'"
+check "bake into the fbx" "$mk" bake "$dir/ex.fbx" --recipe "$src/samples/recipes/barr.json" -o "$dir/baked.fbx" --quiet
+check "the baked fbx has the new channels after its own" sh -c "'$mk' info '$dir/baked.fbx' --json | python3 -c 'import json,sys; d=json.load(sys.stdin); n=[c[\"name\"] for c in d[\"meshes\"][0][\"channels\"]]; assert n == [\"bulge\", \"bend\", \"taper_top\", \"bend_forward\", \"twist_quarter\"], n'"
+check_fails "bake of a blob into an fbx" 1 "$mk" bake "$dir/ex.morph" --recipe "$src/samples/recipes/barr.json" -o "$dir/nope.fbx"
+cp "$dir/out" "$dir/refusal.out"
+check "that refusal names the input" grep -q "an .fbx output is the FBX input" "$dir/refusal.out"
+check "and writes nothing" test ! -e "$dir/nope.fbx"
+check_fails "export to fbx takes no sidecar" 2 "$mk" export "$dir/ex.morph" -o "$dir/nope.fbx" --no-sidecar
 # conform: an OBJ reference frame with forced weights (the frame's "weights", in the mesh's
 # channel order) is compared with those weights, not the clip's; wrong weights fail.
 "$mk" play "$dir/ex.morph" --weights bulge=0.25,bend=1 --space local -o "$dir/forced.obj" >/dev/null
