@@ -143,12 +143,12 @@ static mk_result run_recipe(recipe_ctx *ctx, const char *json, size_t size, mk_b
     if (mesh_item && (r = resolve_mesh(ctx, mesh_item, "recipe", &top_mesh)) != MK_OK) goto done;
     const cJSON *channels = cJSON_GetObjectItemCaseSensitive(root, "channels");
     if (!channels) { r = recipe_field_error(ctx, "channels", "", "missing (an array of channel recipes)%s", NULL); goto done; }
-    if (!cJSON_IsArray(channels) || cJSON_GetArraySize(channels) == 0) {
-        r = recipe_field_error(ctx, "channels", "", "must be a non-empty array%s", NULL);
+    if (!cJSON_IsArray(channels)) {
+        r = recipe_field_error(ctx, "channels", "", "must be an array%s", NULL);
         goto done;
     }
-    count = cJSON_GetArraySize(channels);
-    plans = mk_arena_array(ctx->scratch, (size_t)count, sizeof *plans);
+    count = cJSON_GetArraySize(channels);  /* none: the bake adds nothing (a write-back gives the input back) */
+    plans = mk_arena_array(ctx->scratch, count ? (size_t)count : 1, sizeof *plans);
     if (!plans) { r = mk_error_oom(ctx->err, "recipe"); goto done; }
     int i = 0;
     for (const cJSON *ch = channels->child; ch; ch = ch->next, i++)

@@ -1566,7 +1566,16 @@ static void bad_recipes_name_the_field(void)
                  "channels[0].cage");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"laplacian\", \"handles\": [{\"indices\": [100000]}]}]}",
                  "channels[0].handles[0].indices");
-    expect_error(&raw, "{\"mesh\": 0, \"channels\": []}", "channels");
+    expect_error(&raw, "{\"mesh\": 0, \"channels\": {}}", "channels");
+    /* an empty channel list bakes nothing, and is no error */
+    {
+        static const char empty[] = "{\"mesh\": 0, \"channels\": []}";
+        mk_bake_report report;
+        mk_error err;
+        CHECK(mk_bake_recipe(&raw, empty, sizeof empty - 1, NULL, &report, &err) == MK_OK);
+        CHECK_EQ_INT(report.channels_added, 0);
+        CHECK_EQ_INT(raw.channel_count, 0);
+    }
     expect_error(&raw, "[1, 2]", "recipe");
     expect_error(&raw, "{\"mesh\": 0, \"channels\": [{\"op\": \"twist\", \"angle\": 30}", "JSON");
     /* a later channel failing drops the earlier ones too (all or nothing) */

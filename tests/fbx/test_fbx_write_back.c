@@ -12,6 +12,7 @@
 #include "bake.h"
 #include "check.h"
 #include "fbx_internal.h"
+#include "fbx_node_write.h"
 #include "fbx_test_util.h"
 #include "fbx_write.h"
 
@@ -287,6 +288,32 @@ static void test_refusals(void)
     CHECK(out == NULL);
     t->positions[0] = saved;
 
+    /* A render vertex of a moved control point left out of the target (its siblings moved). */
+    {
+        const mk_raw_mesh *m = &raw.meshes[raw.channels[twist].mesh];
+        uint32_t e = 0;
+        for (; e < t->count; e++) {
+            uint32_t siblings = 0;
+            for (uint32_t v = 0; v < m->vertex_count; v++) siblings += m->control_points[v] == m->control_points[t->indices[e]];
+            if (siblings > 1 && fabsf(t->positions[3 * e]) + fabsf(t->positions[3 * e + 1]) + fabsf(t->positions[3 * e + 2]) > 0.01f) break;
+        }
+        CHECK(e < t->count);
+        uint32_t kept_index = t->indices[e];
+        float kept[3] = { t->positions[3 * e], t->positions[3 * e + 1], t->positions[3 * e + 2] };
+        /* swap the entry to the end and shorten the target by one */
+        const uint32_t last = t->count - 1;
+        t->indices[e] = t->indices[last];
+        memcpy(t->positions + 3 * e, t->positions + 3 * last, 3 * sizeof(float));
+        t->count--;
+        CHECK(mk_fbx_write_back(data, size, &raw, &raw.arena, &out, &out_size, NULL, &err) == MK_ERROR_UNSUPPORTED);
+        CHECK_MSG(message_has(&err, "some render vertices") && message_has(&err, "twist_quarter"), "%s", err.message);
+        t->count++;
+        t->indices[last] = t->indices[e];
+        memcpy(t->positions + 3 * last, t->positions + 3 * e, 3 * sizeof(float));
+        t->indices[e] = kept_index;
+        memcpy(t->positions + 3 * e, kept, sizeof kept);
+    }
+
     /* A geometry shared by two models (an instanced mesh). */
     mk_raw_mesh *copy = mk_raw_add_meshes(&raw, 1);
     CHECK(copy != NULL);
@@ -358,5 +385,27 @@ static void test_ascii_name_refused(void)
     free(data);
 }
 
-CHECK_MAIN(CASE(test_nothing_baked_is_identity), CASE(test_baked_round_trip), CASE(test_refusals),
+/* A new node with neither values nor children is closed by a null record (as the FBX SDK
+ * writes an empty Properties70); one with values and no children is not. */
+static void test_node_records(void)
+{
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    for (int wide = 0; wide < 2; wide++) {
+        const size_t header = wide ? 25 : 13;
+        fbx_bytes out = { .arena = &arena };
+        fbx_wnode *empty = fbx_wn_new(&arena, "Properties70"), *leaf = fbx_wn_new(&arena, "Version");
+        CHECK(empty && leaf && fbx_wn_int(&arena, leaf, 100));
+        fbx_wn_write_binary(&out, empty, 1000, wide);
+        CHECK_EQ_INT(out.size, 2 * header + strlen("Properties70"));
+        CHECK_EQ_INT(out.data[0] | out.data[1] << 8, 1000 + out.size);  /* EndOffset counts from the file's start */
+        const size_t before = out.size;
+        fbx_wn_write_binary(&out, leaf, 1000, wide);
+        CHECK_EQ_INT(out.size - before, header + strlen("Version") + 5);
+        CHECK(!out.failed);
+    }
+    mk_arena_free_all(&arena);
+}
+
+CHECK_MAIN(CASE(test_node_records), CASE(test_nothing_baked_is_identity), CASE(test_baked_round_trip), CASE(test_refusals),
            CASE(test_ascii_name_refused))
