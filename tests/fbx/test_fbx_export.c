@@ -43,6 +43,21 @@ static double diagonal(const mk_raw_mesh *m)
     return sqrt(d);
 }
 
+/* The triangles of m on control points, each rotated to start at its smallest, sorted. */
+static int by_triple(const void *a, const void *b) { return memcmp(a, b, 3 * sizeof(uint32_t)); }
+static uint32_t *cp_triangles(const mk_raw_mesh *m)
+{
+    uint32_t *t = malloc(3 * sizeof *t * ((size_t)m->triangle_count + 1));
+    for (uint32_t i = 0; i < m->triangle_count; i++) {
+        uint32_t c[3];
+        for (int k = 0; k < 3; k++) c[k] = m->control_points[m->triangles[3 * i + k]];
+        int first = c[0] <= c[1] && c[0] <= c[2] ? 0 : c[1] <= c[2] ? 1 : 2;
+        for (int k = 0; k < 3; k++) t[3 * i + k] = c[(first + k) % 3];
+    }
+    qsort(t, m->triangle_count, 3 * sizeof *t, by_triple);
+    return t;
+}
+
 static void compare(const char *name, const mk_raw_asset *a, const mk_raw_asset *b, double *worst_seen)
 {
     CHECK_MSG(a->mesh_count == b->mesh_count, "%s: %u meshes, exported %u", name, a->mesh_count, b->mesh_count);
@@ -63,6 +78,14 @@ static void compare(const char *name, const mk_raw_asset *a, const mk_raw_asset 
         const mk_raw_mesh *x = &a->meshes[m], *y = &b->meshes[m];
         CHECK_MSG(!strcmp(x->name, y->name), "%s: mesh %u '%s' exported as '%s'", name, m, x->name, y->name);
         CHECK_EQ_INT(y->control_point_count, x->control_point_count);
+        CHECK_MSG(y->triangle_count == x->triangle_count, "%s mesh '%s': %u triangles, exported %u", name, x->name,
+                  x->triangle_count, y->triangle_count);
+        if (y->triangle_count == x->triangle_count) {
+            uint32_t *tx = cp_triangles(x), *ty = cp_triangles(y);
+            CHECK_MSG(memcmp(tx, ty, 3 * sizeof *tx * x->triangle_count) == 0, "%s mesh '%s': other triangles", name, x->name);
+            free(tx);
+            free(ty);
+        }
         double size = 1;
         for (int k = 0; k < 16; k++) size = fmax(size, fabs(x->world[k]));
         for (int k = 0; k < 16; k++)
