@@ -3,6 +3,7 @@
  * concept, so `morphkit export` writes each progressive channel as several glTF targets and this
  * JSON file says which targets form which channel, with their full weights; re-import restores
  * the channels. Every field is checked; errors name the JSON path. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -173,8 +174,11 @@ mk_result mk_gltf_sidecar_parse(mk_arena *arena, const char *text, size_t size, 
             const cJSON *st = cJSON_GetObjectItemCaseSensitive(e, "start"), *du = cJSON_GetObjectItemCaseSensitive(e, "duration");
             char path[48];
             snprintf(path, sizeof path, "clips[%u]", out->clip_count);
-            if (!cJSON_IsNumber(st) || !cJSON_IsNumber(du) || !isfinite(st->valuedouble) || !isfinite(du->valuedouble)
-                || du->valuedouble < 0 || fabs(st->valuedouble) > 1e9 || du->valuedouble > 1e9) {
+            /* The raw model's rule (mk_raw_validate): finite as float, duration not negative. A
+             * clip imported from glTF keys far in time has such a range, and the write-back's and
+             * the exporter's sidecars carry it. */
+            if (!cJSON_IsNumber(st) || !cJSON_IsNumber(du) || !(fabs(st->valuedouble) <= FLT_MAX) ||
+                !(du->valuedouble >= 0 && du->valuedouble <= FLT_MAX)) {
                 r = fail(&p, path, "needs finite \"start\" and non-negative \"duration\" seconds");
                 break;
             }

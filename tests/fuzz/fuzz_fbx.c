@@ -14,45 +14,12 @@
 #include "fbx_import.h"
 #include "fbx_write.h"
 #include "import.h"
-
-/* One baked channel per mesh that moves the render vertices of control point 0. Returns the
- * number added. */
-static uint32_t add_baked_channels(mk_raw_asset *raw)
-{
-    uint32_t added = 0;
-    for (uint32_t m = 0; m < raw->mesh_count; m++) {
-        uint32_t count = 0;
-        for (uint32_t v = 0; v < raw->meshes[m].vertex_count; v++) count += raw->meshes[m].control_points[v] == 0;
-        if (!count) continue;
-        mk_raw_channel *ch = mk_raw_add_channels(raw, 1);
-        if (!ch) break;
-        ch->name = "fuzz_written";
-        ch->origin = "{}";
-        ch->mesh = m;
-        mk_raw_target *t = mk_raw_add_targets(raw, ch, 1);
-        if (!t) { raw->channel_count--; break; }
-        t->name = "fuzz_written";
-        t->full_weight = 1;
-        t->count = count;
-        t->indices = mk_arena_array(&raw->arena, count, sizeof *t->indices);
-        t->positions = mk_arena_array(&raw->arena, count, 3 * sizeof *t->positions);
-        if (!t->indices || !t->positions) { raw->channel_count--; break; }
-        count = 0;
-        for (uint32_t v = 0; v < raw->meshes[m].vertex_count; v++) {
-            if (raw->meshes[m].control_points[v] != 0) continue;
-            t->indices[count] = v;
-            t->positions[3 * count] = 0.25f;
-            count++;
-        }
-        added++;
-    }
-    return added;
-}
+#include "fuzz_baked.h"
 
 static void write_back(const uint8_t *data, size_t size, mk_raw_asset *raw)
 {
     const uint32_t before = raw->channel_count;
-    const uint32_t added = add_baked_channels(raw);
+    const uint32_t added = fuzz_add_baked_channels(raw);
     mk_error err;
     if (mk_raw_group_channels(raw, &err) != MK_OK) return;
     void *out = NULL;

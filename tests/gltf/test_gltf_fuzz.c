@@ -2,7 +2,9 @@
 /* Regression run of the glTF importer with the fuzz target's settings (tests/fuzz/fuzz_gltf.c)
  * over the corpus: every glTF/GLB file whole, truncated at a spread of lengths, and with random
  * byte flips. Each input either imports to a model that validates, or fails with a valid code
- * and a message; ASan/UBSan catch the rest. The whole files must import (their damaged copies
+ * and a message; ASan/UBSan catch the rest. Each input also goes through the fuzz target's own
+ * function (linked in), which writes an accepted import back with a made-up baked channel per
+ * mesh and re-imports the output (it aborts on a failure). The whole files must import (their damaged copies
  * are measured against that). .gltf files with external buffers fail early from memory (no
  * base directory), so their JSON parsing is what gets exercised; GLB files exercise everything. */
 #include <stdio.h>
@@ -10,6 +12,9 @@
 #include <string.h>
 #include "check.h"
 #include "gltf_import.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+extern unsigned long fuzz_gltf_written, fuzz_gltf_refused;
 
 static const char *files[] = {
     "gltf/AnimatedMorphCube/glTF/AnimatedMorphCube.gltf",
@@ -62,6 +67,7 @@ static int import_checked(const unsigned char *data, size_t size)
                   "a failure without a valid code and message (%d)", (int)r);
     }
     mk_raw_free(&raw);
+    LLVMFuzzerTestOneInput(data, size);
     return r == MK_OK;
 }
 
@@ -78,8 +84,12 @@ static void test_fuzz_seeds(void)
         found++;
         unsigned char *copy = malloc(size + 1);
         /* The whole GLB files import (.gltf files need their folder, absent from memory). */
+        unsigned long written = fuzz_gltf_written;
         int whole = import_checked(data, size);
-        if (strstr(files[i], ".glb")) CHECK_MSG(whole, "%s does not import from memory", files[i]);
+        if (strstr(files[i], ".glb")) {
+            CHECK_MSG(whole, "%s does not import from memory", files[i]);
+            CHECK_MSG(fuzz_gltf_written == written + 1, "%s is not written back by the fuzz target", files[i]);
+        }
         size_t step = size / 200 + 1;
         for (size_t n = 0; n <= size; n += step) {
             memcpy(copy, data, n);
@@ -97,7 +107,8 @@ static void test_fuzz_seeds(void)
         free(data);
     }
     if (!found) SKIP("corpus not found at %s", corpus);
-    printf("  %d inputs from %d seed files\n", runs, found);
+    printf("  %d inputs from %d seed files; the fuzz target wrote %lu back and re-imported them, refused %lu\n", runs, found,
+           fuzz_gltf_written, fuzz_gltf_refused);
 }
 
 CHECK_MAIN(CASE(test_fuzz_seeds))

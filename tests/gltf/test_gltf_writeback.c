@@ -6,7 +6,11 @@
  * within the quantization step of the accessors written, and a JSON tree that holds the input's
  * tree unchanged (only members and array elements added, the known replacements excepted). An
  * asset without baked channels writes the file back unchanged; a mesh instanced by two nodes
- * baked differently is refused. Outputs pass the Khronos validator when it is installed. */
+ * baked differently is refused. A glTF made here (two primitives, primitive.extras.targetNames,
+ * node.weights other than mesh.weights, a weight animation to 3e10 s) gets a channel moving 2 of
+ * 12 vertices (a sparse accessor) and a progressive one (dense, a default weight): accessors,
+ * padding, weights, names, the extended sampler and both re-imports are checked. Outputs pass
+ * the Khronos validator when it is installed (its exit status, no errors). */
 #define _GNU_SOURCE
 #include <limits.h>
 #include <math.h>
@@ -32,7 +36,9 @@ static void check_valid(const char *path)
     static int have_node = -1;
     if (have_node < 0) have_node = system("node --version > /dev/null 2>&1") == 0;
     char cmd[2048];
-    snprintf(cmd, sizeof cmd, "node '%s/tests/gltf/validate.js' '%s' | head -1", MK_SOURCE_ROOT, path);
+    /* The validator's status, not head's: sh has no pipefail. */
+    snprintf(cmd, sizeof cmd, "out=$(node '%s/tests/gltf/validate.js' '%s'); rc=$?; printf '%%s\\n' \"$out\" | head -1; exit $rc",
+             MK_SOURCE_ROOT, path);
     int rc = have_node ? system(cmd) : -1;
     if (rc == -1 || !WIFEXITED(rc) || WEXITSTATUS(rc) == 77) { validator_missing = 1; return; }
     CHECK_MSG(WEXITSTATUS(rc) == 0, "%s does not pass the glTF validator", path);
@@ -458,10 +464,254 @@ static void test_instanced_refused(void)
     mk_arena_free_all(&arena);
 }
 
+/* ---- a glTF made here: sparse targets, primitive.extras.targetNames, node.weights ---- */
+
+/* Two primitives (12 and 3 vertices, one float target each, named in primitive.extras
+ * targetNames), mesh.weights and node.weights that differ, and a weight animation whose last key
+ * is 3e10 s (a clip range the sidecar must carry). Buffer as a data: URI. */
+static char *synthetic_gltf(void)
+{
+    float bin[12 * 3 * 2 + 3 * 3 * 2 + 2 + 2];
+    size_t o = 0;
+    for (int v = 0; v < 12; v++) { bin[o++] = (float)(v % 4); bin[o++] = (float)(v / 4); bin[o++] = (float)(v % 3) * 0.5f; }
+    for (int v = 0; v < 12; v++) { bin[o++] = 0; bin[o++] = 0.125f; bin[o++] = 0; }
+    for (int v = 0; v < 3; v++) { bin[o++] = 5.0f + (float)v; bin[o++] = (float)(v == 2); bin[o++] = 0; }
+    for (int v = 0; v < 3; v++) { bin[o++] = 0; bin[o++] = 0; bin[o++] = -0.25f; }
+    bin[o++] = 0; bin[o++] = 3e10f;       /* key times */
+    bin[o++] = 0.75f; bin[o++] = 0.25f;   /* weights of the one target */
+    char *b64 = gt_base64((const unsigned char *)bin, sizeof bin);
+    char *json = malloc(8192);
+    snprintf(json, 8192,
+             "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+             "\"nodes\":[{\"name\":\"n\",\"mesh\":0,\"weights\":[0.3]}],"
+             "\"meshes\":[{\"name\":\"m\",\"weights\":[0.5],\"primitives\":["
+             "{\"attributes\":{\"POSITION\":0},\"targets\":[{\"POSITION\":1}],\"extras\":{\"targetNames\":[\"orig\"]}},"
+             "{\"attributes\":{\"POSITION\":2},\"targets\":[{\"POSITION\":3}],\"extras\":{\"targetNames\":[\"orig\"],\"keep\":1}}]}],"
+             "\"animations\":[{\"name\":\"far\",\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"weights\"}}],"
+             "\"samplers\":[{\"input\":4,\"output\":5,\"interpolation\":\"LINEAR\"}]}],"
+             "\"accessors\":["
+             "{\"bufferView\":0,\"componentType\":5126,\"count\":12,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[3,2,1]},"
+             "{\"bufferView\":0,\"byteOffset\":144,\"componentType\":5126,\"count\":12,\"type\":\"VEC3\",\"min\":[0,0.125,0],\"max\":[0,0.125,0]},"
+             "{\"bufferView\":0,\"byteOffset\":288,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[5,0,0],\"max\":[7,1,0]},"
+             "{\"bufferView\":0,\"byteOffset\":324,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,-0.25],\"max\":[0,0,-0.25]},"
+             "{\"bufferView\":1,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\",\"min\":[0],\"max\":[3e10]},"
+             "{\"bufferView\":1,\"byteOffset\":8,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":360,\"byteStride\":12,\"target\":34962},{\"buffer\":0,\"byteOffset\":360,\"byteLength\":16}],"
+             "\"buffers\":[{\"byteLength\":%zu,\"uri\":\"data:application/octet-stream;base64,%s\"}]}",
+             sizeof bin, b64);
+    free(b64);
+    return json;
+}
+
+/* The render vertex of raw mesh m that is glTF vertex g. */
+static uint32_t render_vertex(const mk_raw_mesh *m, uint32_t g)
+{
+    for (uint32_t v = 0; v < m->vertex_count; v++)
+        if (m->control_points[v] == g) return v;
+    return UINT32_MAX;
+}
+
+static const cJSON *at(const cJSON *j, const char *path)
+{
+    /* "a.b.3.c": members and array indices */
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", path);
+    for (char *tok = strtok(buf, "."); tok && j; tok = strtok(NULL, "."))
+        j = (*tok >= '0' && *tok <= '9') ? cJSON_GetArrayItem(j, atoi(tok)) : cJSON_GetObjectItemCaseSensitive(j, tok);
+    return j;
+}
+
+static int numbers_are(const cJSON *a, const double *v, int n)
+{
+    if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != n) return 0;
+    for (int i = 0; i < n; i++)
+        if (fabs(cJSON_GetArrayItem(a, i)->valuedouble - v[i]) > 1e-6) return 0;
+    return 1;
+}
+
+static int strings_are(const cJSON *a, const char *const *v, int n)
+{
+    if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != n) return 0;
+    for (int i = 0; i < n; i++)
+        if (!cJSON_IsString(cJSON_GetArrayItem(a, i)) || strcmp(cJSON_GetArrayItem(a, i)->valuestring, v[i])) return 0;
+    return 1;
+}
+
+static void test_synthetic(void)
+{
+    char *json = synthetic_gltf();
+    size_t json_size = strlen(json);
+    mk_raw_asset raw;
+    mk_error err;
+    mk_import_options io = { .keep_plain_meshes = 1 };
+    CHECK_MSG(gt_import_text(json, &io, &raw, &err) == MK_OK, "%s", err.message);
+    CHECK_EQ_INT(raw.mesh_count, 2);
+    CHECK_EQ_INT(raw.channel_count, 2);
+    CHECK_EQ_INT(raw.clip_count, 1);
+    if (raw.mesh_count != 2 || raw.channel_count != 2 || raw.clip_count != 1) { mk_raw_free(&raw); free(json); return; }
+    CHECK(raw.clips[0].duration == 3e10f);
+    uint32_t a = raw.meshes[0].gltf_primitive == 0 ? 0 : 1;
+    const mk_raw_mesh *ma = &raw.meshes[a];
+    CHECK_NEAR(raw.channels[raw.channels[0].mesh == a ? 0 : 1].default_weight, 0.3, 1e-6);   /* node.weights */
+
+    /* wb_sparse moves glTF vertices 1 and 3 of primitive 0 (2 of 12: a sparse accessor);
+     * wb_prog has two in-betweens moving every vertex (dense) and a default weight of 0.25. */
+    static const float sparse_delta[2][3] = { { 0.5f, 0, 0 }, { 0, 0.25f, -0.125f } };
+    mk_raw_channel *sp = mk_raw_add_channels(&raw, 1);
+    sp->name = "wb_sparse";
+    sp->origin = "{\"op\":\"made_up\"}";
+    sp->mesh = a;
+    mk_raw_target *t = mk_raw_add_targets(&raw, sp, 1);
+    t->name = "wb_sparse";
+    t->full_weight = 1;
+    t->count = 2;
+    t->indices = mk_arena_array(&raw.arena, 2, sizeof *t->indices);
+    t->positions = mk_arena_array(&raw.arena, 2, 3 * sizeof *t->positions);
+    uint32_t rv1 = render_vertex(ma, 1), rv3 = render_vertex(ma, 3);
+    int swap = rv3 < rv1;   /* target indices increase */
+    t->indices[0] = swap ? rv3 : rv1;
+    t->indices[1] = swap ? rv1 : rv3;
+    memcpy(t->positions, sparse_delta[swap], sizeof sparse_delta[0]);
+    memcpy(t->positions + 3, sparse_delta[!swap], sizeof sparse_delta[0]);
+    mk_raw_channel *pg = mk_raw_add_channels(&raw, 1);
+    pg->name = "wb_prog";
+    pg->origin = "{\"op\":\"made_up\"}";
+    pg->mesh = a;
+    pg->default_weight = 0.25f;
+    t = mk_raw_add_targets(&raw, pg, 2);
+    for (int k = 0; k < 2; k++) {
+        t[k].name = k ? "wb_prog_full" : "wb_prog_half";
+        t[k].full_weight = k ? 1.0f : 0.5f;
+        t[k].count = ma->vertex_count;
+        t[k].indices = mk_arena_array(&raw.arena, ma->vertex_count, sizeof *t->indices);
+        t[k].positions = mk_arena_array(&raw.arena, ma->vertex_count, 3 * sizeof *t->positions);
+        for (uint32_t v = 0; v < ma->vertex_count; v++) {
+            t[k].indices[v] = v;
+            t[k].positions[3 * v] = 0;
+            t[k].positions[3 * v + 1] = 0;
+            t[k].positions[3 * v + 2] = (float)(k + 1) * 0.0625f * (float)(ma->control_points[v] + 1);
+        }
+    }
+    CHECK(mk_raw_group_channels(&raw, &err) == MK_OK && mk_raw_validate(&raw, &err) == MK_OK);
+
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    void *out = NULL;
+    char *sc = NULL;
+    size_t size = 0, sc_size = 0;
+    mk_gltf_write_back_report rep;
+    mk_result r = mk_gltf_write_back(json, json_size, NULL, NULL, &raw, &arena, &out, &size, &sc, &sc_size, &rep, &err);
+    CHECK_MSG(r == MK_OK, "%s", err.message);
+    if (r != MK_OK) { mk_raw_free(&raw); mk_arena_free_all(&arena); free(json); return; }
+    CHECK(rep.channels == 2 && rep.targets == 3 && rep.padding_targets == 3 && rep.sparse_accessors == 1 &&
+          rep.dense_accessors == 2 && rep.rewritten_samplers == 1 && rep.sidecar_needed && sc != NULL);
+    char path[96], side[112];
+    snprintf(path, sizeof path, "/tmp/morphkit_writeback_%ld_synthetic.gltf", (long)getpid());
+    snprintf(side, sizeof side, "/tmp/morphkit_writeback_%ld_synthetic.channels.json", (long)getpid());
+    FILE *f = fopen(path, "wb");
+    CHECK(f && fwrite(out, 1, size, f) == size);
+    if (f) fclose(f);
+    f = fopen(side, "wb");
+    CHECK(f && fwrite(sc, 1, sc_size, f) == sc_size);
+    if (f) fclose(f);
+    check_valid(path);
+
+    cJSON *ji = json_of((const uint8_t *)json, json_size), *jo = json_of(out, size);
+    char why[700] = "";
+    CHECK_MSG(ji && jo && contains(ji, jo, "$", ".", ".", why, sizeof why), "%s", why);
+    /* The sparse target: 2 indices (unsigned short) and values, no bufferView; the
+     * in-betweens dense; the other primitive's padding: accessors without data (zeros). */
+    const cJSON *acc = cJSON_GetObjectItemCaseSensitive(jo, "accessors");
+    int pos[2][4];
+    for (int q = 0; q < 2; q++)
+        for (int k = 0; k < 4; k++) {
+            char p[64];
+            snprintf(p, sizeof p, "meshes.0.primitives.%d.targets.%d.POSITION", q, k);
+            const cJSON *x = at(jo, p);
+            pos[q][k] = cJSON_IsNumber(x) ? x->valueint : -1;
+            CHECK_MSG(pos[q][k] >= 0 && pos[q][k] < cJSON_GetArraySize(acc), "%s", p);
+        }
+    CHECK_EQ_INT(cJSON_GetArraySize(at(jo, "meshes.0.primitives.0.targets")), 4);
+    CHECK_EQ_INT(cJSON_GetArraySize(at(jo, "meshes.0.primitives.1.targets")), 4);
+    if (pos[0][1] >= 0) {
+        const cJSON *s1 = cJSON_GetArrayItem(acc, pos[0][1]);
+        CHECK(!cJSON_GetObjectItemCaseSensitive(s1, "bufferView"));
+        CHECK_EQ_INT(at(s1, "sparse.count") ? at(s1, "sparse.count")->valueint : -1, 2);
+        CHECK_EQ_INT(at(s1, "sparse.indices.componentType") ? at(s1, "sparse.indices.componentType")->valueint : -1, 5123);
+        CHECK_EQ_INT(at(s1, "count") ? at(s1, "count")->valueint : -1, 12);
+        static const double lo[3] = { 0, 0, -0.125 }, hi[3] = { 0.5, 0.25, 0 };
+        CHECK(numbers_are(at(s1, "min"), lo, 3) && numbers_are(at(s1, "max"), hi, 3));
+    }
+    for (int k = 2; k < 4; k++)
+        if (pos[0][k] >= 0) {
+            const cJSON *d = cJSON_GetArrayItem(acc, pos[0][k]);
+            CHECK(cJSON_GetObjectItemCaseSensitive(d, "bufferView") && !cJSON_GetObjectItemCaseSensitive(d, "sparse"));
+        }
+    for (int k = 1; k < 4; k++)
+        if (pos[1][k] >= 0) {
+            const cJSON *z = cJSON_GetArrayItem(acc, pos[1][k]);
+            CHECK(!cJSON_GetObjectItemCaseSensitive(z, "bufferView") && !cJSON_GetObjectItemCaseSensitive(z, "sparse"));
+        }
+    /* Weights: the defaults of the new targets (wb_prog at 0.25 = half of its 0.5 in-between)
+     * appended to node.weights and mesh.weights alike. */
+    static const double node_w[4] = { 0.3, 0, 0.5, 0 }, mesh_w[4] = { 0.5, 0, 0.5, 0 };
+    CHECK_MSG(numbers_are(at(jo, "nodes.0.weights"), node_w, 4), "node.weights not extended");
+    CHECK_MSG(numbers_are(at(jo, "meshes.0.weights"), mesh_w, 4), "mesh.weights not extended");
+    /* Target names: both primitives' extras.targetNames and the mesh's (created). */
+    static const char *const names[4] = { "orig", "wb_sparse", "wb_prog_half", "wb_prog_full" };
+    CHECK_MSG(strings_are(at(jo, "meshes.0.primitives.0.extras.targetNames"), names, 4), "primitive 0 targetNames");
+    CHECK_MSG(strings_are(at(jo, "meshes.0.primitives.1.extras.targetNames"), names, 4), "primitive 1 targetNames");
+    CHECK_MSG(strings_are(at(jo, "meshes.0.extras.targetNames"), names, 4), "mesh targetNames");
+    cJSON_Delete(ji);
+    cJSON_Delete(jo);
+
+    /* Re-imported with the sidecar: the same channels (sparse deltas exact, float accessors),
+     * defaults, the clip's weights held, the clip's 3e10 s range. */
+    mk_raw_asset back;
+    r = import_path(path, side, &back, &err);
+    CHECK_MSG(r == MK_OK, "re-import: %s", err.message);
+    if (r == MK_OK) {
+        CHECK_EQ_INT(back.channel_count, 4);
+        CHECK(back.clip_count == 1 && back.clips[0].duration == 3e10f);
+        for (uint32_t c = 0; c < back.channel_count && back.channel_count == 4; c++) {
+            const mk_raw_channel *x = &back.channels[c], *y = NULL;
+            for (uint32_t d = 0; d < raw.channel_count; d++)
+                if (raw.channels[d].mesh == x->mesh && !strcmp(raw.channels[d].name, x->name)) y = &raw.channels[d];
+            CHECK_MSG(y != NULL, "re-imported channel '%s' on mesh %u was not written", x->name, x->mesh);
+            if (!y) continue;
+            CHECK_NEAR(x->default_weight, y->default_weight, 1e-6);
+            CHECK_EQ_INT(x->target_count, y->target_count);
+            for (uint32_t k = 0; k < x->target_count && x->target_count == y->target_count; k++)
+                CHECK_MSG(same_target(&x->targets[k], &y->targets[k]), "channel '%s' target %u differs", x->name, k);
+        }
+        const mk_raw_clip *clip = &back.clips[0];
+        for (uint32_t k = 0; k < clip->track_count; k++) {
+            const mk_raw_channel *x = &back.channels[clip->tracks[k].channel];
+            if (!strcmp(x->name, "orig")) continue;
+            for (uint32_t q = 0; q < clip->tracks[k].key_count; q++)
+                CHECK_NEAR(clip->tracks[k].keys[q].value, x->default_weight, 1e-6);
+        }
+        mk_raw_free(&back);
+    }
+    /* Without it: one channel per target, named from the target names. */
+    r = import_path(path, NULL, &back, &err);
+    CHECK_MSG(r == MK_OK, "re-import without sidecar: %s", err.message);
+    if (r == MK_OK) {
+        CHECK_EQ_INT(back.channel_count, 8);
+        for (uint32_t c = 0; c < back.channel_count && back.channel_count == 8; c++)
+            CHECK_MSG(!strcmp(back.channels[c].name, names[c % 4]), "channel %u is '%s'", c, back.channels[c].name);
+        mk_raw_free(&back);
+    }
+    if (!getenv("MK_KEEP_OUTPUT")) { remove(path); remove(side); }
+    mk_raw_free(&raw);
+    mk_arena_free_all(&arena);
+    free(json);
+}
+
 static void test_validator_ran(void)
 {
     if (validator_missing || !validated) SKIP("glTF validator not available (npm install --prefix tests/gltf)");
     printf("  %d written-back files passed the Khronos glTF validator\n", validated);
 }
 
-CHECK_MAIN(CASE(test_corpus_write_back), CASE(test_instanced_refused), CASE(test_validator_ran))
+CHECK_MAIN(CASE(test_corpus_write_back), CASE(test_instanced_refused), CASE(test_synthetic), CASE(test_validator_ran))
