@@ -58,8 +58,7 @@ static void copy_record(doc_writer *w, const fbx_node *node)
         static const uint8_t zeros[25];
         fbx_bytes_append(out, zeros, w->header);  /* the null record closing the new children */
     }
-    if (!out->failed)
-        fbx_record_header(out->data + start, w->wide, out->size, value_count, list_length, (uint8_t)node->name_length);
+    fbx_record_header(out, start, w->wide, out->size, value_count, list_length, (uint8_t)node->name_length);
 }
 
 static mk_result write_binary(doc_writer *w)
@@ -135,5 +134,8 @@ mk_result fbx_doc_write(const fbx_doc *doc, const fbx_insertion *insertions, uin
     doc_writer w = { doc, insertions, count, out, 0, 0 };
     mk_result r = doc->binary ? write_binary(&w) : write_ascii(&w);
     if (r == MK_OK && out->failed) r = mk_error_oom(doc->err, "FBX output");
+    if (r == MK_OK && out->too_large)
+        r = mk_error_set(doc->err, MK_ERROR_LIMIT, UINT64_MAX,
+                         "FBX output passes 4 GiB, which a file before FBX 7.5 (32-bit record offsets) cannot address");
     return r;
 }

@@ -306,6 +306,8 @@ mk_result mk_fbx_export(const mk_raw_asset *raw, mk_arena *arena, void **out, si
         fbx_bytes_append(&bytes, zeros, 120);
         fbx_bytes_append(&bytes, footer_magic, 16);
         if (bytes.failed) r = mk_error_oom(err, "FBX output");
+        else if (bytes.too_large)
+            r = mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "FBX export: the file would pass 4 GiB (FBX 7.4's record offsets are 32-bit)");
     }
     if (r == MK_OK) {
         *out = bytes.data;

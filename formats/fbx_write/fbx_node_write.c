@@ -152,9 +152,15 @@ static void put_le(uint8_t *at, uint64_t v, int bytes)
     for (int i = 0; i < bytes; i++) at[i] = (uint8_t)(v >> (8 * i));
 }
 
-void fbx_record_header(uint8_t *at, int wide, uint64_t end, uint64_t value_count, uint64_t list_length,
+void fbx_record_header(fbx_bytes *out, size_t offset, int wide, uint64_t end, uint64_t value_count, uint64_t list_length,
                        uint8_t name_length)
 {
+    if (out->failed) return;
+    if (!wide && (end > UINT32_MAX || value_count > UINT32_MAX || list_length > UINT32_MAX)) {
+        out->too_large = 1;
+        return;
+    }
+    uint8_t *at = out->data + offset;
     int w = wide ? 8 : 4;
     put_le(at, end, w);
     put_le(at + w, value_count, w);
@@ -221,8 +227,7 @@ void fbx_wn_write_binary(fbx_bytes *out, const fbx_wnode *node, uint64_t base, i
     const size_t list_length = out->size - values_at;
     for (uint32_t i = 0; i < node->child_count; i++) fbx_wn_write_binary(out, node->children[i], base, wide);
     if (node->child_count || !node->value_count) fbx_bytes_append(out, zeros, header);
-    if (out->failed) return;
-    fbx_record_header(out->data + start, wide, base + out->size, node->value_count, list_length, (uint8_t)name_length);
+    fbx_record_header(out, start, wide, base + out->size, node->value_count, list_length, (uint8_t)name_length);
 }
 
 /* ---- ASCII ---- */

@@ -39,12 +39,14 @@ struct fbx_wnode {
     uint32_t child_count, child_cap;
 };
 
-/* A growing byte buffer in an arena. Appends set `failed` instead of returning errors. */
+/* A growing byte buffer in an arena. Appends set `failed` instead of returning errors;
+ * `too_large` is set when a record of a file with 13-byte record headers would end past 4 GiB
+ * (its u32 EndOffset cannot say where). */
 typedef struct fbx_bytes {
     mk_arena *arena;
     uint8_t *data;
     size_t size, cap;
-    int failed;
+    int failed, too_large;
 } fbx_bytes;
 
 void fbx_bytes_append(fbx_bytes *b, const void *data, size_t size);
@@ -76,8 +78,9 @@ fbx_wnode *fbx_wn_array(mk_arena *arena, fbx_wnode *parent, const char *name, ch
  * else 13. A null record closes the children, and follows a node with neither values nor
  * children (as the FBX SDK and Blender write them). */
 void fbx_wn_write_binary(fbx_bytes *out, const fbx_wnode *node, uint64_t base, int wide);
-/* Record header fields at `at` in out (after the record is complete). */
-void fbx_record_header(uint8_t *at, int wide, uint64_t end, uint64_t value_count, uint64_t list_length,
+/* Record header fields at `at` of out (after the record is complete); sets out->too_large
+ * when a narrow header cannot hold a field. */
+void fbx_record_header(fbx_bytes *out, size_t at, int wide, uint64_t end, uint64_t value_count, uint64_t list_length,
                        uint8_t name_length);
 /* ASCII text of `node` at nesting `depth` (tabs), ending with a newline. */
 void fbx_wn_write_ascii(fbx_bytes *out, const fbx_wnode *node, uint32_t depth);
