@@ -205,6 +205,28 @@ static void dir_of(const char *path, char *out, size_t n)
     snprintf(out, n, "%.*s", sl ? (int)(sl - path) : 1, sl ? path : ".");
 }
 
+/* Alignment glTF requires of what the write-back adds: every new bufferView starts on a 4-byte
+ * boundary (float components), and a GLB's chunks have lengths that are multiples of 4. */
+static int aligned(const cJSON *ji, const cJSON *jo, const uint8_t *bytes, size_t size, char *why, size_t n)
+{
+    const cJSON *vi = cJSON_GetObjectItemCaseSensitive(ji, "bufferViews"), *vo = cJSON_GetObjectItemCaseSensitive(jo, "bufferViews");
+    for (int i = cJSON_GetArraySize(vi); i < cJSON_GetArraySize(vo); i++) {
+        const cJSON *off = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(vo, i), "byteOffset");
+        if (off && (!cJSON_IsNumber(off) || (long long)off->valuedouble % 4 != 0)) {
+            snprintf(why, n, "bufferViews[%d].byteOffset %g is not a multiple of 4", i, off->valuedouble);
+            return 0;
+        }
+    }
+    if (size >= 12 && memcmp(bytes, "glTF", 4) == 0)
+        for (size_t at = 12; at + 8 <= size;) {
+            uint32_t length = (uint32_t)bytes[at] | (uint32_t)bytes[at + 1] << 8 | (uint32_t)bytes[at + 2] << 16 |
+                              (uint32_t)bytes[at + 3] << 24;
+            if (length % 4) { snprintf(why, n, "GLB chunk at byte %zu has length %u", at, length); return 0; }
+            at += 8 + (size_t)length;
+        }
+    return 1;
+}
+
 static void test_corpus_write_back(void)
 {
     pb_manifest manifest;
@@ -291,6 +313,7 @@ static void test_corpus_write_back(void)
         cJSON *ji = json_of(in, in_size), *jo = json_of(bytes, size);
         char why[700] = "";
         CHECK_MSG(ji && jo && contains(ji, jo, "$", in_dir, out_dir, why, sizeof why), "%s: %s", c->name, why);
+        CHECK_MSG(ji && jo && aligned(ji, jo, bytes, size, why, sizeof why), "%s: %s", c->name, why);
 
         r = import_path(out, side, &back, &err);
         CHECK_MSG(r == MK_OK, "%s: re-import: %s", c->name, err.message);
@@ -558,9 +581,10 @@ static void test_synthetic(void)
     const mk_raw_mesh *ma = &raw.meshes[a];
     CHECK_NEAR(raw.channels[raw.channels[0].mesh == a ? 0 : 1].default_weight, 0.3, 1e-6);   /* node.weights */
 
-    /* wb_sparse moves glTF vertices 1 and 3 of primitive 0 (2 of 12: a sparse accessor);
-     * wb_prog has two in-betweens moving every vertex (dense) and a default weight of 0.25. */
-    static const float sparse_delta[2][3] = { { 0.5f, 0.125f, -0.25f }, { 0.25f, 0.25f, -0.125f } };
+    /* wb_sparse moves glTF vertices 1, 3 and 5 of primitive 0 (3 of 12: a sparse accessor, whose
+     * 3 uint16 indices end off a 4-byte boundary); wb_prog has two in-betweens moving every
+     * vertex (dense) and a default weight of 0.25. */
+    static const float sparse_delta[3][3] = { { 0.5f, 0.125f, -0.25f }, { 0.25f, 0.25f, -0.125f }, { 0.375f, 0.125f, -0.125f } };
     mk_raw_channel *sp = mk_raw_add_channels(&raw, 1);
     sp->name = "wb_sparse";
     sp->origin = "{\"op\":\"made_up\"}";
@@ -568,15 +592,19 @@ static void test_synthetic(void)
     mk_raw_target *t = mk_raw_add_targets(&raw, sp, 1);
     t->name = "wb_sparse";
     t->full_weight = 1;
-    t->count = 2;
-    t->indices = mk_arena_array(&raw.arena, 2, sizeof *t->indices);
-    t->positions = mk_arena_array(&raw.arena, 2, 3 * sizeof *t->positions);
-    uint32_t rv1 = render_vertex(ma, 1), rv3 = render_vertex(ma, 3);
-    int swap = rv3 < rv1;   /* target indices increase */
-    t->indices[0] = swap ? rv3 : rv1;
-    t->indices[1] = swap ? rv1 : rv3;
-    memcpy(t->positions, sparse_delta[swap], sizeof sparse_delta[0]);
-    memcpy(t->positions + 3, sparse_delta[!swap], sizeof sparse_delta[0]);
+    t->count = 3;
+    t->indices = mk_arena_array(&raw.arena, 3, sizeof *t->indices);
+    t->positions = mk_arena_array(&raw.arena, 3, 3 * sizeof *t->positions);
+    {
+        uint32_t rv[3] = { render_vertex(ma, 1), render_vertex(ma, 3), render_vertex(ma, 5) }, order[3] = { 0, 1, 2 };
+        for (int i = 0; i < 3; i++)   /* target indices increase */
+            for (int j = i + 1; j < 3; j++)
+                if (rv[order[j]] < rv[order[i]]) { uint32_t x = order[i]; order[i] = order[j]; order[j] = x; }
+        for (int i = 0; i < 3; i++) {
+            t->indices[i] = rv[order[i]];
+            memcpy(t->positions + 3 * i, sparse_delta[order[i]], sizeof sparse_delta[0]);
+        }
+    }
     mk_raw_channel *pg = mk_raw_add_channels(&raw, 1);
     pg->name = "wb_prog";
     pg->origin = "{\"op\":\"made_up\"}";
@@ -623,7 +651,8 @@ static void test_synthetic(void)
     cJSON *ji = json_of((const uint8_t *)json, json_size), *jo = json_of(out, size);
     char why[700] = "";
     CHECK_MSG(ji && jo && contains(ji, jo, "$", ".", ".", why, sizeof why), "%s", why);
-    /* The sparse target: 2 indices (unsigned short) and values, no bufferView; the
+    CHECK_MSG(ji && jo && aligned(ji, jo, out, size, why, sizeof why), "%s", why);
+    /* The sparse target: 3 indices (unsigned short) and values, no bufferView; the
      * in-betweens dense; the other primitive's padding: accessors without data (zeros). */
     const cJSON *acc = cJSON_GetObjectItemCaseSensitive(jo, "accessors");
     int pos[2][4];
@@ -640,7 +669,7 @@ static void test_synthetic(void)
     if (pos[0][1] >= 0) {
         const cJSON *s1 = cJSON_GetArrayItem(acc, pos[0][1]);
         CHECK(!cJSON_GetObjectItemCaseSensitive(s1, "bufferView"));
-        CHECK_EQ_INT(at(s1, "sparse.count") ? at(s1, "sparse.count")->valueint : -1, 2);
+        CHECK_EQ_INT(at(s1, "sparse.count") ? at(s1, "sparse.count")->valueint : -1, 3);
         CHECK_EQ_INT(at(s1, "sparse.indices.componentType") ? at(s1, "sparse.indices.componentType")->valueint : -1, 5123);
         CHECK_EQ_INT(at(s1, "count") ? at(s1, "count")->valueint : -1, 12);
         /* the untouched vertices' zeros count: no moved delta is 0 on any axis */
