@@ -59,7 +59,9 @@ static void release_file_bytes(void *user)
     f->data = NULL;
 }
 
-mk_result mk_import_file(const char *path, const mk_import_options *options, mk_raw_asset *out, mk_error *err)
+/* mk_import_file, the file's bytes kept in out->arena (*kept, *kept_size) when kept is set. */
+static mk_result import_file(const char *path, const mk_import_options *options, mk_raw_asset *out, const void **kept,
+                             size_t *kept_size, mk_error *err)
 {
     if (!path || !out) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "import: invalid argument");
     mk_import_options o;
@@ -69,9 +71,10 @@ mk_result mk_import_file(const char *path, const mk_import_options *options, mk_
     mk_arena_init(&tmp, &out->arena.allocator);
     void *data;
     size_t size;
+    mk_arena *holder = kept ? &out->arena : &tmp;
     mk_result r =
-        mk_read_file_threads(&tmp, path, o.max_input_size ? o.max_input_size : MK_IMPORT_DEFAULT_MAX_INPUT,
-                             mk_arena_threads(&tmp, o.threads), &data, &size, err);
+        mk_read_file_threads(holder, path, o.max_input_size ? o.max_input_size : MK_IMPORT_DEFAULT_MAX_INPUT,
+                             mk_arena_threads(holder, o.threads), &data, &size, err);
     if (r != MK_OK) {  /* the message names the file */
         mk_arena_free_all(&tmp);
         return r;
@@ -89,8 +92,13 @@ mk_result mk_import_file(const char *path, const mk_import_options *options, mk_
         o.base_dir = dir;
     }
     file_bytes bytes = { &tmp, data };
-    o.input_done = release_file_bytes;
-    o.input_done_user = &bytes;
+    if (kept) {
+        *kept = data;
+        *kept_size = size;
+    } else {
+        o.input_done = release_file_bytes;
+        o.input_done_user = &bytes;
+    }
     r = mk_import_memory(data, size, &o, out, err);
     if (r != MK_OK && err && strncmp(err->message, path, strlen(path)) != 0) {
         /* Name the file once, in front, unless the message already starts with it. */
@@ -101,6 +109,18 @@ mk_result mk_import_file(const char *path, const mk_import_options *options, mk_
     }
     mk_arena_free_all(&tmp);
     return r;
+}
+
+mk_result mk_import_file(const char *path, const mk_import_options *options, mk_raw_asset *out, mk_error *err)
+{
+    return import_file(path, options, out, NULL, NULL, err);
+}
+
+mk_result mk_import_file_keeping(const char *path, const mk_import_options *options, mk_raw_asset *out,
+                                 const void **bytes, size_t *size, mk_error *err)
+{
+    if (!bytes || !size) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "import: invalid argument");
+    return import_file(path, options, out, bytes, size, err);
 }
 
 mk_result mk_import_load_asset(void *user, const char *path, mk_raw_asset *out, mk_error *err)

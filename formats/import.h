@@ -12,6 +12,11 @@
 mk_result mk_import_memory(const void *data, size_t size, const mk_import_options *options, mk_raw_asset *out,
                            mk_error *err);
 mk_result mk_import_file(const char *path, const mk_import_options *options, mk_raw_asset *out, mk_error *err);
+/* mk_import_file, and the file's bytes stay in out->arena (*bytes, *size): a write-back puts
+ * the bake into the very bytes the import read (the file is read once, so a pipe works and a
+ * file changed meanwhile does not matter). */
+mk_result mk_import_file_keeping(const char *path, const mk_import_options *options, mk_raw_asset *out,
+                                 const void **bytes, size_t *size, mk_error *err);
 /* mk_import_file in the shape of mk_bake_options.load_asset (a `transfer` recipe's source), with
  * the default options and every mesh kept, so mesh indices count the file's meshes. user is not
  * read: mk_bake_options.user is shared with the bake's other callbacks (progress, reports). */

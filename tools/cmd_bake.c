@@ -245,47 +245,53 @@ static void dir_of(const char *path, char *out, size_t size)
     out[n] = 0;
 }
 
-/* -o OUT.fbx: the input FBX file with the baked channels added. */
-static mk_result write_back_fbx(const bake_args *a, mk_raw_asset *raw, void **out, size_t *size, mk_error *err)
+/* -o OUT.fbx: what the write-back refuses about IN itself, before the bake. */
+static mk_result check_fbx_input(const bake_args *a, const mk_raw_asset *raw, const void *input, size_t input_size,
+                                 mk_error *err)
 {
     if (strncmp(raw->source_format, "fbx", 3) != 0)
         return mk_error_set(err, MK_ERROR_UNSUPPORTED, UINT64_MAX,
                             "-o %s: an .fbx output is the FBX input with the baked channels added, and %s is not FBX (%s); "
                             "write a .morph, or export it as FBX first (morphkit export IN -o IN.fbx)",
                             a->output, a->input, raw->source_format[0] ? raw->source_format : "unknown");
-    void *input = NULL;
-    size_t input_size = 0;
+    return mk_fbx_write_back_check(input, input_size, err);
+}
+
+/* -o OUT.fbx: the input FBX file (the bytes the import read) with the baked channels added. */
+static mk_result write_back_fbx(const bake_args *a, mk_raw_asset *raw, const void *input, size_t input_size, void **out,
+                                size_t *size, mk_error *err)
+{
     mk_fbx_write_report rep;
-    mk_result r = mk_read_file(&raw->arena, a->input, MK_IMPORT_DEFAULT_MAX_INPUT, &input, &input_size, err);
-    if (r == MK_OK) r = mk_fbx_write_back(input, input_size, raw, &raw->arena, out, size, &rep, err);
-    mk_arena_release(&raw->arena, input);
+    mk_result r = mk_fbx_write_back(input, input_size, raw, &raw->arena, out, size, &rep, err);
     if (r == MK_OK && !a->json)
         printf("FBX: %u channel%s with %u shape%s on %u mesh%s (%u new BlendShape deformer%s), %u clip%s as animation stacks\n",
                rep.channels, rep.channels == 1 ? "" : "s", rep.shapes, rep.shapes == 1 ? "" : "s", rep.meshes,
                rep.meshes == 1 ? "" : "es", rep.blend_shapes, rep.blend_shapes == 1 ? "" : "s", rep.clips,
                rep.clips == 1 ? "" : "s");
+    if (r == MK_OK && !a->json && rep.progressive_channels)
+        printf("note: %u channel%s with in-betweens (FBX's own progressive shapes, as Maya writes them; ufbx plays them; "
+               "Blender 3.4's FBX importer cannot read in-betweens and refuses such files; \"inbetweens\": 1 bakes one target)\n",
+               rep.progressive_channels, rep.progressive_channels == 1 ? "" : "s");
     return r;
 }
 
 /* -o OUT.gltf|OUT.glb: IN's own glTF with the baked channels appended as targets (formats/gltf_writeback),
  * and the channel sidecar OUT.channels.json (outs[*count]) beside it. The raw asset still has
  * its plain meshes. Returns -1 when outs[0] (and the sidecar) are filled, else the exit status. */
-static int write_back_gltf(const cli_verb *verb, const bake_args *a, mk_raw_asset *raw, cli_output *outs,
-                           uint32_t *count, size_t *size)
+static int write_back_gltf(const cli_verb *verb, const bake_args *a, mk_raw_asset *raw, const void *in, size_t in_size,
+                           cli_output *outs, uint32_t *count, size_t *size)
 {
     static char sidecar_path[4200];
     const char *dot = strrchr(a->output, '.');
     snprintf(sidecar_path, sizeof sidecar_path, "%.*s.channels.json", (int)(dot - a->output), a->output);
     static const char *const json_ext[] = { ".json", NULL };
     const char *inputs[] = { a->input, a->recipe, a->output };
-    void *in = NULL, *out = NULL;
+    void *out = NULL;
     char *sidecar = NULL;
-    size_t in_size = 0, sidecar_size = 0;
+    size_t sidecar_size = 0;
     mk_gltf_write_back_report rep;
     mk_error err;
-    mk_result r = mk_read_file(&raw->arena, a->input, MK_IMPORT_DEFAULT_MAX_INPUT, &in, &in_size, &err);
-    if (r == MK_OK)
-        r = mk_gltf_write_back(in, in_size, a->input, a->output, raw, &raw->arena, &out, size, &sidecar, &sidecar_size,
+    mk_result r = mk_gltf_write_back(in, in_size, a->input, a->output, raw, &raw->arena, &out, size, &sidecar, &sidecar_size,
                                &rep, &err);
     if (r != MK_OK) return cli_fail(verb->name, &err);
     outs[0].file.data = out;
@@ -349,7 +355,13 @@ static int run_bake(void *p)
     void *recipe = NULL, *blob = NULL;
     size_t recipe_size = 0, size = 0;
     char *dep_text = NULL;
-    mk_result r = mk_import_file(a->input, &io, &raw, &err);
+    const int to_fbx = mk_path_has_extension(a->output, ".fbx");
+    /* A write-back puts the bake into the bytes the import read (the input is read once). */
+    const void *input = NULL;
+    size_t input_size = 0;
+    mk_result r = write_back || to_fbx ? mk_import_file_keeping(a->input, &io, &raw, &input, &input_size, &err)
+                                       : mk_import_file(a->input, &io, &raw, &err);
+    if (r == MK_OK && to_fbx) r = check_fbx_input(a, &raw, input, input_size, &err);
     if (r == MK_OK) r = mk_read_file(&raw.arena, a->recipe, (size_t)64 << 20, &recipe, &recipe_size, &err);
     if (r == MK_OK && a->depfile) cli_depfile_add(&ui.deps, a->recipe);
     char dir[4096];
@@ -360,16 +372,15 @@ static int run_bake(void *p)
     mk_bake_report report;
     if (r == MK_OK) r = mk_bake_recipe(&raw, recipe, recipe_size, &bo, &report, &err);
     mk_write_report wr = { 0 };
-    const int to_fbx = mk_path_has_extension(a->output, ".fbx");
     if (r == MK_OK && write_back) {
         cli_print_warnings(&raw);
-        if ((status = write_back_gltf(verb, a, &raw, outs, &out_count, &size)) >= 0) goto done;
+        if ((status = write_back_gltf(verb, a, &raw, input, input_size, outs, &out_count, &size)) >= 0) goto done;
     } else {
         if (r == MK_OK && !a->all_meshes && !to_fbx)
             mk_raw_drop_plain_meshes(&raw, "not written (no channel; --all-meshes keeps it)");
         cli_print_warnings(&raw);
         mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16 };
-        if (r == MK_OK) r = to_fbx ? write_back_fbx(a, &raw, &blob, &size, &err)
+        if (r == MK_OK) r = to_fbx ? write_back_fbx(a, &raw, input, input_size, &blob, &size, &err)
                                    : mk_write_blob(&raw, &wo, &raw.arena, &blob, &size, &wr, &err);
         if (r != MK_OK) {
             status = cli_fail(verb->name, &err);

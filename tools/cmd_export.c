@@ -40,7 +40,7 @@ const cli_verb cli_verb_export = {
                    "the grouping so "
                    "a re-import restores the channels. The glTF and the sidecar are written both or neither. As .fbx, "
                    "each mesh becomes a model with its geometry and blend shape channels, in-betweens as FBX "
-                   "in-between shapes (docs/importing-fbx.md, \"Export to FBX\").",
+                   "in-between shapes (docs/baking.md, \"Baking into your own file\").",
     .positional = "FILE",
     .positional_help = "A .morph blob, or any file 'morphkit import' reads.",
     .positional_offset = offsetof(export_args, input),
@@ -59,7 +59,8 @@ static int export_fbx(const cli_verb *verb, const export_args *a)
     cli_output out;
     int status = cli_output_check(verb, &out, "-o", a->output, fbx_ext, "an FBX file", 0, inputs, 2);
     if (status >= 0) return status;
-    mk_import_options io = { .channels_sidecar = a->channels };
+    /* A scene: meshes without morph targets are written too. */
+    mk_import_options io = { .channels_sidecar = a->channels, .keep_plain_meshes = 1 };
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     mk_error err;
@@ -74,9 +75,14 @@ static int export_fbx(const cli_verb *verb, const export_args *a)
         return cli_fail(verb->name, &err);
     }
     status = cli_write_outputs(verb, &out, 1);
-    if (status == 0)
+    if (status == 0) {
         printf("%s -> %s: %u meshes, %u channels with %u shapes, %u clips as animation stacks, %zu bytes\n", a->input,
                a->output, rep.meshes, rep.channels, rep.shapes, rep.clips, out.file.size);
+        if (rep.progressive_channels)
+            printf("note: %u channel%s with in-betweens (FBX's own progressive shapes, as Maya writes them; ufbx plays "
+                   "them; Blender 3.4's FBX importer cannot read in-betweens and refuses such files)\n",
+                   rep.progressive_channels, rep.progressive_channels == 1 ? "" : "s");
+    }
     mk_raw_free(&raw);
     return status;
 }

@@ -114,18 +114,30 @@ static mk_result write_ascii(doc_writer *w)
         order[n++] = &w->ins[i];
     }
     qsort(order, n, sizeof *order, by_position);
+    /* The file's line ending: CRLF when its first line ends so. */
+    const uint8_t *first_newline = memchr(doc->data, '\n', doc->size);
+    const int crlf = first_newline && first_newline > doc->data && first_newline[-1] == '\r';
+    fbx_bytes text = { .arena = w->out->arena };
     uint64_t copied = 0;
     for (uint32_t i = 0; i < n; i++) {
         const uint64_t brace = order[i]->parent->end - 1;
         fbx_bytes_append(w->out, doc->data + copied, (size_t)(brace - copied));
         /* The brace may follow other text on its line: the new nodes start on a line of their own. */
-        if (brace > 0 && doc->data[brace - 1] != '\n' && doc->data[brace - 1] != '\t' && doc->data[brace - 1] != ' ')
-            fbx_bytes_append(w->out, "\n", 1);
+        uint64_t line = brace;
+        while (line > 0 && (doc->data[line - 1] == ' ' || doc->data[line - 1] == '\t')) line--;
+        if (line > 0 && doc->data[line - 1] != '\n') fbx_bytes_append(w->out, crlf ? "\r\n" : "\n", crlf ? 2 : 1);
+        text.size = 0;
         for (uint32_t k = 0; k < order[i]->count; k++)
-            fbx_wn_write_ascii(w->out, order[i]->nodes[k], order[i]->parent->depth + 1);
+            fbx_wn_write_ascii(&text, order[i]->nodes[k], order[i]->parent->depth + 1);
+        for (size_t c = 0; c < text.size; c++) {
+            if (crlf && text.data[c] == '\n') fbx_bytes_append(w->out, "\r", 1);
+            fbx_bytes_append(w->out, text.data + c, 1);
+        }
+        w->out->failed |= text.failed;
         copied = brace;
     }
     fbx_bytes_append(w->out, doc->data + copied, (size_t)(doc->size - copied));
+    mk_arena_release(text.arena, text.data);
     return MK_OK;
 }
 

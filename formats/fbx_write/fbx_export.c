@@ -2,7 +2,8 @@
 /* A raw asset as a new binary FBX 7.4 file (fbx_write.h, mk_fbx_export).
  *
  * Top level: FBXHeaderExtension, FileId, CreationTime, Creator, GlobalSettings (axes and unit
- * of the source when the asset knows them, else Y up and 1 cm per unit), Definitions (object
+ * of the source when the asset knows them: an FBX's own, glTF's Y up in metres; else Y up and
+ * 1 cm per unit), Definitions (object
  * counts), Objects, Connections, then the footer. FileId, CreationTime and the footer's 16
  * bytes are the fixed values Blender's exporter writes (every FBX reader accepts that triple).
  *
@@ -85,8 +86,11 @@ static mk_result header(exporter *e)
         !fbx_wn_string(e->o.a, creator, "morphkit", 8))
         return OOM(e);
     const mk_raw_asset *raw = e->raw;
-    const int up = raw->up_axis >= 0 && raw->up_axis <= 2 ? raw->up_axis : 1;
-    const double unit = raw->unit_scale > 0 ? raw->unit_scale : 1.0;
+    /* glTF is Y up in metres (100 cm per unit); an FBX source says its own; a blob does not
+     * record them: Y up, 1 cm per unit. */
+    const int gltf = strncmp(raw->source_format, "gltf", 4) == 0;
+    const int up = !gltf && raw->up_axis >= 0 && raw->up_axis <= 2 ? raw->up_axis : 1;
+    const double unit = gltf ? 100.0 : raw->unit_scale > 0 ? raw->unit_scale : 1.0;
     fbx_wnode *g = top_node(e, "GlobalSettings");
     fbx_wnode *props = g ? fbx_wn_child(e->o.a, g, "Properties70") : NULL;
     /* Right-handed axes: up, front and coordinate axes as Maya (Y up: front Z, coord X) and
@@ -163,6 +167,9 @@ static mk_result mesh(exporter *e, uint32_t mi, int64_t *channel_ids)
     if (r == MK_OK) r = decompose(e, m, t, rot, s);
     if (r != MK_OK) return r;
     const uint32_t cps = m->control_point_count;
+    if (cps > UINT32_MAX / 3 || m->triangle_count > UINT32_MAX / 9)
+        return mk_error_set(o->err, MK_ERROR_LIMIT, UINT64_MAX, "FBX export: mesh '%s' is larger than an FBX array can hold",
+                            m->name);
     double *points = mk_arena_array(o->a, cps, 3 * sizeof(double));
     int32_t *corners = mk_arena_array(o->a, 3 * (size_t)m->triangle_count + 1, sizeof(int32_t));
     double *normals = m->normals ? mk_arena_array(o->a, 9 * (size_t)m->triangle_count + 1, sizeof(double)) : NULL;

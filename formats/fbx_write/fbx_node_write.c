@@ -194,6 +194,7 @@ static void write_value(fbx_bytes *out, const fbx_wvalue *v)
         break;
     case 'i': case 'l': case 'f': case 'd': {
         const int elem = v->type == 'i' || v->type == 'f' ? 4 : 8;
+        if ((uint64_t)v->count * (uint64_t)elem > UINT32_MAX) { out->too_large = 1; return; }
         append_le(out, v->count, 4);
         append_le(out, 0, 4);  /* raw, not deflated */
         append_le(out, (uint64_t)v->count * (uint64_t)elem, 4);

@@ -28,6 +28,7 @@
 #include "fbx_objects.h"
 
 #define KTIME_PER_SECOND 46186158000.0  /* FBX 7.x */
+#define KTIME_MAX_SECONDS 1.9e8          /* int64 KTime reaches about 2e8 s */
 
 mk_result fbx_objects_oom(fbx_objects *w) { return mk_error_oom(w->err, "FBX objects"); }
 
@@ -79,8 +80,6 @@ mk_result fbx_object_check_name(fbx_objects *w, const char *what, const char *na
     }
     return MK_OK;
 }
-
-/* ---- channels ---- */
 
 /* ---- channels ---- */
 
@@ -150,9 +149,17 @@ static mk_result control_point_deltas(fbx_objects *w, const mk_raw_mesh *m, cons
                                 ch->name, t, cp, m->name);
         if (size > 0) n++;
     }
+    /* A target that moves nothing keeps one entry, control point 0 by zero: Blender requires
+     * FullWeights to have one value per index, and a shape without indexes fails its import. */
     *indexes = mk_arena_array(w->a, n ? n : 1, sizeof(int32_t));
     *deltas = mk_arena_array(w->a, n ? n : 1, 3 * sizeof(double));
     if (!*indexes || !*deltas) return fbx_objects_oom(w);
+    if (n == 0) {
+        *count = 1;
+        mk_arena_release(w->a, sum);
+        mk_arena_release(w->a, seen);
+        return MK_OK;
+    }
     n = 0;
     for (uint32_t cp = 0; cp < cps; cp++) {
         if (!seen[cp] || fabs(sum[3 * cp]) + fabs(sum[3 * cp + 1]) + fabs(sum[3 * cp + 2]) == 0) continue;
@@ -194,6 +201,9 @@ mk_result fbx_objects_add_channel(fbx_objects *w, const mk_raw_mesh *m, const ui
         double *deltas = NULL;
         uint32_t n = 0;
         if ((r = control_point_deltas(w, m, render_count, ch, t, tolerance, &indexes, &deltas, &n)) != MK_OK) return r;
+        if (n > UINT32_MAX / 3)
+            return mk_error_set(w->err, MK_ERROR_LIMIT, UINT64_MAX, "FBX: channel '%s' target %u moves more control points "
+                                "than an FBX array can hold", ch->name, t);
         char fallback[160];
         snprintf(fallback, sizeof fallback, "%s_%u", ch->name, t);
         const char *name = tg->name && *tg->name ? tg->name : fallback;
@@ -211,7 +221,7 @@ mk_result fbx_objects_add_channel(fbx_objects *w, const mk_raw_mesh *m, const ui
                                     "FBX: channel '%s' has one target at full weight %g; this file comes from "
                                     "Blender, whose FullWeights of a one-shape channel are per-vertex weights",
                                     ch->name, (double)tg->full_weight);
-            full_count = n ? n : 1;
+            full_count = n;
             full = mk_arena_array(w->a, full_count, sizeof(double));
             if (!full) return fbx_objects_oom(w);
             for (uint32_t k = 0; k < full_count; k++) full[k] = 100.0;
@@ -221,6 +231,7 @@ mk_result fbx_objects_add_channel(fbx_objects *w, const mk_raw_mesh *m, const ui
     }
     if (!fbx_wn_array(w->a, c, "FullWeights", 'd', full, full_count)) return fbx_objects_oom(w);
     w->report->channels++;
+    w->report->progressive_channels += ch->target_count > 1;
     return MK_OK;
 }
 
@@ -229,8 +240,8 @@ mk_result fbx_objects_add_channel(fbx_objects *w, const mk_raw_mesh *m, const ui
 static mk_result add_curve(fbx_objects *w, const mk_raw_track *track, int64_t layer, int64_t channel_id)
 {
     const uint32_t n = track->key_count;
-    int64_t node_id_, curve_id;
-    fbx_wnode *node = fbx_object_new(w, "AnimationCurveNode", "AnimCurveNode", "DeformPercent", "", &node_id_);
+    int64_t curve_node, curve_id;
+    fbx_wnode *node = fbx_object_new(w, "AnimationCurveNode", "AnimCurveNode", "DeformPercent", "", &curve_node);
     fbx_wnode *props = node ? fbx_wn_child(w->a, node, "Properties70") : NULL;
     if (!props || !fbx_wn_prop(w->a, props, "d|DeformPercent", "Number", "", "A",
                                (fbx_wvalue){ .type = 'D', .u.d = 100.0 * track->keys[0].value }))
@@ -243,6 +254,10 @@ static mk_result add_curve(fbx_objects *w, const mk_raw_track *track, int64_t la
     if (!curve || !times || !values || !flags || !refs || !data) return fbx_objects_oom(w);
     for (uint32_t i = 0; i < n; i++) {
         const mk_key *k = &track->keys[i];
+        if (fabs((double)k->time) > KTIME_MAX_SECONDS)
+            return mk_error_set(w->err, MK_ERROR_LIMIT, UINT64_MAX, "FBX: key %u of a clip's track for channel %u is at %g s; "
+                                "FBX key times (int64 ticks of 1/46186158000 s) reach about 2e8 s", i, track->channel,
+                                (double)k->time);
         times[i] = (int64_t)llround((double)k->time * KTIME_PER_SECOND);
         values[i] = 100.0f * k->value;
         refs[i] = 1;
@@ -279,8 +294,8 @@ static mk_result add_curve(fbx_objects *w, const mk_raw_track *track, int64_t la
                     : !fbx_wn_array(w->a, curve, "KeyAttrDataFloat", 'i', bits, 4 * n)) ||
         !fbx_wn_array(w->a, curve, "KeyAttrRefCount", 'i', refs, n))
         return fbx_objects_oom(w);
-    if (!fbx_object_connect(w, "OO", node_id_, layer, NULL) || !fbx_object_connect(w, "OP", node_id_, channel_id, "DeformPercent") ||
-        !fbx_object_connect(w, "OP", curve_id, node_id_, "d|DeformPercent"))
+    if (!fbx_object_connect(w, "OO", curve_node, layer, NULL) || !fbx_object_connect(w, "OP", curve_node, channel_id, "DeformPercent") ||
+        !fbx_object_connect(w, "OP", curve_id, curve_node, "d|DeformPercent"))
         return fbx_objects_oom(w);
     return MK_OK;
 }
@@ -292,6 +307,9 @@ mk_result fbx_objects_add_clip(fbx_objects *w, const mk_raw_clip *clip, const in
     int64_t stack, layer;
     fbx_wnode *s = fbx_object_new(w, "AnimationStack", "AnimStack", clip->name ? clip->name : "", "", &stack);
     fbx_wnode *props = s ? fbx_wn_child(w->a, s, "Properties70") : NULL;
+    if (fabs((double)clip->start) > KTIME_MAX_SECONDS || fabs((double)clip->start + clip->duration) > KTIME_MAX_SECONDS)
+        return mk_error_set(w->err, MK_ERROR_LIMIT, UINT64_MAX, "FBX: clip '%s' runs to %g s; FBX times (int64 ticks of "
+                            "1/46186158000 s) reach about 2e8 s", clip->name ? clip->name : "", (double)clip->start + clip->duration);
     const int64_t start = (int64_t)llround((double)clip->start * KTIME_PER_SECOND);
     const int64_t stop = (int64_t)llround(((double)clip->start + clip->duration) * KTIME_PER_SECOND);
     static const char *const names[4] = { "LocalStart", "LocalStop", "ReferenceStart", "ReferenceStop" };

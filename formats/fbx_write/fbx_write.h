@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The FBX writer: a bake written back into the artist's own FBX file, and a raw asset (a blob)
  * as a new FBX file (docs/baking.md, "Baking into your own file"; docs/importing-fbx.md,
- * "Export to FBX"). */
+ * "Writing FBX"). */
 #ifndef MK_FBX_WRITE_H
 #define MK_FBX_WRITE_H
 
@@ -14,6 +14,7 @@ typedef struct mk_fbx_write_report {
     uint32_t blend_shapes;      /* BlendShape deformers made (write-back: meshes that had none) */
     uint32_t clips;             /* animation stacks written */
     uint32_t blender_weights;   /* one-target channels written with per-vertex FullWeights (files made by Blender) */
+    uint32_t progressive_channels; /* channels written with in-betweens (Blender 3.4 cannot import those) */
 } mk_fbx_write_report;
 
 /* `input` is the FBX file (binary little-endian or ASCII, FBX 7.2 or later) that `raw` was
@@ -32,6 +33,10 @@ typedef struct mk_fbx_write_report {
  * `arena`. */
 mk_result mk_fbx_write_back(const void *input, size_t input_size, const mk_raw_asset *raw, mk_arena *arena,
                             void **out, size_t *out_size, mk_fbx_write_report *report, mk_error *err);
+
+/* What mk_fbx_write_back refuses about the file itself (not FBX 7.2 or later, big-endian, no
+ * Objects or Connections), for a caller to check before it bakes. */
+mk_result mk_fbx_write_back_check(const void *input, size_t input_size, mk_error *err);
 
 /* `raw` as a new binary FBX 7.4 file: per mesh a Model (its world transform as translation,
  * XYZ rotation and scale at the root) with a Geometry (control points, triangles, normals by

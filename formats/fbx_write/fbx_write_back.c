@@ -57,6 +57,9 @@ static int64_t blend_shape_of(const write_back *w, int64_t g)
 static mk_result find_document(write_back *w)
 {
     fbx_doc *doc = w->doc;
+    if (doc->binary && doc->big_endian)
+        return mk_error_set(w->err, MK_ERROR_UNSUPPORTED, 22,
+                            "FBX write-back: big-endian binary files cannot be written back (only little-endian ones)");
     int64_t version = doc->version;
     const fbx_node *header = fbx_child(&doc->root, "FBXHeaderExtension");
     int64_t stated;
@@ -175,6 +178,22 @@ mk_result mk_fbx_write_back(const void *input, size_t input_size, const mk_raw_a
         mk_arena_release(arena, bytes.data);
         memset(report, 0, sizeof *report);
     }
+    fbx_doc_free(&doc);
+    mk_arena_free_all(&scratch);
+    return r;
+}
+
+mk_result mk_fbx_write_back_check(const void *input, size_t input_size, mk_error *err)
+{
+    mk_error local_err;
+    if (!err) err = &local_err;
+    if (!input) return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "mk_fbx_write_back_check: NULL input");
+    mk_arena scratch;
+    mk_arena_init(&scratch, NULL);
+    fbx_doc doc;
+    mk_result r = fbx_doc_parse(&doc, &scratch, input, input_size, err);
+    write_back w = { .doc = &doc, .err = err };
+    if (r == MK_OK) r = find_document(&w);
     fbx_doc_free(&doc);
     mk_arena_free_all(&scratch);
     return r;

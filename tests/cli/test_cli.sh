@@ -55,6 +55,9 @@ check "export to fbx" "$mk" export "$dir/ex.morph" -o "$dir/ex.fbx"
 check "the fbx plays as the blob (per control point)" sh -c "'$mk' play '$dir/ex.morph' --clip wave --time 1 -o '$dir/pm.json' && '$mk' play '$dir/ex.fbx' --clip wave --time 1 -o '$dir/pf.json' && python3 -c 'import json; m=[json.load(open(f))[\"meshes\"][0] for f in (\"$dir/pm.json\", \"$dir/pf.json\")]; p=[{c: x[\"positions\"][3*v:3*v+3] for v, c in enumerate(x[\"control_points\"])} for x in m]; assert p[0].keys() == p[1].keys() and max(abs(a-b) for c in p[0] for a,b in zip(p[0][c], p[1][c])) < 1e-5'"
 check "bake into the fbx" "$mk" bake "$dir/ex.fbx" --recipe "$src/samples/recipes/barr.json" -o "$dir/baked.fbx" --quiet
 check "the baked fbx has the new channels after its own" sh -c "'$mk' info '$dir/baked.fbx' --json | python3 -c 'import json,sys; d=json.load(sys.stdin); n=[c[\"name\"] for c in d[\"meshes\"][0][\"channels\"]]; assert n == [\"bulge\", \"bend\", \"taper_top\", \"bend_forward\", \"twist_quarter\"], n'"
+mkfifo "$dir/pipe.fbx" && (cat "$dir/ex.fbx" > "$dir/pipe.fbx" &)
+check "bake into an fbx read from a pipe (read once)" timeout 120 "$mk" bake "$dir/pipe.fbx" --recipe "$src/samples/recipes/barr.json" -o "$dir/piped.fbx" --quiet
+check "the piped bake is the same file" cmp "$dir/baked.fbx" "$dir/piped.fbx"
 printf '{ "channels": [] }' > "$dir/empty.json"
 check "an empty recipe writes the fbx back byte for byte" sh -c "'$mk' bake '$dir/ex.fbx' --recipe '$dir/empty.json' -o '$dir/same.fbx' --quiet && cmp '$dir/ex.fbx' '$dir/same.fbx'"
 check_fails "bake of a blob into an fbx" 1 "$mk" bake "$dir/ex.morph" --recipe "$src/samples/recipes/barr.json" -o "$dir/nope.fbx"

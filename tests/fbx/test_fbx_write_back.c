@@ -412,5 +412,61 @@ static void test_node_records(void)
     mk_arena_free_all(&arena);
 }
 
-CHECK_MAIN(CASE(test_node_records), CASE(test_nothing_baked_is_identity), CASE(test_baked_round_trip), CASE(test_refusals),
+/* The array length of child `name` of the Objects child of that type whose name value starts
+ * with `object` (-1: none). */
+static long array_length(const fbx_doc *doc, const char *type, const char *object, const char *name)
+{
+    const fbx_node *objects = fbx_child(&doc->root, "Objects");
+    for (uint32_t i = 0; objects && i < objects->child_count; i++) {
+        const fbx_node *o = &objects->children[i];
+        const char *s;
+        uint32_t n;
+        if (!fbx_name_is(o, type) || o->value_count < 2 || !fbx_value_string(&o->values[1], &s, &n) || n < strlen(object) ||
+            memcmp(s, object, strlen(object)) != 0)
+            continue;
+        const fbx_node *c = fbx_child(o, name);
+        return c ? (long)fbx_node_array_length(c) : -1;
+    }
+    return -1;
+}
+
+/* A baked target that moves nothing keeps one index (control point 0, by zero) and FullWeights
+ * as long as the indexes in a file made by Blender, whose importer refuses a file otherwise. */
+static void test_still_target(void)
+{
+    static const char still[] = "{ \"mesh\": 0, \"channels\": [ { \"name\": \"still\", \"op\": \"taper\", \"axis\": \"y\", "
+                                "\"scale\": 1 } ] }";
+    const char *files[2] = { "blender440_shape_weight_anim_7400_binary", "maya_blend_shape_cube_7700_binary" };
+    for (int f = 0; f < 2; f++) {
+        size_t size;
+        unsigned char *data = ft_read_corpus(files[f], &size);
+        if (!data) SKIP("corpus not found at %s", check_corpus_dir());
+        mk_raw_asset raw, back;
+        mk_error err;
+        CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
+        CHECK(mk_bake_recipe(&raw, still, sizeof still - 1, NULL, NULL, &err) == MK_OK);
+        void *out = NULL;
+        size_t out_size = 0;
+        CHECK(mk_fbx_write_back(data, size, &raw, &raw.arena, &out, &out_size, NULL, &err) == MK_OK);
+        mk_arena arena;
+        mk_arena_init(&arena, NULL);
+        fbx_doc doc;
+        CHECK(out && fbx_doc_parse(&doc, &arena, out, out_size, &err) == MK_OK);
+        if (out) {
+            CHECK_EQ_INT(array_length(&doc, "Geometry", "still", "Indexes"), 1);
+            CHECK_EQ_INT(array_length(&doc, "Geometry", "still", "Vertices"), 3);
+            CHECK_EQ_INT(array_length(&doc, "Deformer", "still", "FullWeights"), 1);
+            CHECK(ft_import(out, out_size, NULL, &back, &err) == MK_OK);
+            const mk_raw_channel *c = find_channel(&back, "still", NULL);
+            CHECK(c && c->target_count == 1);
+            mk_raw_free(&back);
+        }
+        fbx_doc_free(&doc);
+        mk_arena_free_all(&arena);
+        mk_raw_free(&raw);
+        free(data);
+    }
+}
+
+CHECK_MAIN(CASE(test_node_records), CASE(test_still_target), CASE(test_nothing_baked_is_identity), CASE(test_baked_round_trip), CASE(test_refusals),
            CASE(test_ascii_name_refused))
