@@ -101,9 +101,8 @@ static int by_position(const void *a, const void *b)
 static mk_result write_ascii(doc_writer *w)
 {
     const fbx_doc *doc = w->doc;
-    const fbx_insertion *order[16];
-    if (w->ins_count > 16)
-        return mk_error_set(doc->err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "FBX writer: too many insertion points");
+    const fbx_insertion **order = mk_arena_array(w->out->arena, w->ins_count + 1u, sizeof *order);
+    if (!order) return mk_error_oom(doc->err, "FBX output");
     uint32_t n = 0;
     for (uint32_t i = 0; i < w->ins_count; i++) {
         const fbx_node *parent = w->ins[i].parent;
@@ -138,6 +137,7 @@ static mk_result write_ascii(doc_writer *w)
     }
     fbx_bytes_append(w->out, doc->data + copied, (size_t)(doc->size - copied));
     mk_arena_release(text.arena, text.data);
+    mk_arena_release(w->out->arena, order);
     return MK_OK;
 }
 

@@ -270,7 +270,7 @@ static mk_result build(exporter *e)
     for (uint32_t mi = 0; mi < raw->mesh_count; mi++)
         if ((r = mesh(e, mi, channel_ids)) != MK_OK) return r;
     for (uint32_t k = 0; k < raw->clip_count; k++)
-        if ((r = fbx_objects_add_clip(&e->o, &raw->clips[k], channel_ids)) != MK_OK) return r;
+        if ((r = fbx_objects_add_clip(&e->o, &raw->clips[k], channel_ids, NULL)) != MK_OK) return r;
     if ((r = definitions(e, defs)) != MK_OK) return r;
     objects->children = e->o.objects;
     objects->child_count = objects->child_cap = e->o.object_count;

@@ -115,7 +115,7 @@ mk_result fbx_objects_mesh(fbx_objects *w, const mk_raw_mesh *m, uint32_t **rend
 }
 
 /* The target's deltas on control points: indexes (increasing) and 3 doubles each. */
-static mk_result control_point_deltas(fbx_objects *w, const mk_raw_mesh *m, const uint32_t *render_count,
+mk_result fbx_objects_target(fbx_objects *w, const mk_raw_mesh *m, const uint32_t *render_count,
                                       const mk_raw_channel *ch, uint32_t t, double tolerance, int32_t **indexes,
                                       double **deltas, uint32_t *count)
 {
@@ -200,7 +200,7 @@ mk_result fbx_objects_add_channel(fbx_objects *w, const mk_raw_mesh *m, const ui
         int32_t *indexes = NULL;
         double *deltas = NULL;
         uint32_t n = 0;
-        if ((r = control_point_deltas(w, m, render_count, ch, t, tolerance, &indexes, &deltas, &n)) != MK_OK) return r;
+        if ((r = fbx_objects_target(w, m, render_count, ch, t, tolerance, &indexes, &deltas, &n)) != MK_OK) return r;
         if (n > UINT32_MAX / 3)
             return mk_error_set(w->err, MK_ERROR_LIMIT, UINT64_MAX, "FBX: channel '%s' target %u moves more control points "
                                 "than an FBX array can hold", ch->name, t);
@@ -237,13 +237,17 @@ mk_result fbx_objects_add_channel(fbx_objects *w, const mk_raw_mesh *m, const ui
 
 /* ---- clips ---- */
 
-static mk_result add_curve(fbx_objects *w, const mk_raw_track *track, int64_t layer, int64_t channel_id)
+/* A curve animating property `prop` of object `owner` (a channel's DeformPercent; in FBX 7.1 the
+ * Geometry property named after the shape). */
+static mk_result add_curve(fbx_objects *w, const mk_raw_track *track, int64_t layer, int64_t owner, const char *prop)
 {
+    char d_prop[300];
+    snprintf(d_prop, sizeof d_prop, "d|%s", prop);
     const uint32_t n = track->key_count;
     int64_t curve_node, curve_id;
-    fbx_wnode *node = fbx_object_new(w, "AnimationCurveNode", "AnimCurveNode", "DeformPercent", "", &curve_node);
+    fbx_wnode *node = fbx_object_new(w, "AnimationCurveNode", "AnimCurveNode", prop, "", &curve_node);
     fbx_wnode *props = node ? fbx_wn_child(w->a, node, "Properties70") : NULL;
-    if (!props || !fbx_wn_prop(w->a, props, "d|DeformPercent", "Number", "", "A",
+    if (!props || !fbx_wn_prop(w->a, props, d_prop, "Number", "", "A",
                                (fbx_wvalue){ .type = 'D', .u.d = 100.0 * track->keys[0].value }))
         return fbx_objects_oom(w);
     fbx_wnode *curve = fbx_object_new(w, "AnimationCurve", "AnimCurve", "", "", &curve_id);
@@ -282,7 +286,8 @@ static mk_result add_curve(fbx_objects *w, const mk_raw_track *track, int64_t la
         memcpy(&data[4 * i + 2], &packed, 4);
         data[4 * i + 3] = 0.0f;
     }
-    /* ASCII files from 7.2 on spell the attribute floats as their int32 bit patterns. */
+    /* ASCII files from 7.2 on spell the attribute floats as their int32 bit patterns (before,
+     * as decimal floats). */
     int32_t *bits = mk_arena_array(w->a, n, 4 * sizeof(int32_t));
     if (!bits) return fbx_objects_oom(w);
     memcpy(bits, data, 4 * (size_t)n * sizeof(float));
@@ -290,17 +295,18 @@ static mk_result add_curve(fbx_objects *w, const mk_raw_track *track, int64_t la
         !fbx_wn_int(w->a, fbx_wn_child(w->a, curve, "KeyVer"), 4009) ||
         !fbx_wn_array(w->a, curve, "KeyTime", 'l', times, n) || !fbx_wn_array(w->a, curve, "KeyValueFloat", 'f', values, n) ||
         !fbx_wn_array(w->a, curve, "KeyAttrFlags", 'i', flags, n) ||
-        (w->binary ? !fbx_wn_array(w->a, curve, "KeyAttrDataFloat", 'f', data, 4 * n)
+        (!w->ascii_float_bits ? !fbx_wn_array(w->a, curve, "KeyAttrDataFloat", 'f', data, 4 * n)
                     : !fbx_wn_array(w->a, curve, "KeyAttrDataFloat", 'i', bits, 4 * n)) ||
         !fbx_wn_array(w->a, curve, "KeyAttrRefCount", 'i', refs, n))
         return fbx_objects_oom(w);
-    if (!fbx_object_connect(w, "OO", curve_node, layer, NULL) || !fbx_object_connect(w, "OP", curve_node, channel_id, "DeformPercent") ||
-        !fbx_object_connect(w, "OP", curve_id, curve_node, "d|DeformPercent"))
+    if (!fbx_object_connect(w, "OO", curve_node, layer, NULL) || !fbx_object_connect(w, "OP", curve_node, owner, prop) ||
+        !fbx_object_connect(w, "OP", curve_id, curve_node, d_prop))
         return fbx_objects_oom(w);
     return MK_OK;
 }
 
-mk_result fbx_objects_add_clip(fbx_objects *w, const mk_raw_clip *clip, const int64_t *channel_ids)
+mk_result fbx_objects_add_clip(fbx_objects *w, const mk_raw_clip *clip, const int64_t *channel_ids,
+                               const char *const *channel_props)
 {
     mk_result r = fbx_object_check_name(w, "clip", clip->name ? clip->name : "");
     if (r != MK_OK) return r;
@@ -321,7 +327,8 @@ mk_result fbx_objects_add_clip(fbx_objects *w, const mk_raw_clip *clip, const in
     for (uint32_t t = 0; t < clip->track_count; t++) {
         const mk_raw_track *track = &clip->tracks[t];
         if (!track->key_count) continue;
-        if ((r = add_curve(w, track, layer, channel_ids[track->channel])) != MK_OK) return r;
+        const char *prop = channel_props ? channel_props[track->channel] : "DeformPercent";
+        if ((r = add_curve(w, track, layer, channel_ids[track->channel], prop)) != MK_OK) return r;
     }
     w->report->clips++;
     return MK_OK;

@@ -11,6 +11,7 @@ typedef struct fbx_objects {
     mk_arena *a;                 /* the nodes' arena */
     mk_error *err;
     int binary;                  /* names spelled for a binary file, else for ASCII */
+    int ascii_float_bits;        /* ASCII 7.2+: KeyAttrDataFloat as int32 bit patterns */
     int blender;                 /* the file's Creator is Blender's exporter (fbx_objects.c) */
     int64_t next_id;             /* the next new object's id */
     fbx_wnode **objects, **connections;   /* new Objects and Connections children, in order */
@@ -33,7 +34,13 @@ mk_result fbx_objects_mesh(fbx_objects *o, const mk_raw_mesh *m, uint32_t **rend
 /* Channel ch of mesh m as a BlendShapeChannel with its Shapes, connected to blend_shape. */
 mk_result fbx_objects_add_channel(fbx_objects *o, const mk_raw_mesh *m, const uint32_t *render_count, double tolerance,
                                   const mk_raw_channel *ch, int64_t blend_shape, int64_t *channel_id);
-/* A clip as an animation stack; channel_ids: the FBX id of every raw channel its tracks name. */
-mk_result fbx_objects_add_clip(fbx_objects *o, const mk_raw_clip *clip, const int64_t *channel_ids);
+/* A clip as an animation stack; channel_ids: the FBX object each raw channel's weight is a
+ * property of, channel_props: that property's name per channel (NULL: "DeformPercent"). */
+mk_result fbx_objects_add_clip(fbx_objects *o, const mk_raw_clip *clip, const int64_t *channel_ids,
+                               const char *const *channel_props);
+/* The deltas of target t of channel ch on control points (fbx_objects.c's rule): *count entries,
+ * indexes increasing, 3 doubles each; a target that moves nothing gives one zero entry. */
+mk_result fbx_objects_target(fbx_objects *o, const mk_raw_mesh *m, const uint32_t *render_count, const mk_raw_channel *ch,
+                             uint32_t t, double tolerance, int32_t **indexes, double **deltas, uint32_t *count);
 
 #endif

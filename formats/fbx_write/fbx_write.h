@@ -17,24 +17,25 @@ typedef struct mk_fbx_write_report {
     uint32_t progressive_channels; /* channels written with in-betweens (Blender 3.4 cannot import those) */
 } mk_fbx_write_report;
 
-/* `input` is the FBX file (binary little-endian or ASCII, FBX 7.2 or later) that `raw` was
+/* `input` is the FBX file (binary little-endian or ASCII, FBX 7.1 or later) that `raw` was
  * imported from (mk_import_memory / mk_import_file, which record each mesh's Geometry id) and
  * then baked into. The output is the input with, for every channel whose `origin` is set (a
  * baked channel), a BlendShapeChannel with one Shape per target (deltas on the geometry's
  * control points), connected to the mesh's BlendShape deformer (the first one it has, else a
  * new one), and, for every clip that animates only baked channels, an animation stack with
- * DeformPercent curves. Binary in gives binary out, ASCII in gives ASCII out; every node of
+ * DeformPercent curves (FBX 7.1: a Shape inside the Geometry per channel, its weight a Geometry
+ * property). Binary in gives binary out, ASCII in gives ASCII out; every node of
  * the input is kept, byte for byte apart from the record end offsets that move.
  *
- * Refused with a message naming the element, nothing written: FBX before 7.2 (shapes inside
- * the geometry), big-endian files, a geometry shared by two models, a baked target whose
+ * Refused with a message naming the element, nothing written: FBX before 7.1, in-betweens in
+ * FBX 7.1, big-endian files, a geometry shared by two models, a baked target whose
  * render vertices of one control point moved differently (the file keeps one delta per control
  * point), in-betweens in a file made by Blender, names a file cannot hold. The output lives in
  * `arena`. */
 mk_result mk_fbx_write_back(const void *input, size_t input_size, const mk_raw_asset *raw, mk_arena *arena,
                             void **out, size_t *out_size, mk_fbx_write_report *report, mk_error *err);
 
-/* What mk_fbx_write_back refuses about the file itself (not FBX 7.2 or later, big-endian, no
+/* What mk_fbx_write_back refuses about the file itself (not FBX 7.1 or later, big-endian, no
  * Objects or Connections), for a caller to check before it bakes. */
 mk_result mk_fbx_write_back_check(const void *input, size_t input_size, mk_error *err);
 

@@ -3,7 +3,12 @@
  * set) added to the file it was imported from, as the objects of fbx_objects.c: on each deformed
  * mesh's Geometry G, the first BlendShape deformer G has (else a new one -OO-> G) gets the
  * channels; every clip that animates only baked channels becomes an animation stack. The file's
- * own nodes are copied (fbx_doc_write.c). */
+ * own nodes are copied (fbx_doc_write.c).
+ *
+ * FBX 7.1 has no blend shape deformers: a shape is a `Shape: "NAME"` child of the Geometry
+ * (Indexes, Vertices, Normals) and its weight the Geometry property NAME (percent), animated by
+ * a curve node OP-connected to the Geometry with that property name. A channel is one shape
+ * there: in-betweens are refused, and so is a name the Geometry's properties already use. */
 #include <string.h>
 #include "fbx_doc_write.h"
 #include "fbx_objects.h"
@@ -14,6 +19,9 @@ typedef struct write_back {
     const mk_raw_asset *raw;
     mk_error *err;
     const fbx_node *objects, *connections;
+    int shapes_in_geometry;    /* FBX 7.1 */
+    fbx_insertion *ins;        /* Objects, Connections, then (7.1) per Geometry its shapes and properties */
+    uint32_t ins_count;
 } write_back;
 
 /* ---- the document ---- */
@@ -64,11 +72,15 @@ static mk_result find_document(write_back *w)
     const fbx_node *header = fbx_child(&doc->root, "FBXHeaderExtension");
     int64_t stated;
     if (header && fbx_child_int(header, "FBXVersion", &stated)) version = stated;
-    if (version < 7200)
+    if (version < 7100)
         return mk_error_set(w->err, MK_ERROR_UNSUPPORTED, UINT64_MAX,
-                            "FBX write-back: this is an FBX %lld file; files before 7.2 keep shapes inside the geometry, "
-                            "and write-back adds FBX 7.2+ blend shape deformers (save the file as FBX 2012 or later)",
+                            "FBX write-back: this is an FBX %lld file; write-back writes FBX 7.1 and later (6.x and "
+                            "earlier address objects by name and keep animation in takes; save the file as FBX 2011 or later)",
                             (long long)version);
+    w->shapes_in_geometry = version < 7200;
+    /* as the reader decides: the ASCII header comment's version, else FBXVersion */
+    const int64_t read_as = doc->version >= 6000 ? doc->version : version;
+    w->o.ascii_float_bits = !doc->binary && read_as >= 7200;
     w->objects = fbx_child(&doc->root, "Objects");
     w->connections = fbx_child(&doc->root, "Connections");
     if (!w->objects || !w->connections || !w->objects->child_count || !w->connections->child_count)
@@ -84,6 +96,73 @@ static mk_result find_document(write_back *w)
     return MK_OK;
 }
 
+/* ---- FBX 7.1: shapes inside the geometry ---- */
+
+/* Appends `node` to the children inserted into `parent` (one insertion per parent). */
+static int insert_into(write_back *w, const fbx_node *parent, fbx_wnode *node)
+{
+    fbx_insertion *in = NULL;
+    for (uint32_t i = 0; i < w->ins_count; i++)
+        if (w->ins[i].parent == parent) in = &w->ins[i];
+    if (!in) {
+        fbx_insertion *grown = mk_arena_realloc(w->o.a, w->ins, w->ins_count * sizeof *w->ins, (w->ins_count + 1) * sizeof *w->ins);
+        if (!grown) return 0;
+        w->ins = grown;
+        in = &w->ins[w->ins_count++];
+        memset(in, 0, sizeof *in);
+        in->parent = parent;
+    }
+    fbx_wnode **nodes = mk_arena_realloc(w->o.a, (void *)in->nodes, in->count * sizeof *nodes, (in->count + 1) * sizeof *nodes);
+    if (!nodes) return 0;
+    nodes[in->count++] = node;
+    in->nodes = nodes;
+    return 1;
+}
+
+static mk_result add_shape_71(write_back *w, const fbx_node *g, const mk_raw_mesh *m, const uint32_t *render_count,
+                              double tolerance, const mk_raw_channel *ch)
+{
+    fbx_objects *o = &w->o;
+    mk_result r = fbx_object_check_name(o, "channel", ch->name);
+    if (r != MK_OK) return r;
+    if (ch->target_count != 1 || ch->targets[0].full_weight != 1.0f)
+        return mk_error_set(w->err, MK_ERROR_UNSUPPORTED, UINT64_MAX,
+                            "FBX write-back: channel '%s' has %u targets; FBX 7.1 shapes have no in-betweens (bake it "
+                            "with \"inbetweens\": 1, or save the file as FBX 2012 or later)", ch->name, ch->target_count);
+    const fbx_node *props = fbx_child(g, "Properties70");
+    if (fbx_prop_find(fbx_props_of(g), ch->name))
+        return mk_error_set(w->err, MK_ERROR_UNSUPPORTED, UINT64_MAX,
+                            "FBX write-back: channel '%s': the geometry of mesh '%s' has a property of that name already "
+                            "(FBX 7.1 weights are geometry properties named after the shape)", ch->name, m->name);
+    int32_t *indexes;
+    double *deltas;
+    uint32_t n;
+    if ((r = fbx_objects_target(o, m, render_count, ch, 0, tolerance, &indexes, &deltas, &n)) != MK_OK) return r;
+    double *normals = mk_arena_array(o->a, n, 3 * sizeof(double));
+    fbx_wnode *shape = fbx_wn_new(o->a, "Shape");
+    if (!normals || !shape || !fbx_wn_string(o->a, shape, ch->name, strlen(ch->name)) ||
+        !fbx_wn_array(o->a, shape, "Indexes", 'i', indexes, n) || !fbx_wn_array(o->a, shape, "Vertices", 'd', deltas, 3 * n) ||
+        !fbx_wn_array(o->a, shape, "Normals", 'd', normals, 3 * n) || !insert_into(w, g, shape))
+        return fbx_objects_oom(o);
+    const fbx_wvalue percent = { .type = 'D', .u.d = 100.0 * ch->default_weight };
+    if (props && props->child_count) {
+        fbx_wnode *holder = fbx_wn_new(o->a, "Properties70");
+        fbx_wnode *p = holder ? fbx_wn_prop(o->a, holder, ch->name, "Number", "", "A+", percent) : NULL;
+        if (!p || !insert_into(w, props, p)) return fbx_objects_oom(o);
+    } else {
+        /* no Properties70 with children to add to (ASCII splices before a closing brace): a new one */
+        if (props)
+            return mk_error_set(w->err, MK_ERROR_UNSUPPORTED, props->offset,
+                                "FBX write-back: mesh '%s': its geometry's Properties70 is empty", m->name);
+        fbx_wnode *holder = fbx_wn_new(o->a, "Properties70");
+        if (!holder || !fbx_wn_prop(o->a, holder, ch->name, "Number", "", "A+", percent) || !insert_into(w, g, holder))
+            return fbx_objects_oom(o);
+    }
+    o->report->channels++;
+    o->report->shapes++;
+    return MK_OK;
+}
+
 /* ---- the whole ---- */
 
 static int is_baked(const mk_raw_channel *ch) { return ch->origin && *ch->origin; }
@@ -93,7 +172,9 @@ static mk_result add_all(write_back *w)
     const mk_raw_asset *raw = w->raw;
     fbx_objects *o = &w->o;
     int64_t *channel_ids = mk_arena_array(o->a, raw->channel_count ? raw->channel_count : 1, sizeof(int64_t));
-    if (!channel_ids) return fbx_objects_oom(o);
+    const char **channel_props = mk_arena_array(o->a, raw->channel_count ? raw->channel_count : 1, sizeof(char *));
+    if (!channel_ids || !channel_props) return fbx_objects_oom(o);
+    for (uint32_t c = 0; c < raw->channel_count; c++) channel_props[c] = w->shapes_in_geometry ? raw->channels[c].name : "DeformPercent";
     for (uint32_t mi = 0; mi < raw->mesh_count; mi++) {
         const mk_raw_mesh *m = &raw->meshes[mi];
         uint32_t baked = 0;
@@ -117,6 +198,15 @@ static mk_result add_all(write_back *w)
         double tolerance;
         mk_result r = fbx_objects_mesh(o, m, &render_count, &tolerance);
         if (r != MK_OK) return r;
+        if (w->shapes_in_geometry) {
+            for (uint32_t c = 0; c < raw->channel_count; c++) {
+                if (raw->channels[c].mesh != mi || !is_baked(&raw->channels[c])) continue;
+                if ((r = add_shape_71(w, g, m, render_count, tolerance, &raw->channels[c])) != MK_OK) return r;
+                channel_ids[c] = m->fbx_geometry;
+            }
+            o->report->meshes++;
+            continue;
+        }
         int64_t blend = blend_shape_of(w, m->fbx_geometry);
         if (!blend) {
             if ((r = fbx_object_check_name(o, "mesh", m->name)) != MK_OK) return r;
@@ -139,7 +229,7 @@ static mk_result add_all(write_back *w)
         for (uint32_t t = 0; t < clip->track_count; t++)
             baked += clip->tracks[t].channel < raw->channel_count && is_baked(&raw->channels[clip->tracks[t].channel]);
         if (!baked || baked != clip->track_count) continue;  /* the file's own clips are in it already */
-        mk_result r = fbx_objects_add_clip(o, clip, channel_ids);
+        mk_result r = fbx_objects_add_clip(o, clip, channel_ids, channel_props);
         if (r != MK_OK) return r;
     }
     return MK_OK;
@@ -167,9 +257,14 @@ mk_result mk_fbx_write_back(const void *input, size_t input_size, const mk_raw_a
     if (r == MK_OK) r = add_all(&w);
     fbx_bytes bytes = { .arena = arena };
     if (r == MK_OK) {
-        fbx_insertion ins[2] = { { w.objects, w.o.objects, w.o.object_count },
-                                 { w.connections, w.o.connections, w.o.connection_count } };
-        r = fbx_doc_write(&doc, ins, 2, &bytes);
+        fbx_insertion *ins = mk_arena_array(&scratch, w.ins_count + 2, sizeof *ins);
+        if (!ins) r = mk_error_oom(err, "FBX write-back");
+        if (r == MK_OK) {
+            ins[0] = (fbx_insertion){ w.objects, w.o.objects, w.o.object_count };
+            ins[1] = (fbx_insertion){ w.connections, w.o.connections, w.o.connection_count };
+            if (w.ins_count) memcpy(ins + 2, w.ins, w.ins_count * sizeof *ins);
+            r = fbx_doc_write(&doc, ins, w.ins_count + 2, &bytes);
+        }
     }
     if (r == MK_OK) {
         *out = bytes.data;

@@ -20,6 +20,7 @@ static const char *const corpus_files[] = {
     "maya_blend_inbetween_7500_ascii", "maya_blend_shape_cube_7700_binary", "maya_blend_shape_cube_7700_ascii",
     "zbrush_d20_7500_binary",          "zbrush_d20_7500_ascii",             "blender440_shape_weight_anim_7400_binary",
     "blender_279_shape_weights_7400_binary", "synthetic_blend_shape_order_7500_ascii",
+    "maya_blend_shape_cube_7100_binary",     "maya_blend_shape_cube_7100_ascii",
 };
 
 /* Pointwise deformers (one with in-betweens) and a travelling lattice with its clip. Files made
@@ -37,6 +38,8 @@ static const char recipe[] = RECIPE("3");
 static const char recipe_flat[] = RECIPE("1");
 
 static int made_by_blender(const char *file) { return strncmp(file, "blender", 7) == 0; }
+/* FBX 7.1 keeps shapes inside the geometry, one per channel: no in-betweens. */
+static int shapes_in_geometry(const char *file) { return strstr(file, "_7100_") != NULL; }
 
 static const mk_raw_channel *find_channel(const mk_raw_asset *raw, const char *name, uint32_t *index)
 {
@@ -63,15 +66,25 @@ static int same_value(const fbx_value *a, const fbx_value *b)
     }
 }
 
-/* Every node of `in` is in `out` with the same name and values; only Objects and Connections
- * (top level) may have more children, after the input's. Returns the number of differences. */
+/* Whether node `in` may gain children in a write-back: Objects and Connections; in FBX 7.1 a
+ * Geometry (its shapes) and its Properties70 (their weights). */
+static int may_grow(const fbx_node *in, int top)
+{
+    if (top) return fbx_name_is(in, "Objects") || fbx_name_is(in, "Connections");
+    const fbx_node *p = in->parent;
+    if (fbx_name_is(in, "Geometry")) return p && fbx_name_is(p, "Objects");
+    return fbx_name_is(in, "Properties70") && p && fbx_name_is(p, "Geometry") && p->parent && fbx_name_is(p->parent, "Objects");
+}
+
+/* Every node of `in` is in `out` with the same name and values; only the nodes of may_grow may
+ * have more children, after the input's. Returns the number of differences. */
 static int compare_nodes(const fbx_node *in, const fbx_node *out, int top)
 {
     int bad = 0;
     if (in->name_length != out->name_length || memcmp(in->name, out->name, in->name_length) != 0) return 1;
     if (in->value_count != out->value_count) return 1;
     for (uint32_t i = 0; i < in->value_count; i++) bad += !same_value(&in->values[i], &out->values[i]);
-    const int grows = top && (fbx_name_is(in, "Objects") || fbx_name_is(in, "Connections"));
+    const int grows = may_grow(in, top);
     if (grows ? out->child_count < in->child_count : out->child_count != in->child_count) return bad + 1;
     for (uint32_t i = 0; i < in->child_count; i++) bad += compare_nodes(&in->children[i], &out->children[i], 0);
     return bad;
@@ -187,8 +200,8 @@ static void test_baked_round_trip(void)
         CHECK(ft_import(data, size, NULL, &original, &err) == MK_OK);
         CHECK(ft_import(data, size, NULL, &baked, &err) == MK_OK);
         mk_bake_report report;
-        const int blender = made_by_blender(file);
-        mk_result r = blender ? mk_bake_recipe(&baked, recipe_flat, sizeof recipe_flat - 1, NULL, &report, &err)
+        const int blender = made_by_blender(file), flat = blender || shapes_in_geometry(file);
+        mk_result r = flat ? mk_bake_recipe(&baked, recipe_flat, sizeof recipe_flat - 1, NULL, &report, &err)
                               : mk_bake_recipe(&baked, recipe, sizeof recipe - 1, NULL, &report, &err);
         CHECK_MSG(r == MK_OK, "%s: bake: %s", file, err.message);
         void *out = NULL;
@@ -198,7 +211,7 @@ static void test_baked_round_trip(void)
         CHECK_MSG(r == MK_OK, "%s: write-back: %s", file, err.message);
         if (r != MK_OK) { mk_raw_free(&original); mk_raw_free(&baked); free(data); continue; }
         CHECK_EQ_INT(wr.channels, 3);
-        CHECK_EQ_INT(wr.shapes, blender ? 3 : 5);
+        CHECK_EQ_INT(wr.shapes, flat ? 3 : 5);
         CHECK_EQ_INT(wr.blender_weights, blender ? 3 : 0);
         CHECK_EQ_INT(wr.clips, 1);
         CHECK_MSG(tree_differences(data, size, out, out_size) == 0, "%s: input nodes changed in the output", file);
@@ -354,14 +367,32 @@ static void test_refusals(void)
         free(data);
     }
 
-    /* FBX 7.1: shapes live inside the geometry; refused, naming the version. */
+    /* FBX 7.1: one shape per channel, no in-betweens; a name the geometry's properties use. */
     data = ft_read_corpus("maya_blend_shape_cube_7100_binary", &size);
     CHECK(data != NULL);
     if (data) {
         CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
         CHECK(mk_bake_recipe(&raw, recipe, sizeof recipe - 1, NULL, NULL, &err) == MK_OK);
         CHECK(mk_fbx_write_back(data, size, &raw, &raw.arena, &out, &out_size, NULL, &err) == MK_ERROR_UNSUPPORTED);
-        CHECK_MSG(message_has(&err, "7100"), "%s", err.message);
+        CHECK_MSG(message_has(&err, "twist_quarter") && message_has(&err, "7.1"), "%s", err.message);
+        mk_raw_free(&raw);
+        static const char clash[] = "{ \"mesh\": 0, \"channels\": [ { \"name\": \"TopH\", \"op\": \"taper\", \"axis\": \"y\", "
+                                    "\"scale\": 0.5 } ] }";
+        CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
+        CHECK(mk_bake_recipe(&raw, clash, sizeof clash - 1, NULL, NULL, &err) == MK_OK);
+        CHECK(mk_fbx_write_back(data, size, &raw, &raw.arena, &out, &out_size, NULL, &err) == MK_ERROR_UNSUPPORTED);
+        CHECK_MSG(message_has(&err, "TopH") && message_has(&err, "property"), "%s", err.message);
+        mk_raw_free(&raw);
+        free(data);
+    }
+    /* FBX 6.1: objects by name, animation in takes; refused, naming the version. */
+    data = ft_read_corpus("maya_blend_shape_cube_6100_binary", &size);
+    CHECK(data != NULL);
+    if (data) {
+        CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
+        CHECK(mk_bake_recipe(&raw, recipe_flat, sizeof recipe_flat - 1, NULL, NULL, &err) == MK_OK);
+        CHECK(mk_fbx_write_back(data, size, &raw, &raw.arena, &out, &out_size, NULL, &err) == MK_ERROR_UNSUPPORTED);
+        CHECK_MSG(message_has(&err, "6100"), "%s", err.message);
         mk_raw_free(&raw);
         free(data);
     }
