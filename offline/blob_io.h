@@ -77,6 +77,8 @@ mk_result mk_read_file_threads(mk_arena *arena, const char *path, size_t max_siz
                                size_t *size, mk_error *err);
 /* Does path end with extension (lower case, with the dot), ignoring the path's case? */
 int mk_path_has_extension(const char *path, const char *extension);
+/* The folder of path into out: "." for a bare name, "/" for "/name". */
+void mk_path_dir(const char *path, char *out, size_t size);
 
 /* ---- Outputs ----
  * An output is checked before anything is read or computed (mk_output_check), then written

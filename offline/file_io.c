@@ -172,8 +172,7 @@ mk_result mk_read_file_threads(mk_arena *arena, const char *path, size_t max_siz
 
 /* ---- outputs ---- */
 
-/* dir of path into out ("." for a bare name, "/" for "/name"). */
-static void dir_of(const char *path, char *out, size_t size)
+void mk_path_dir(const char *path, char *out, size_t size)
 {
     const char *slash = strrchr(path, '/');
     if (!slash) {
@@ -200,7 +199,7 @@ static mk_result resolve_links(const char *path, char *target, size_t size, mk_e
             snprintf(joined, sizeof joined, "%s", link);
         } else {
             char dir[PATH_MAX];
-            dir_of(target, dir, sizeof dir);
+            mk_path_dir(target, dir, sizeof dir);
             if ((size_t)snprintf(joined, sizeof joined, "%s/%s", dir, link) >= sizeof joined)
                 return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: link target path too long", path);
         }
@@ -237,7 +236,7 @@ mk_result mk_output_check(mk_output *out, const char *const *inputs, uint32_t in
         }
     }
     char dir[PATH_MAX];
-    dir_of(out->target, dir, sizeof dir);
+    mk_path_dir(out->target, dir, sizeof dir);
     struct stat ds;
     if (stat(dir, &ds) != 0)
         return mk_error_set(err, MK_ERROR_IO, UINT64_MAX, "%.200s: cannot create it: folder %.200s: %s", path, dir,
@@ -327,7 +326,7 @@ static void remove_pending(const char *name)
 static void sync_dir_of(const char *target)
 {
     char dir[PATH_MAX];
-    dir_of(target, dir, sizeof dir);
+    mk_path_dir(target, dir, sizeof dir);
     int fd = open(dir, O_RDONLY);
     if (fd >= 0) {
         (void)fsync(fd);

@@ -281,3 +281,17 @@ mk_result mk_raw_validate(const mk_raw_asset *raw, mk_error *err)
     }
     return MK_OK;
 }
+
+float mk_raw_mesh_diagonal(const mk_raw_mesh *m)
+{
+    float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    for (uint32_t v = 0; v < m->vertex_count; v++)
+        for (int d = 0; d < 3; d++) {
+            float x = m->positions[3u * v + (uint32_t)d];
+            lo[d] = x < lo[d] ? x : lo[d];
+            hi[d] = x > hi[d] ? x : hi[d];
+        }
+    float s = 0;
+    for (int d = 0; d < 3; d++) s += (hi[d] - lo[d]) * (hi[d] - lo[d]);
+    return sqrtf(s);
+}

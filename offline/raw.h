@@ -112,6 +112,10 @@ void mk_raw_drop_plain_meshes(mk_raw_asset *raw, const char *what);
  * and tangent deltas stay. */
 void mk_raw_drop_target_normals(mk_raw_asset *raw);
 
+/* The length of the diagonal of the mesh's base positions' bounding box, in float (the writer's
+ * default quantization tolerance is 1e-4 of it; writers of other formats compare deltas with it). */
+float mk_raw_mesh_diagonal(const mk_raw_mesh *mesh);
+
 /* Checks everything the writer and runtime rely on: counts, indices in range, strictly
  * increasing sparse indices and key times, finite values, nonzero and strictly increasing
  * full weights, channel grouping. The error names the element (mesh/channel/target/key). */

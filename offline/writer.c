@@ -108,20 +108,6 @@ static double quant_error(const float *p, size_t n, float scale)
  * 2^-24 x 32767 scale < 2^-9 scale (offset_fits). */
 static double quant_error_bound(float scale) { return (double)scale * (0.5 + 1.0 / 256); }
 
-static float mesh_diagonal(const mk_raw_mesh *m)
-{
-    float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
-    for (uint32_t v = 0; v < m->vertex_count; v++)
-        for (int d = 0; d < 3; d++) {
-            float x = m->positions[3u * v + (uint32_t)d];
-            lo[d] = x < lo[d] ? x : lo[d];
-            hi[d] = x > hi[d] ? x : hi[d];
-        }
-    float s = 0;
-    for (int d = 0; d < 3; d++) s += (hi[d] - lo[d]) * (hi[d] - lo[d]);
-    return sqrtf(s);
-}
-
 typedef struct target_plan {
     uint32_t flags;
     float position_scale, normal_scale, tangent_scale;
@@ -629,7 +615,7 @@ static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, cons
     const mk_raw_target **all_targets = mk_arena_array(arena, target_count + 1, sizeof *all_targets);
     if (!all_targets) return mk_error_oom(err, "writing the blob tables");
     for (uint32_t mi = 0, c = 0, k = 0; mi < raw->mesh_count; mi++) {
-        double tolerance = opt.tolerance > 0 ? opt.tolerance : 1e-4 * mesh_diagonal(&raw->meshes[mi]);
+        double tolerance = opt.tolerance > 0 ? opt.tolerance : 1e-4 * mk_raw_mesh_diagonal(&raw->meshes[mi]);
         if (tolerance > report.tolerance_used) report.tolerance_used = tolerance;
         for (; c < raw->channel_count && raw->channels[c].mesh == mi; c++)
             for (uint32_t j = 0; j < raw->channels[c].target_count; j++, k++) {

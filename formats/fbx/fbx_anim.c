@@ -37,16 +37,6 @@
 #include <string.h>
 #include "fbx_anim.h"
 
-#define KEY_CONSTANT 0x2u
-#define KEY_CONSTANT_NEXT 0x100u
-#define KEY_CUBIC 0x8u
-#define KEY_TCB 0x200u
-#define KEY_USER 0x400u
-#define KEY_CLAMP 0x1000u
-#define KEY_TIME_INDEPENDENT 0x2000u
-#define KEY_CLAMP_PROGRESSIVE 0x4000u
-#define KEY_WEIGHTED_RIGHT 0x1000000u
-#define KEY_WEIGHTED_NEXT_LEFT 0x2000000u
 
 #define THIRD (1.0 / 3.0)
 

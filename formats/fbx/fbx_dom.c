@@ -533,6 +533,23 @@ mk_result fbx_doc_parse(fbx_doc *doc, mk_arena *arena, const void *data, size_t 
     mk_result r = doc->binary ? fbx_parse_binary(doc) : fbx_parse_ascii(doc);
     if (r == MK_OK && doc->root.child_count == 0)
         r = mk_error_set(err, MK_ERROR_PARSE, 0, "not an FBX file: no nodes found (%zu bytes)", size);
-    if (r == MK_OK) fbx_link_parents(&doc->root);
-    return r;
+    if (r != MK_OK) return r;
+    fbx_link_parents(&doc->root);
+    const fbx_node *header = fbx_child(&doc->root, "FBXHeaderExtension");
+    int64_t fbx_version = 0;
+    if (fbx_child_int(header, "FBXVersion", &fbx_version) && fbx_version > 0 && fbx_version < 100000 &&
+        (doc->version == 0 || doc->version < 6000))
+        doc->version = (uint32_t)fbx_version;
+    if (doc->version == 0) doc->version = 7400;
+    return MK_OK;
+}
+
+double fbx_doc_ticks(const fbx_doc *doc)
+{
+    const fbx_node *header = fbx_child(&doc->root, "FBXHeaderExtension");
+    int64_t header_version = 0, tc = 0;
+    if (fbx_child_int(header, "FBXHeaderVersion", &header_version) && header_version >= 1004 &&
+        fbx_child_int(fbx_child(header, "OtherFlags"), "TCDefinition", &tc))
+        return tc == 127 ? FBX_TICKS_PER_SECOND_OLD : FBX_TICKS_PER_SECOND_NEW;
+    return doc->version < 8000 ? FBX_TICKS_PER_SECOND_OLD : FBX_TICKS_PER_SECOND_NEW;
 }

@@ -77,8 +77,15 @@ typedef struct fbx_doc {
 
 void fbx_doc_free(fbx_doc *doc);
 /* Parses data (binary or ASCII, told apart by the magic) into doc, its tree in `arena`, errors
- * into err, parents linked. A file without nodes is an error. Free with fbx_doc_free (fbx_dom.c). */
+ * into err, parents linked, doc->version settled (the header's, or FBXVersion where the header
+ * says nothing or below 6000: 3ds Max 7 writes header 3000 with FBXVersion 5000; 7400 when
+ * neither does). A file without nodes is an error. Free with fbx_doc_free (fbx_dom.c). */
 mk_result fbx_doc_parse(fbx_doc *doc, mk_arena *arena, const void *data, size_t size, mk_error *err);
+/* KTime ticks per second of the document (ufbx): 46186158000 before FBX 8000, 141120000 after;
+ * from FBXHeaderVersion 1004 the OtherFlags/TCDefinition field decides (127 = the old rate). */
+#define FBX_TICKS_PER_SECOND_OLD 46186158000.0
+#define FBX_TICKS_PER_SECOND_NEW 141120000.0
+double fbx_doc_ticks(const fbx_doc *doc);
 
 /* Parsers (fbx_binary.c, fbx_ascii.c). Fill doc->root; errors carry offsets. */
 mk_result fbx_parse_binary(fbx_doc *doc);

@@ -1047,13 +1047,7 @@ static void read_globals(scene *s)
         double unit;
         if (fbx_prop_number_opt(props, "UnitScaleFactor", &unit) && isfinite(unit)) raw->unit_scale = (float)unit;
     }
-    /* KTime ticks per second (ufbx): 46186158000 before FBX 8000, 141120000 after; from
-     * FBXHeaderVersion 1004 the OtherFlags/TCDefinition field decides (127 = the old rate). */
-    s->ticks = doc->version < 8000 ? 46186158000.0 : 141120000.0;
-    int64_t header_version = 0, tc = 0;
-    if (fbx_child_int(header, "FBXHeaderVersion", &header_version) && header_version >= 1004 &&
-        fbx_child_int(fbx_child(header, "OtherFlags"), "TCDefinition", &tc))
-        s->ticks = tc == 127 ? 46186158000.0 : 141120000.0;
+    s->ticks = fbx_doc_ticks(doc);
 }
 
 mk_result fbx_convert(fbx_doc *doc, const mk_import_options *options, mk_raw_asset *raw)
@@ -1063,14 +1057,6 @@ mk_result fbx_convert(fbx_doc *doc, const mk_import_options *options, mk_raw_ass
     s.doc = doc;
     s.raw = raw;
     s.options = options;
-    /* Version: the header says which record layout, FBXVersion what the content is. 3ds Max 7
-     * writes header 3000 with FBXVersion 5000; ASCII without "; FBX" comment needs FBXVersion. */
-    const fbx_node *header = fbx_child(&doc->root, "FBXHeaderExtension");
-    int64_t fbx_version = 0;
-    if (fbx_child_int(header, "FBXVersion", &fbx_version) && fbx_version > 0 && fbx_version < 100000) {
-        if (doc->version == 0 || doc->version < 6000) doc->version = (uint32_t)fbx_version;
-    }
-    if (doc->version == 0) doc->version = 7400;
     s.legacy_ids = doc->version < 7000;
     snprintf(raw->source_format, sizeof raw->source_format, "fbx %u %s", doc->version, doc->binary ? "binary" : "ascii");
     read_globals(&s);

@@ -15,6 +15,7 @@
  * Geometry, its channels and the clips as fbx_objects.c writes them. */
 #include <math.h>
 #include <string.h>
+#include "fbx_internal.h"
 #include "fbx_objects.h"
 
 #define FBX_EXPORT_VERSION 7400
@@ -291,7 +292,10 @@ mk_result mk_fbx_export(const mk_raw_asset *raw, mk_arena *arena, void **out, si
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "mk_fbx_export: NULL argument");
     mk_arena scratch;
     mk_arena_init(&scratch, &arena->allocator);
-    exporter e = { .o = { .a = &scratch, .err = err, .binary = 1, .next_id = 1000000, .report = report }, .raw = raw };
+    /* FBX 7.4 with FBXHeaderVersion 1003: the old tick rate */
+    exporter e = { .o = { .a = &scratch, .err = err, .binary = 1, .next_id = 1000000, .ticks = FBX_TICKS_PER_SECOND_OLD,
+                          .report = report },
+                   .raw = raw };
     mk_result r = build(&e);
     fbx_bytes bytes = { .arena = arena };
     if (r == MK_OK) {

@@ -267,7 +267,12 @@ static void write_ascii_value(fbx_bytes *out, const fbx_wvalue *v, uint32_t dept
         for (uint32_t k = 0; k < v->count; k++) {
             if (k) fbx_bytes_append(out, ",", 1);
             switch (v->type) {
-            case 'i': fbx_bytes_printf(out, "%d", (int)v->u.ai[k]); break;
+            case 'i': {  /* read as bytes: 'i' may carry other 4-byte values (float bits) */
+                int32_t x;
+                memcpy(&x, (const uint8_t *)v->u.ai + 4 * (size_t)k, 4);
+                fbx_bytes_printf(out, "%d", (int)x);
+                break;
+            }
             case 'l': fbx_bytes_printf(out, "%lld", (long long)v->u.al[k]); break;
             case 'f': write_double(out, (double)v->u.af[k]); break;
             default: write_double(out, v->u.ad[k]); break;

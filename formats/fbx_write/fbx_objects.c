@@ -25,10 +25,11 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include "fbx_anim.h"
 #include "fbx_objects.h"
 
-#define KTIME_PER_SECOND 46186158000.0  /* FBX 7.x */
-#define KTIME_MAX_SECONDS 1.9e8          /* int64 KTime reaches about 2e8 s */
+/* The longest time an int64 KTime holds at the file's tick rate, with a margin. */
+static double max_seconds(const fbx_objects *w) { return 9.0e18 / w->ticks; }
 
 mk_result fbx_objects_oom(fbx_objects *w) { return mk_error_oom(w->err, "FBX objects"); }
 
@@ -83,20 +84,6 @@ mk_result fbx_object_check_name(fbx_objects *w, const char *what, const char *na
 
 /* ---- channels ---- */
 
-static double mesh_diagonal(const mk_raw_mesh *m)
-{
-    float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
-    for (uint32_t v = 0; v < m->vertex_count; v++)
-        for (int k = 0; k < 3; k++) {
-            float x = m->positions[3 * v + k];
-            if (x < lo[k]) lo[k] = x;
-            if (x > hi[k]) hi[k] = x;
-        }
-    double d = 0;
-    for (int k = 0; k < 3 && m->vertex_count; k++) d += ((double)hi[k] - lo[k]) * ((double)hi[k] - lo[k]);
-    return sqrt(d);
-}
-
 mk_result fbx_objects_mesh(fbx_objects *w, const mk_raw_mesh *m, uint32_t **render_count, double *tolerance)
 {
     if (!m->control_points || !m->control_point_count)
@@ -110,7 +97,7 @@ mk_result fbx_objects_mesh(fbx_objects *w, const mk_raw_mesh *m, uint32_t **rend
         count[m->control_points[v]]++;
     }
     *render_count = count;
-    *tolerance = 1e-6 * fmax(mesh_diagonal(m), 1e-30);
+    *tolerance = 1e-6 * fmax((double)mk_raw_mesh_diagonal(m), 1e-30);
     return MK_OK;
 }
 
@@ -138,6 +125,7 @@ mk_result fbx_objects_target(fbx_objects *w, const mk_raw_mesh *m, const uint32_
                                     "of mesh '%s' differently (%g apart); the file holds one delta per control point",
                                     ch->name, t, cp, m->name, fabs(sum[3 * cp + k] - d[k]));
     }
+    /* Control points that moved: seen[] keeps them (zero deltas are dropped). */
     uint32_t n = 0;
     for (uint32_t cp = 0; cp < cps; cp++) {
         if (!seen[cp]) continue;
@@ -147,27 +135,20 @@ mk_result fbx_objects_target(fbx_objects *w, const mk_raw_mesh *m, const uint32_
                                 "FBX: channel '%s' target %u moves some render vertices of control point %u of "
                                 "mesh '%s' and not others; the file holds one delta per control point",
                                 ch->name, t, cp, m->name);
-        if (size > 0) n++;
+        seen[cp] = size > 0;
+        n += seen[cp];
     }
     /* A target that moves nothing keeps one entry, control point 0 by zero: Blender requires
      * FullWeights to have one value per index, and a shape without indexes fails its import. */
     *indexes = mk_arena_array(w->a, n ? n : 1, sizeof(int32_t));
     *deltas = mk_arena_array(w->a, n ? n : 1, 3 * sizeof(double));
     if (!*indexes || !*deltas) return fbx_objects_oom(w);
-    if (n == 0) {
-        *count = 1;
-        mk_arena_release(w->a, sum);
-        mk_arena_release(w->a, seen);
-        return MK_OK;
+    *count = n ? n : 1;
+    for (uint32_t cp = 0, e = 0; cp < cps; cp++) {
+        if (!seen[cp]) continue;
+        (*indexes)[e] = (int32_t)cp;
+        memcpy(*deltas + 3 * (size_t)e++, sum + 3 * (size_t)cp, 3 * sizeof(double));
     }
-    n = 0;
-    for (uint32_t cp = 0; cp < cps; cp++) {
-        if (!seen[cp] || fabs(sum[3 * cp]) + fabs(sum[3 * cp + 1]) + fabs(sum[3 * cp + 2]) == 0) continue;
-        (*indexes)[n] = (int32_t)cp;
-        memcpy(*deltas + 3 * (size_t)n, sum + 3 * (size_t)cp, 3 * sizeof(double));
-        n++;
-    }
-    *count = n;
     mk_arena_release(w->a, sum);
     mk_arena_release(w->a, seen);
     return MK_OK;
@@ -192,6 +173,13 @@ mk_result fbx_objects_add_channel(fbx_objects *w, const mk_raw_mesh *m, const ui
         !fbx_wn_double(w->a, fbx_wn_child(w->a, c, "DeformPercent"), 100.0 * ch->default_weight))
         return fbx_objects_oom(w);
     if (!fbx_object_connect(w, "OO", *channel_id, blend_shape, NULL)) return fbx_objects_oom(w);
+    /* Files made by Blender: a one-target channel's FullWeights are per-index weights (100 each). */
+    const int per_index = w->blender;   /* in-betweens were refused above */
+    if (per_index && ch->targets[0].full_weight != 1.0f)
+        return mk_error_set(w->err, MK_ERROR_UNSUPPORTED, UINT64_MAX,
+                            "FBX: channel '%s' has one target at full weight %g; this file comes from "
+                            "Blender, whose FullWeights of a one-shape channel are per-vertex weights",
+                            ch->name, (double)ch->targets[0].full_weight);
     double *full = mk_arena_array(w->a, ch->target_count ? ch->target_count : 1, sizeof(double));
     if (!full) return fbx_objects_oom(w);
     uint32_t full_count = ch->target_count;
@@ -215,16 +203,11 @@ mk_result fbx_objects_add_channel(fbx_objects *w, const mk_raw_mesh *m, const ui
             !fbx_object_connect(w, "OO", shape_id, *channel_id, NULL))
             return fbx_objects_oom(w);
         full[t] = 100.0 * tg->full_weight;
-        if (w->blender && ch->target_count == 1) {
-            if (tg->full_weight != 1.0f)
-                return mk_error_set(w->err, MK_ERROR_UNSUPPORTED, UINT64_MAX,
-                                    "FBX: channel '%s' has one target at full weight %g; this file comes from "
-                                    "Blender, whose FullWeights of a one-shape channel are per-vertex weights",
-                                    ch->name, (double)tg->full_weight);
+        if (per_index) {
             full_count = n;
-            full = mk_arena_array(w->a, full_count, sizeof(double));
+            full = mk_arena_array(w->a, n, sizeof(double));
             if (!full) return fbx_objects_oom(w);
-            for (uint32_t k = 0; k < full_count; k++) full[k] = 100.0;
+            for (uint32_t k = 0; k < n; k++) full[k] = 100.0;
             w->report->blender_weights++;
         }
         w->report->shapes++;
@@ -258,26 +241,26 @@ static mk_result add_curve(fbx_objects *w, const mk_raw_track *track, int64_t la
     if (!curve || !times || !values || !flags || !refs || !data) return fbx_objects_oom(w);
     for (uint32_t i = 0; i < n; i++) {
         const mk_key *k = &track->keys[i];
-        if (fabs((double)k->time) > KTIME_MAX_SECONDS)
+        if (fabs((double)k->time) > max_seconds(w))
             return mk_error_set(w->err, MK_ERROR_LIMIT, UINT64_MAX, "FBX: key %u of a clip's track for channel %u is at %g s; "
-                                "FBX key times (int64 ticks of 1/46186158000 s) reach about 2e8 s", i, track->channel,
-                                (double)k->time);
-        times[i] = (int64_t)llround((double)k->time * KTIME_PER_SECOND);
+                                "FBX key times (int64 ticks of 1/%.0f s) reach %.3g s", i, track->channel,
+                                (double)k->time, w->ticks, max_seconds(w));
+        times[i] = (int64_t)llround((double)k->time * w->ticks);
         values[i] = 100.0f * k->value;
         refs[i] = 1;
         uint32_t f;
         switch (k->interp) {
-        case MK_INTERP_CONSTANT: f = 0x2; break;
-        case MK_INTERP_CONSTANT_NEXT: f = 0x102; break;
-        case MK_INTERP_LINEAR: f = 0x4; break;
-        default: f = 0x8 | 0x400; break;  /* cubic, user tangents */
+        case MK_INTERP_CONSTANT: f = KEY_CONSTANT; break;
+        case MK_INTERP_CONSTANT_NEXT: f = KEY_CONSTANT | KEY_CONSTANT_NEXT; break;
+        case MK_INTERP_LINEAR: f = KEY_LINEAR; break;
+        default: f = KEY_CUBIC | KEY_USER; break;  /* the slopes as stored */
         }
         float next_left_slope = i + 1 < n ? track->keys[i + 1].left_slope : 0.0f;
         float next_left_weight = i + 1 < n ? track->keys[i + 1].left_weight : 1.0f / 3.0f;
         uint32_t packed = 0;
         if (k->interp == MK_INTERP_CUBIC && (fabsf(k->right_weight - 1.0f / 3.0f) > 1e-6f ||
                                              fabsf(next_left_weight - 1.0f / 3.0f) > 1e-6f)) {
-            f |= 0x1000000u | 0x2000000u;
+            f |= KEY_WEIGHTED_RIGHT | KEY_WEIGHTED_NEXT_LEFT;
             packed = (uint32_t)lrintf(k->right_weight * 10000.0f) | ((uint32_t)lrintf(next_left_weight * 10000.0f) << 16);
         }
         flags[i] = (int32_t)f;
@@ -287,16 +270,12 @@ static mk_result add_curve(fbx_objects *w, const mk_raw_track *track, int64_t la
         data[4 * i + 3] = 0.0f;
     }
     /* ASCII files from 7.2 on spell the attribute floats as their int32 bit patterns (before,
-     * as decimal floats). */
-    int32_t *bits = mk_arena_array(w->a, n, 4 * sizeof(int32_t));
-    if (!bits) return fbx_objects_oom(w);
-    memcpy(bits, data, 4 * (size_t)n * sizeof(float));
+     * as decimal floats): the same bytes as an 'i' array. */
     if (!fbx_wn_double(w->a, fbx_wn_child(w->a, curve, "Default"), 100.0 * track->keys[0].value) ||
         !fbx_wn_int(w->a, fbx_wn_child(w->a, curve, "KeyVer"), 4009) ||
         !fbx_wn_array(w->a, curve, "KeyTime", 'l', times, n) || !fbx_wn_array(w->a, curve, "KeyValueFloat", 'f', values, n) ||
         !fbx_wn_array(w->a, curve, "KeyAttrFlags", 'i', flags, n) ||
-        (!w->ascii_float_bits ? !fbx_wn_array(w->a, curve, "KeyAttrDataFloat", 'f', data, 4 * n)
-                    : !fbx_wn_array(w->a, curve, "KeyAttrDataFloat", 'i', bits, 4 * n)) ||
+        !fbx_wn_array(w->a, curve, "KeyAttrDataFloat", w->ascii_float_bits ? 'i' : 'f', data, 4 * n) ||
         !fbx_wn_array(w->a, curve, "KeyAttrRefCount", 'i', refs, n))
         return fbx_objects_oom(w);
     if (!fbx_object_connect(w, "OO", curve_node, layer, NULL) || !fbx_object_connect(w, "OP", curve_node, owner, prop) ||
@@ -313,11 +292,12 @@ mk_result fbx_objects_add_clip(fbx_objects *w, const mk_raw_clip *clip, const in
     int64_t stack, layer;
     fbx_wnode *s = fbx_object_new(w, "AnimationStack", "AnimStack", clip->name ? clip->name : "", "", &stack);
     fbx_wnode *props = s ? fbx_wn_child(w->a, s, "Properties70") : NULL;
-    if (fabs((double)clip->start) > KTIME_MAX_SECONDS || fabs((double)clip->start + clip->duration) > KTIME_MAX_SECONDS)
+    if (fabs((double)clip->start) > max_seconds(w) || fabs((double)clip->start + clip->duration) > max_seconds(w))
         return mk_error_set(w->err, MK_ERROR_LIMIT, UINT64_MAX, "FBX: clip '%s' runs to %g s; FBX times (int64 ticks of "
-                            "1/46186158000 s) reach about 2e8 s", clip->name ? clip->name : "", (double)clip->start + clip->duration);
-    const int64_t start = (int64_t)llround((double)clip->start * KTIME_PER_SECOND);
-    const int64_t stop = (int64_t)llround(((double)clip->start + clip->duration) * KTIME_PER_SECOND);
+                            "1/%.0f s) reach %.3g s", clip->name ? clip->name : "", (double)clip->start + clip->duration,
+                            w->ticks, max_seconds(w));
+    const int64_t start = (int64_t)llround((double)clip->start * w->ticks);
+    const int64_t stop = (int64_t)llround(((double)clip->start + clip->duration) * w->ticks);
     static const char *const names[4] = { "LocalStart", "LocalStop", "ReferenceStart", "ReferenceStop" };
     for (int i = 0; i < 4; i++)
         if (!props || !fbx_wn_prop(w->a, props, names[i], "KTime", "Time", "", (fbx_wvalue){ .type = 'L', .u.i = i & 1 ? stop : start }))

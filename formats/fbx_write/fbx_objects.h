@@ -12,6 +12,7 @@ typedef struct fbx_objects {
     mk_error *err;
     int binary;                  /* names spelled for a binary file, else for ASCII */
     int ascii_float_bits;        /* ASCII 7.2+: KeyAttrDataFloat as int32 bit patterns */
+    double ticks;                /* KTime ticks per second of the file (fbx_doc_ticks) */
     int blender;                 /* the file's Creator is Blender's exporter (fbx_objects.c) */
     int64_t next_id;             /* the next new object's id */
     fbx_wnode **objects, **connections;   /* new Objects and Connections children, in order */

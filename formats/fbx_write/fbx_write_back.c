@@ -68,19 +68,15 @@ static mk_result find_document(write_back *w)
     if (doc->binary && doc->big_endian)
         return mk_error_set(w->err, MK_ERROR_UNSUPPORTED, 22,
                             "FBX write-back: big-endian binary files cannot be written back (only little-endian ones)");
-    int64_t version = doc->version;
-    const fbx_node *header = fbx_child(&doc->root, "FBXHeaderExtension");
-    int64_t stated;
-    if (header && fbx_child_int(header, "FBXVersion", &stated)) version = stated;
+    const int64_t version = doc->version;   /* as the reader settles it (fbx_doc_parse) */
     if (version < 7100)
         return mk_error_set(w->err, MK_ERROR_UNSUPPORTED, UINT64_MAX,
                             "FBX write-back: this is an FBX %lld file; write-back writes FBX 7.1 and later (6.x and "
                             "earlier address objects by name and keep animation in takes; save the file as FBX 2011 or later)",
                             (long long)version);
     w->shapes_in_geometry = version < 7200;
-    /* as the reader decides: the ASCII header comment's version, else FBXVersion */
-    const int64_t read_as = doc->version >= 6000 ? doc->version : version;
-    w->o.ascii_float_bits = !doc->binary && read_as >= 7200;
+    w->o.ascii_float_bits = !doc->binary && version >= 7200;
+    w->o.ticks = fbx_doc_ticks(doc);
     w->objects = fbx_child(&doc->root, "Objects");
     w->connections = fbx_child(&doc->root, "Connections");
     if (!w->objects || !w->connections || !w->objects->child_count || !w->connections->child_count)
@@ -119,8 +115,10 @@ static int insert_into(write_back *w, const fbx_node *parent, fbx_wnode *node)
     return 1;
 }
 
+/* One baked channel as a Shape of geometry g, its weight a P of g's Properties70, or of the
+ * Properties70 made for g (*made) when g has none. */
 static mk_result add_shape_71(write_back *w, const fbx_node *g, const mk_raw_mesh *m, const uint32_t *render_count,
-                              double tolerance, const mk_raw_channel *ch)
+                              double tolerance, const mk_raw_channel *ch, fbx_wnode **made)
 {
     fbx_objects *o = &w->o;
     mk_result r = fbx_object_check_name(o, "channel", ch->name);
@@ -145,18 +143,13 @@ static mk_result add_shape_71(write_back *w, const fbx_node *g, const mk_raw_mes
         !fbx_wn_array(o->a, shape, "Normals", 'd', normals, 3 * n) || !insert_into(w, g, shape))
         return fbx_objects_oom(o);
     const fbx_wvalue percent = { .type = 'D', .u.d = 100.0 * ch->default_weight };
-    if (props && props->child_count) {
-        fbx_wnode *holder = fbx_wn_new(o->a, "Properties70");
+    if (props) {
+        fbx_wnode *holder = fbx_wn_new(o->a, "Properties70");   /* builds the P, which goes into props */
         fbx_wnode *p = holder ? fbx_wn_prop(o->a, holder, ch->name, "Number", "", "A+", percent) : NULL;
         if (!p || !insert_into(w, props, p)) return fbx_objects_oom(o);
     } else {
-        /* no Properties70 with children to add to (ASCII splices before a closing brace): a new one */
-        if (props)
-            return mk_error_set(w->err, MK_ERROR_UNSUPPORTED, props->offset,
-                                "FBX write-back: mesh '%s': its geometry's Properties70 is empty", m->name);
-        fbx_wnode *holder = fbx_wn_new(o->a, "Properties70");
-        if (!holder || !fbx_wn_prop(o->a, holder, ch->name, "Number", "", "A+", percent) || !insert_into(w, g, holder))
-            return fbx_objects_oom(o);
+        if (!*made && (!(*made = fbx_wn_new(o->a, "Properties70")) || !insert_into(w, g, *made))) return fbx_objects_oom(o);
+        if (!fbx_wn_prop(o->a, *made, ch->name, "Number", "", "A+", percent)) return fbx_objects_oom(o);
     }
     o->report->channels++;
     o->report->shapes++;
@@ -199,9 +192,10 @@ static mk_result add_all(write_back *w)
         mk_result r = fbx_objects_mesh(o, m, &render_count, &tolerance);
         if (r != MK_OK) return r;
         if (w->shapes_in_geometry) {
+            fbx_wnode *made = NULL;
             for (uint32_t c = 0; c < raw->channel_count; c++) {
                 if (raw->channels[c].mesh != mi || !is_baked(&raw->channels[c])) continue;
-                if ((r = add_shape_71(w, g, m, render_count, tolerance, &raw->channels[c])) != MK_OK) return r;
+                if ((r = add_shape_71(w, g, m, render_count, tolerance, &raw->channels[c], &made)) != MK_OK) return r;
                 channel_ids[c] = m->fbx_geometry;
             }
             o->report->meshes++;

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "gltf_export.h"
+#include "gltf_weights.h"
 extern "C" {
 #include "blob_io.h"
 }
@@ -144,18 +145,11 @@ struct Exporter {
         return (int)model.accessors.size() - 1;
     }
 
-    // Slot weights of channel c at channel weight w (the runtime's span coefficients).
+    // Slot weights of channel c at channel weight w (gltf_weights.h).
     void slot_weights(uint32_t c, float w, std::vector<float> &u)
     {
-        const mk_raw_channel &ch = raw->channels[c];
-        std::vector<float> fw(ch.target_count);
-        for (uint32_t k = 0; k < ch.target_count; ++k) fw[k] = ch.targets[k].full_weight;
-        u.assign(ch.target_count, 0.0f);
-        int32_t ia, ib;
-        float ca, cb, t;
-        mk_channel_span(fw.data(), ch.target_count, w, &ia, &ca, &ib, &cb, &t);
-        if (ia >= 0 && (uint32_t)ia < ch.target_count) u[ia] += ca;
-        if (ib >= 0 && (uint32_t)ib < ch.target_count) u[ib] += cb;
+        u.assign(raw->channels[c].target_count, 0.0f);
+        mk_gltf_slot_weights(&raw->channels[c], w, u.data());
     }
 
     const mk_raw_track *track_of(const mk_raw_clip &clip, uint32_t c)
@@ -395,36 +389,15 @@ struct Exporter {
                 const mk_raw_track *t = tr[d];
                 if (!t) continue;
                 const mk_raw_channel &ch = raw->channels[g.drivers[d]];
-                std::vector<float> bends;   // weights where slot weights change slope
-                if (ch.target_count > 1) {
-                    bends.push_back(0.0f);
-                    for (uint32_t k = 0; k < ch.target_count; ++k) bends.push_back(ch.targets[k].full_weight);
-                }
+                std::vector<float> inside(MK_GLTF_SEGMENT_TIMES);
                 for (uint32_t k = 0; k < t->key_count; ++k) {
-                    const mk_key &a = t->keys[k];
-                    times.push_back(a.time);
+                    times.push_back(t->keys[k].time);
                     if (k + 1 == t->key_count) break;
-                    const mk_key &b = t->keys[k + 1];
-                    float gap = b.time - a.time, delta = std::min(1e-3f, gap / 4);
-                    switch (a.interp) {
-                    case MK_INTERP_CONSTANT: times.push_back(b.time - delta); break;
-                    case MK_INTERP_CONSTANT_NEXT: times.push_back(a.time + delta); break;
-                    case MK_INTERP_LINEAR:
-                        for (float f : bends)
-                            if ((a.value - f) * (b.value - f) < 0) times.push_back(a.time + gap * (f - a.value) / (b.value - a.value));
-                        break;
-                    default: {
-                        int steps = std::max(2, (int)std::ceil(gap * 60.0f));
-                        for (int q = 1; q < steps; ++q) times.push_back(a.time + gap * (float)q / (float)steps);
-                    }
-                    }
+                    uint32_t n = mk_gltf_segment_times(&t->keys[k], &t->keys[k + 1], &ch, inside.data());
+                    times.insert(times.end(), inside.begin(), inside.begin() + n);
                 }
             }
-            std::sort(times.begin(), times.end());
-            std::vector<float> uniq;
-            for (float t : times)
-                if (uniq.empty() || t - uniq.back() > 1e-6f) uniq.push_back(t);
-            times.swap(uniq);
+            times.resize(mk_gltf_unique_times(times.data(), times.size()));
             values.assign(times.size() * T, 0.0f);
             for (size_t k = 0; k < times.size(); ++k) {
                 for (size_t d = 0; d < g.drivers.size(); ++d) {

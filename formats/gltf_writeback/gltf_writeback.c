@@ -24,7 +24,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <cjson/cJSON.h>
+#include "blob_io.h"
 #include "gltf_accessor.h"
+#include "gltf_weights.h"
 
 enum { GLB_JSON = 0x4E4F534A, GLB_BIN = 0x004E4942, ARRAY_BUFFER = 34962 };
 
@@ -414,20 +416,6 @@ static int same_channel(const mk_raw_channel *a, const mk_raw_channel *b)
     return 1;
 }
 
-/* glTF weights of a channel's targets at channel weight wgt (the exporter's encoding: the two
- * targets of the span get their factors, docs/importing-gltf.md). */
-static void slot_weights(const mk_raw_channel *ch, float wgt, float *u)
-{
-    float fw[256] = { 0 };
-    uint32_t n = ch->target_count < 256 ? ch->target_count : 256;
-    for (uint32_t k = 0; k < n; k++) { fw[k] = ch->targets[k].full_weight; u[k] = 0; }
-    int32_t ia, ib;
-    float ca, cb, t;
-    mk_channel_span(fw, n, wgt, &ia, &ca, &ib, &cb, &t);
-    if (ia >= 0 && (uint32_t)ia < n) u[ia] += ca;
-    if (ib >= 0 && (uint32_t)ib < n) u[ib] += cb;
-}
-
 static mk_result plan_mesh(wb *w, int32_t mi, mesh_plan *p)
 {
     const mk_raw_asset *raw = w->raw;
@@ -512,7 +500,7 @@ static mk_result plan_mesh(wb *w, int32_t mi, mesh_plan *p)
             if (ch->target_count > 256)
                 return mk_error_set(w->err, MK_ERROR_LIMIT, UINT64_MAX, "glTF write-back: channel '%s' has %u targets (256 at most)",
                                     ch->name ? ch->name : "", ch->target_count);
-            slot_weights(ch, ch->default_weight, &p->defaults[p->slot_count]);
+            mk_gltf_slot_weights(ch, ch->default_weight, &p->defaults[p->slot_count]);
             for (uint32_t t = 0; t < ch->target_count; t++)
                 p->slots[p->slot_count++] = (slot){ q, k, t, ref_baked[q][k] };
             w->rep->channels++;
@@ -839,12 +827,6 @@ static mk_result extend_animations(wb *w)
     return r;
 }
 
-static int cmp_float(const void *a, const void *b)
-{
-    float x = *(const float *)a, y = *(const float *)b;
-    return (x > y) - (x < y);
-}
-
 static const mk_raw_track *track_of(const mk_raw_clip *clip, uint32_t channel)
 {
     for (uint32_t t = 0; t < clip->track_count; t++)
@@ -852,43 +834,26 @@ static const mk_raw_track *track_of(const mk_raw_clip *clip, uint32_t channel)
     return NULL;
 }
 
-/* Appends the key-sampling times of one track (as `morphkit export` does for curves glTF
- * cannot express exactly: key times, where a linear segment crosses a full weight or 0, 1 ms
- * before a constant segment's jump, 60 Hz inside cubic segments). */
+/* Appends the key-sampling times of one track: its keys and what gltf_weights.h samples
+ * between them (as `morphkit export` does). */
 static mk_result track_times(wb *w, const mk_raw_track *t, const mk_raw_channel *ch, float **times, size_t *n, size_t *cap)
 {
+    float *add = mk_arena_array(&w->tmp, MK_GLTF_SEGMENT_TIMES + 1, sizeof(float));
+    if (!add) return mk_error_oom(w->err, "glTF write-back");
     for (uint32_t k = 0; k < t->key_count; k++) {
-        float add[512];
-        int na = 0;
-        const mk_key *a = &t->keys[k];
-        add[na++] = a->time;
-        if (k + 1 < t->key_count) {
-            const mk_key *b = &t->keys[k + 1];
-            float gap = b->time - a->time, delta = gap / 4 < 1e-3f ? gap / 4 : 1e-3f;
-            if (a->interp == MK_INTERP_CONSTANT) add[na++] = b->time - delta;
-            else if (a->interp == MK_INTERP_CONSTANT_NEXT) add[na++] = a->time + delta;
-            else if (a->interp == MK_INTERP_LINEAR) {
-                for (uint32_t j = 0; ch->target_count > 1 && j <= ch->target_count && na < 500; j++) {
-                    float f = j ? ch->targets[j - 1].full_weight : 0.0f;
-                    if ((a->value - f) * (b->value - f) < 0) add[na++] = a->time + gap * (f - a->value) / (b->value - a->value);
-                }
-            } else {
-                int steps = (int)ceilf(gap * 60.0f);
-                if (steps < 2) steps = 2;
-                if (steps > 500) steps = 500;
-                for (int q = 1; q < steps; q++) add[na++] = a->time + gap * (float)q / (float)steps;
-            }
-        }
-        if (*n + (size_t)na > *cap) {
-            size_t c = (*cap ? *cap * 2 : 256) + (size_t)na;
+        add[0] = t->keys[k].time;
+        size_t na = 1 + (k + 1 < t->key_count ? mk_gltf_segment_times(&t->keys[k], &t->keys[k + 1], ch, add + 1) : 0);
+        if (*n + na > *cap) {
+            size_t c = (*cap ? *cap * 2 : 256) + na;
             float *g = mk_arena_realloc(&w->tmp, *times, *cap * sizeof(float), c * sizeof(float));
             if (!g) return mk_error_oom(w->err, "glTF write-back");
             *times = g;
             *cap = c;
         }
-        memcpy(*times + *n, add, (size_t)na * sizeof(float));
-        *n += (size_t)na;
+        memcpy(*times + *n, add, na * sizeof(float));
+        *n += na;
     }
+    mk_arena_release(&w->tmp, add);
     return MK_OK;
 }
 
@@ -937,10 +902,7 @@ static mk_result add_clips(wb *w)
                 if (t) { any = 1; r = track_times(w, t, drv[k], &times, &n, &cap); }
             }
             if (r != MK_OK || !any) continue;
-            qsort(times, n, sizeof *times, cmp_float);
-            size_t u = 0;
-            for (size_t i = 0; i < n; i++)
-                if (!u || times[i] - times[u - 1] > 1e-6f) times[u++] = times[i];
+            size_t u = mk_gltf_unique_times(times, n);
             float *vals = mk_arena_array(&w->tmp, u * (T + S) + 1, sizeof(float)), wts[256];
             if (!vals) return mk_error_oom(w->err, "glTF write-back");
             for (size_t i = 0; i < u; i++)
@@ -949,7 +911,7 @@ static mk_result add_clips(wb *w)
                     const mk_raw_track *t = track_of(clip, (uint32_t)(ch - raw->channels));
                     float wv = t ? mk_curve_eval(t->keys, t->key_count, times[i], NULL) : ch->default_weight;
                     if (k < T) { vals[i * (T + S) + k] = wv; continue; }
-                    slot_weights(ch, wv, wts);
+                    mk_gltf_slot_weights(ch, wv, wts);
                     vals[i * (T + S) + k] = wts[p->slots[k - T].target];
                 }
             int32_t in = add_floats(w, times, u, 1, &r);
@@ -1061,21 +1023,13 @@ static int relative_uri(const char *u)
     return 1;
 }
 
-static void dir_part(const char *path, char *out, size_t n)
-{
-    const char *s = strrchr(path, '/');
-    if (!s) snprintf(out, n, ".");
-    else if (s == path) snprintf(out, n, "/");
-    else snprintf(out, n, "%.*s", (int)(s - path), path);
-}
-
 /* Relative URIs of buffers and images point at the input's folder from the output's. */
 static mk_result rewrite_uris(wb *w, const char *input_path, const char *output_path)
 {
     if (!input_path || !output_path) return MK_OK;
     char a[4096], b[4096], in_dir[PATH_MAX], out_dir[PATH_MAX];
-    dir_part(input_path, a, sizeof a);
-    dir_part(output_path, b, sizeof b);
+    mk_path_dir(input_path, a, sizeof a);
+    mk_path_dir(output_path, b, sizeof b);
     if (!realpath(a, in_dir) || !realpath(b, out_dir)) return MK_OK;   /* the output check reports a missing folder */
     if (!strcmp(in_dir, out_dir)) return MK_OK;
     /* prefix = out_dir -> in_dir, percent-encoded */
@@ -1227,23 +1181,17 @@ static mk_result assemble(wb *w, mk_arena *arena, void **out, size_t *out_size)
 
 /* ---- entry ---- */
 
-static int ends_with(const char *s, const char *suffix)
-{
-    size_t a = strlen(s), b = strlen(suffix);
-    return a >= b && !strcmp(s + a - b, suffix);
-}
-
 static mk_result run(wb *w, const uint8_t *in, size_t size, const char *input_path, const char *output_path,
                      mk_arena *arena, void **out, size_t *out_size, char **sidecar, size_t *sidecar_size)
 {
     mk_result r = split_container(w, in, size);
     if (r != MK_OK) return r;
-    if (output_path && !ends_with(output_path, w->glb ? ".glb" : ".gltf"))
+    if (output_path && !mk_path_has_extension(output_path, w->glb ? ".glb" : ".gltf"))
         return mk_error_set(w->err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX,
                             "glTF write-back: the input is %s, so the output must end in %s (%.200s)",
                             w->glb ? "a .glb" : "glTF JSON", w->glb ? ".glb" : ".gltf", output_path);
     char base[4096];
-    if (input_path) dir_part(input_path, base, sizeof base);
+    if (input_path) mk_path_dir(input_path, base, sizeof base);
     if ((r = mk_gltf_doc_load(&w->tmp, in, size, w->glb, input_path ? base : NULL, 0, NULL, NULL, &w->doc, w->err)) != MK_OK)
         return r;
     w->doc_loaded = 1;

@@ -31,17 +31,8 @@ static double played_apart(const mk_raw_asset *a, const mk_raw_asset *b, uint32_
     return worst;
 }
 
-static double diagonal(const mk_raw_mesh *m)
-{
-    double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY }, d = 0;
-    for (uint32_t v = 0; v < m->vertex_count; v++)
-        for (int k = 0; k < 3; k++) {
-            lo[k] = fmin(lo[k], m->positions[3 * v + k]);
-            hi[k] = fmax(hi[k], m->positions[3 * v + k]);
-        }
-    for (int k = 0; k < 3; k++) d += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    return sqrt(d);
-}
+/* The mesh's size for tolerances: its diagonal, at least 1. */
+static double diagonal(const mk_raw_mesh *m) { return fmax((double)mk_raw_mesh_diagonal(m), 1); }
 
 /* The triangles of m on control points, each rotated to start at its smallest, sorted. */
 static int by_triple(const void *a, const void *b) { return memcmp(a, b, 3 * sizeof(uint32_t)); }
@@ -91,7 +82,7 @@ static void compare(const char *name, const mk_raw_asset *a, const mk_raw_asset 
         for (int k = 0; k < 16; k++)
             CHECK_MSG(fabs(y->world[k] - x->world[k]) <= 1e-5 * size, "%s mesh '%s': world[%d] %.9g, exported %.9g",
                       name, x->name, k, x->world[k], y->world[k]);
-        const double tol = 1e-6 * fmax(diagonal(x), 1);
+        const double tol = 1e-6 * diagonal(x);
         /* the rest pose and every channel alone at four weights */
         for (uint32_t c = 0; c <= a->channel_count; c++) {
             if (c < a->channel_count && a->channels[c].mesh != m) continue;
@@ -102,7 +93,7 @@ static void compare(const char *name, const mk_raw_asset *a, const mk_raw_asset 
                 double d = played_apart(a, b, m, -1, 0, wa, wb);
                 CHECK_MSG(d >= 0 && d <= tol, "%s mesh '%s' channel %d at weight %g: played %g apart", name, x->name,
                           c < a->channel_count ? (int)c : -1, (double)wa[c], d);
-                if (d / fmax(diagonal(x), 1) > worst_seen[0]) worst_seen[0] = d / fmax(diagonal(x), 1);
+                if (d / diagonal(x) > worst_seen[0]) worst_seen[0] = d / diagonal(x);
             }
         }
         /* every clip at nine times over its span */
@@ -111,9 +102,9 @@ static void compare(const char *name, const mk_raw_asset *a, const mk_raw_asset 
             for (int i = 0; i <= 8; i++) {
                 float time = a->clips[k].start + a->clips[k].duration * (float)i / 8.0f;
                 double d = played_apart(a, b, m, (int32_t)k, time, NULL, NULL);
-                CHECK_MSG(d >= 0 && d <= 1e-4 * fmax(diagonal(x), 1), "%s mesh '%s' clip %u at %g s: played %g apart", name,
+                CHECK_MSG(d >= 0 && d <= 1e-4 * diagonal(x), "%s mesh '%s' clip %u at %g s: played %g apart", name,
                           x->name, k, (double)time, d);
-                if (d / fmax(diagonal(x), 1) > worst_seen[1]) worst_seen[1] = d / fmax(diagonal(x), 1);
+                if (d / diagonal(x) > worst_seen[1]) worst_seen[1] = d / diagonal(x);
             }
         }
     }

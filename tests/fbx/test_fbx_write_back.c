@@ -499,5 +499,82 @@ static void test_still_target(void)
     }
 }
 
-CHECK_MAIN(CASE(test_node_records), CASE(test_still_target), CASE(test_nothing_baked_is_identity), CASE(test_baked_round_trip), CASE(test_refusals),
+/* FBX 7.1 weights go into the geometry's Properties70; a geometry without one gets a single new
+ * one for all its baked channels. */
+static void test_71_properties(void)
+{
+    size_t size;
+    unsigned char *data = ft_read_corpus("maya_blend_shape_cube_7100_ascii", &size);
+    if (!data) SKIP("corpus not found at %s", check_corpus_dir());
+    /* the geometry's Properties70 (the first one after "Geometry:") cut out */
+    char *text = (char *)data, *geometry = strstr(text, "Geometry:");
+    char *props = geometry ? strstr(geometry, "Properties70:") : NULL, *close = props ? strstr(props, "}") : NULL;
+    CHECK(props && close);
+    if (!props || !close) { free(data); return; }
+    while (props > text && props[-1] == '\t') props--;
+    close = strchr(close, '\n') + 1;
+    memmove(props, close, size - (size_t)(close - text));
+    size -= (size_t)(close - props);
+    static const char two[] = "{ \"mesh\": 0, \"channels\": [ { \"name\": \"taper_a\", \"op\": \"taper\", \"axis\": \"y\", "
+                              "\"scale\": 0.5 }, { \"name\": \"taper_b\", \"op\": \"taper\", \"axis\": \"x\", \"scale\": 0.5 } ] }";
+    mk_raw_asset raw, back;
+    mk_error err;
+    CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
+    CHECK(mk_bake_recipe(&raw, two, sizeof two - 1, NULL, NULL, &err) == MK_OK);
+    void *out = NULL;
+    size_t out_size = 0;
+    CHECK(mk_fbx_write_back(data, size, &raw, &raw.arena, &out, &out_size, NULL, &err) == MK_OK);
+    mk_arena arena;
+    mk_arena_init(&arena, NULL);
+    fbx_doc doc;
+    memset(&doc, 0, sizeof doc);
+    if (out && fbx_doc_parse(&doc, &arena, out, out_size, &err) == MK_OK) {
+        const fbx_node *g = fbx_child(fbx_child(&doc.root, "Objects"), "Geometry");
+        int blocks = 0;
+        for (const fbx_node *p = NULL; g && (p = fbx_next_child(g, p, "Properties70")) != NULL;) blocks++;
+        CHECK_EQ_INT(blocks, 1);
+        CHECK(ft_import(out, out_size, NULL, &back, &err) == MK_OK);
+        CHECK(find_channel(&back, "taper_a", NULL) && find_channel(&back, "taper_b", NULL));
+        mk_raw_free(&back);
+    } else {
+        CHECK_MSG(0, "%s", err.message);
+    }
+    fbx_doc_free(&doc);
+    mk_arena_free_all(&arena);
+    mk_raw_free(&raw);
+    free(data);
+}
+
+/* A file at FBX's newer tick rate (TCDefinition 0: 141120000 per second) gets its new keys at
+ * that rate: the clip plays at the same times after a re-import. */
+static void test_tick_rate(void)
+{
+    size_t size;
+    unsigned char *data = ft_read_corpus("maya_blend_shape_cube_7700_ascii", &size);
+    if (!data) SKIP("corpus not found at %s", check_corpus_dir());
+    char *tc = strstr((char *)data, "TCDefinition: 127");
+    CHECK(tc != NULL);
+    if (!tc) { free(data); return; }
+    memcpy(tc + strlen("TCDefinition: "), "  0", 3);
+    mk_raw_asset raw, back;
+    mk_error err;
+    CHECK(ft_import(data, size, NULL, &raw, &err) == MK_OK);
+    CHECK(mk_bake_recipe(&raw, recipe, sizeof recipe - 1, NULL, NULL, &err) == MK_OK);
+    void *out = NULL;
+    size_t out_size = 0;
+    CHECK(mk_fbx_write_back(data, size, &raw, &raw.arena, &out, &out_size, NULL, &err) == MK_OK);
+    CHECK(out && ft_import(out, out_size, NULL, &back, &err) == MK_OK);
+    if (out) {
+        const mk_raw_clip *a = &raw.clips[raw.clip_count - 1], *b = &back.clips[back.clip_count - 1];
+        CHECK_NEAR(b->duration, a->duration, 1e-6);
+        CHECK(a->track_count == 1 && b->track_count == 1 && a->tracks[0].key_count == b->tracks[0].key_count);
+        for (uint32_t k = 0; a->track_count == 1 && b->track_count == 1 && k < a->tracks[0].key_count; k++)
+            CHECK_NEAR(b->tracks[0].keys[k].time, a->tracks[0].keys[k].time, 1e-6);
+        mk_raw_free(&back);
+    }
+    mk_raw_free(&raw);
+    free(data);
+}
+
+CHECK_MAIN(CASE(test_node_records), CASE(test_still_target), CASE(test_71_properties), CASE(test_tick_rate), CASE(test_nothing_baked_is_identity), CASE(test_baked_round_trip), CASE(test_refusals),
            CASE(test_ascii_name_refused))
