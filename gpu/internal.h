@@ -28,6 +28,7 @@ typedef struct mkg_params {
     uint32_t positions, normals, tangents, block_table, entries, target_data, first_target;
     uint32_t vertex_count, target_count, block_count, flags, groups_x;
     uint32_t out_p, out_p_stride, out_n, out_n_stride, out_t, out_t_stride;
+    uint32_t entry_words, components, mesh_flags;   /* the mesh's entry layout (format.h) */
 } mkg_params;
 
 enum { MKG_WANT_NORMALS = 1u, MKG_WANT_TANGENTS = 2u };

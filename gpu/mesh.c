@@ -31,10 +31,13 @@ static mk_result data_window(const mkg_mesh *gm, const mk_blob_mesh *m, window *
     if (m->flags & MK_MESH_HAS_NORMALS) cover(&lo, &hi, m->normals, 12 * v);
     if (m->flags & MK_MESH_HAS_TANGENTS) cover(&lo, &hi, m->tangents, 16 * v);
     cover(&lo, &hi, m->block_entries, 4 * ((uint64_t)m->block_count + 1));
-    cover(&lo, &hi, m->entries, 16 * m->entry_count);
+    cover(&lo, &hi, m->entries, (uint64_t)mk_entry_stride(m->flags) * m->entry_count);
+    /* The size counts the zero tail after the last entry's data (mk_asset_open checks every entry
+     * leaves MK_TARGET_DATA_TAIL bytes), so the shader's two-word reads of packed values stay in
+     * the window. */
     cover(&lo, &hi, m->target_data, m->target_data_size);
-    /* The shader reads whole 32-bit words: an int16 entry may end 2 bytes into its last word (the
-     * blob's sizes need not be multiples of 4; the uploaded buffer is padded to whole words). */
+    /* The shader reads whole 32-bit words, and the blob's sizes need not be multiples of 4 (the
+     * uploaded buffer is padded to whole words). */
     w->offset = align_down(lo, gm->asset->ctx->offset_alignment);
     w->range = align_up(hi, 4) - w->offset;
     if (w->range > lim->maxStorageBufferRange)
@@ -173,6 +176,9 @@ mk_result mkg_mesh_create(mkg_asset *asset, const mkg_mesh_desc *d, mkg_mesh **o
     p->vertex_count = m->vertex_count;
     p->target_count = m->target_count;
     p->block_count = m->block_count;
+    p->entry_words = mk_entry_stride(m->flags) / 4;   /* 24, 32 or 40 bytes */
+    p->components = mk_mesh_components(m->flags);
+    p->mesh_flags = m->flags;
     window win[MKG_BINDINGS];
     mk_result res = data_window(gm, m, &win[0], p, err);
     if (res == MK_OK) res = targets_window(gm, m, &win[1], p, err);

@@ -7,23 +7,29 @@
 #include "raw.h"
 
 typedef enum mk_precision {
-    MK_PRECISION_Q16 = 0,      /* default: int16 per component with a per-target scale */
+    MK_PRECISION_Q16 = 0,      /* default: packed integers at a step the tolerance sets (format v5) */
     MK_PRECISION_FLOAT = 1     /* lossless float32 */
 } mk_precision;
 
+/* The default largest error of a stored normal or tangent delta component (unit vectors: 1e-3
+ * moves a normal by at most 0.1 degree per target). */
+#define MK_DEFAULT_NORMAL_TOLERANCE 1e-3
+
 typedef struct mk_write_options {
     mk_precision precision;
-    /* Largest allowed absolute position error of quantization, in mesh units. A quantized
-     * target's scales come from its entries (64-vertex blocks) that fit this with int16; the
-     * entries that do not (outlier deltas) are stored as int16 around a position offset where
-     * their spread allows it, else as float32. 0 = 1e-4 x the mesh's bounding-box diagonal (a
+    /* Largest allowed absolute position error of quantization, in mesh units: the positions'
+     * step is the largest whose bound (half a step, plus 2^-8 of one for float32 evaluation)
+     * stays within it. A block whose values span more than 16 bits at that step, or lie beyond
+     * 2^23 steps, is stored as float32. 0 = 1e-4 x the mesh's bounding-box diagonal (a
      * relative default that works for cm and m assets alike). */
     float tolerance;
+    /* The same for normal and tangent deltas; 0 = MK_DEFAULT_NORMAL_TOLERANCE. */
+    float normal_tolerance;
     /* The entry mask rule (mk_block_mask, block_mask.h) with gap = gap_limit - 1: gaps of at
-     * most `gap` unmoved vertices between moved ones are stored as zeros, and a block that
-     * still lacks at most 3 x gap is stored whole. 1 stores exactly the moved vertices, 65
-     * every touched block whole (larger values count as 65); 0 = the default
-     * (MK_DEFAULT_FILL_GAP + 1). */
+     * most `gap` vertices without a nonzero stored value between ones with it are stored as
+     * zeros, and a block that still lacks at most 3 x gap is stored whole. 1 stores exactly the
+     * vertices with a nonzero value, 65 every touched block whole (larger values count as 65);
+     * 0 = the default (MK_DEFAULT_FILL_GAP + 1). */
     uint32_t gap_limit;
     /* Phases of the write (quantize, lay out blocks, assemble); may be NULL. */
     mk_phase_log *phases;
@@ -40,12 +46,12 @@ typedef struct mk_write_options {
 
 typedef struct mk_write_report {
     double max_position_error;  /* largest |stored - exact| component over all targets */
-    double max_normal_error;    /* the same for normal and tangent deltas: not bounded by the */
-    double max_tangent_error;   /* tolerance; int16 of a unit-vector difference errs < 3.1e-5 */
+    double max_normal_error;    /* the same for normal and tangent deltas (within the */
+    double max_tangent_error;   /* normal tolerance) */
     double tolerance_used;      /* the largest per-mesh tolerance that was applied */
     uint32_t quantized_targets, float_targets;
     uint64_t float_entries;     /* entries of quantized targets stored as float32 (outliers) */
-    uint64_t offset_entries;    /* int16 entries around a position offset (outliers that fit) */
+    uint64_t wide_entries;      /* packed entries with int32 position offsets */
     uint64_t entry_count;       /* all block entries */
     uint64_t target_bytes;      /* bytes of block data (entries + deltas) */
     uint64_t total_bytes;

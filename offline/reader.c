@@ -1,8 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* mk_read_blob: an opened .morph asset back into a raw model (deltas dequantized, each
  * entry by its own precision). An entry's mask may cover vertices a target does not move (the
- * writer fills short gaps and nearly full blocks), stored as zeros; all-zero vertices are
- * dropped again (a vertex the author stored with a zero delta is indistinguishable from that
+ * writer may fill short gaps), stored as zeros; all-zero vertices are dropped again (a vertex the author stored with a zero delta is indistinguishable from that
  * padding, and moves nothing). */
 #include <stdio.h>
 #include <string.h>
@@ -16,17 +15,27 @@ static void *copy(mk_arena *arena, const void *src, size_t n)
     return p;
 }
 
-/* Decodes component c of the j-th xyz triple of an entry's attribute starting at p. */
-static float decode(const uint8_t *p, int quantized, int c, uint32_t j, float scale)
+/* Component c (0-2) of attribute `attribute` of the j-th vertex of an entry whose data starts at
+ * p (docs/format.md): float32 triples, or the packed value (offset + u) times the step. */
+static float decode(const mk_blob_entry *en, const uint8_t *p, uint32_t mesh_flags, uint32_t target_flags,
+                    uint32_t attribute, uint32_t c, uint32_t j, float step)
 {
-    if (quantized) {
-        int16_t q;
-        memcpy(&q, p + (3 * (size_t)j + (size_t)c) * 2, 2);
-        return (float)q * scale;
+    const uint32_t m = mk_popcount64(en->mask);
+    if (!mk_entry_packed(en)) {
+        const uint32_t before = attribute == 0 ? 0u : attribute == 1 ? 1u : 1u + ((target_flags & MK_TARGET_HAS_NORMALS) ? 1u : 0u);
+        float f;
+        memcpy(&f, p + 12u * ((size_t)before * m + j) + 4u * c, 4);
+        return f;
     }
-    float f;
-    memcpy(&f, p + (3 * (size_t)j + (size_t)c) * 4, 4);
-    return f;
+    const uint32_t components = mk_mesh_components(mesh_flags), k = mk_attribute_component(mesh_flags, attribute) + c;
+    int32_t offset = mk_entry_offset(en, components, k);
+    if (mk_entry_wide(en)) {
+        if (k < 3) offset = (int32_t)mk_load_u32le(p + 4u * k);
+        p += MK_ENTRY_WIDE_BYTES;
+    }
+    for (uint32_t i = 0; i < k; i++) p += mk_packed_bytes(m, mk_width_of_code(mk_entry_code(en, i)));
+    const uint32_t w = mk_width_of_code(mk_entry_code(en, k));
+    return (float)(offset + (int32_t)mk_unpack(p, w, j)) * step;
 }
 
 static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t local, mk_raw_target *t,
@@ -34,11 +43,13 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
 {
     const mk_blob_target *bt = &a->targets[bm->first_target + local];
     const uint32_t *block_first = (const uint32_t *)(a->data + bm->block_entries);
-    const mk_blob_entry *entries = (const mk_blob_entry *)(a->data + bm->entries);
+    const uint8_t *entries = a->data + bm->entries;
+    const uint32_t stride = mk_entry_stride(bm->flags);
     const int hn = (bt->flags & MK_TARGET_HAS_NORMALS) != 0, ht = (bt->flags & MK_TARGET_HAS_TANGENTS) != 0;
     uint64_t capacity = 0;
     for (uint64_t e = 0; e < bm->entry_count; e++)
-        if (mk_entry_target(&entries[e]) == local) capacity += (uint64_t)mk_popcount64(entries[e].mask);
+        if (mk_entry_target(mk_entry_at(entries, stride, e)) == local)
+            capacity += (uint64_t)mk_popcount64(mk_entry_at(entries, stride, e)->mask);
     t->indices = mk_arena_array(arena, capacity + 1, sizeof(uint32_t));
     t->positions = mk_arena_array(arena, 3 * capacity + 3, sizeof(float));
     t->normals = hn ? mk_arena_array(arena, 3 * capacity + 3, sizeof(float)) : NULL;
@@ -48,24 +59,18 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
     uint32_t n = 0;
     for (uint32_t b = 0; b < bm->block_count; b++) {
         for (uint32_t e = block_first[b]; e < block_first[b + 1]; e++) {
-            const mk_blob_entry *en = &entries[e];
+            const mk_blob_entry *en = mk_entry_at(entries, stride, e);
             if (mk_entry_target(en) != local) continue;
-            const int q = mk_entry_quantized(en);   /* per entry: a quantized target's outliers are float */
-            const size_t attr = (size_t)mk_entry_attribute_bytes(en);
-            const uint8_t *p = a->data + bm->target_data + (size_t)en->data * MK_ALIGN;
-            float offset[3] = { 0, 0, 0 };   /* MK_ENTRY_OFFSET: the positions' common part */
-            if (mk_entry_has_offset(en)) {
-                memcpy(offset, p, sizeof offset);
-                p += MK_ENTRY_OFFSET_BYTES;
-            }
+            const int q = mk_entry_packed(en);   /* per entry: a quantized target's outliers are float */
+            const uint8_t *p = a->data + bm->target_data + (size_t)en->data * MK_DATA_UNIT;
             uint32_t j = 0;
             for (uint64_t bits = en->mask; bits; bits &= bits - 1, j++) {
                 float pv[3], nv[3] = { 0, 0, 0 }, tv[3] = { 0, 0, 0 };
                 int nonzero = 0;
-                for (int c = 0; c < 3; c++) {
-                    pv[c] = offset[c] + decode(p, q, c, j, bt->position_scale);
-                    if (hn) nv[c] = decode(p + attr, q, c, j, bt->normal_scale);
-                    if (ht) tv[c] = decode(p + attr * (hn ? 2 : 1), q, c, j, bt->tangent_scale);
+                for (uint32_t c = 0; c < 3; c++) {
+                    pv[c] = decode(en, p, bm->flags, bt->flags, 0, c, j, q ? bt->position_scale : 1.0f);
+                    if (hn) nv[c] = decode(en, p, bm->flags, bt->flags, 1, c, j, q ? bt->normal_scale : 1.0f);
+                    if (ht) tv[c] = decode(en, p, bm->flags, bt->flags, 2, c, j, q ? bt->tangent_scale : 1.0f);
                     nonzero |= pv[c] != 0 || nv[c] != 0 || tv[c] != 0;
                 }
                 if (!nonzero) continue;   /* a vertex the mask covers but the target does not move */

@@ -5,15 +5,13 @@
  * KEYS | DATA, every piece 16-aligned. DATA holds, per mesh: base positions, normals,
  * tangents, triangles, control-point map, the block table, the entries and the delta data.
  *
- * Targets are cut into blocks of 64 vertices, one entry per touched block. An entry's mask
- * (mk_block_mask) holds the moved vertices plus short gaps between them, or the whole block
- * when little of it is unmoved, so the runtime adds few, long runs (a whole block is its
- * constant-trip loop) while few zeros are stored. Quantized targets store int16 per component
- * with a per-target, per-attribute scale = max|component| / 32767 over their int16 entries;
- * when the whole target's position error would exceed the tolerance, the entries whose deltas
- * do not fit it (outliers) are stored as int16 around a position offset where their spread
- * allows it (MK_ENTRY_OFFSET), else as float32, and the scales come from the int16 entries (a
- * target with no entry that fits either way is stored as float32).
+ * Targets are cut into blocks of 64 vertices, one entry per block where a target keeps a
+ * nonzero value. Quantized targets store integers at one step per attribute and mesh (the
+ * position step from the tolerance, the normal and tangent step from the normal tolerance):
+ * per entry and component the smallest value is the offset and the rest are packed in as few
+ * bits as their range needs (0-16), vertices whose values are all zero left out of the mask
+ * (mk_block_mask may fill short gaps). An entry whose values span more than 16 bits is stored
+ * as float32; one whose position offsets leave int16 carries int32 offsets (MK_ENTRY_WIDE).
  *
  * Deterministic: fixed iteration order, all padding zero, nothing taken from pointers/time.
  */
@@ -63,58 +61,34 @@ static uint32_t put_string(bytes *strings, const char *s)
 
 /* ---- quantization ---- */
 
-static float max_abs(const float *p, size_t n)
+/* The error bound of a value stored as the nearest multiple of `step`: half a step, and 2^-8
+ * of a step more for the float32 arithmetic that evaluates it (the step times an integer below
+ * 2^24 rounds by at most 2^-24 of it). */
+static double quant_error_bound(float step) { return (double)step * (0.5 + 1.0 / 256); }
+
+/* The largest step whose bound stays within the tolerance (0: none does, store float32). */
+static float step_for(double tolerance)
 {
-    float m = 0;
-    for (size_t i = 0; i < n; i++) m = fabsf(p[i]) > m ? fabsf(p[i]) : m;
-    return m;
+    float step = (float)(tolerance / (0.5 + 1.0 / 256));
+    if (!(step < FLT_MAX)) step = FLT_MAX;
+    while (step > 0 && !(step >= FLT_MIN && quant_error_bound(step) <= tolerance))
+        step = step >= FLT_MIN ? nextafterf(step, 0.0f) : 0.0f;
+    return step;
 }
 
-static float quant_scale(float maxabs) { return maxabs > 0 ? maxabs / 32767.0f : 0.0f; }
-
-/* roundf(v / scale) clamped to +-32767, without the libm call (a tenth of an import's time
- * went to roundf): clamping first gives the same integer (both bounds are integers), and the
- * clamped quotient converts to int32 exactly; its fraction (exact below 2^23) decides the
- * rounding, halves away from zero as roundf. */
-static int16_t quantize(float v, float scale)
+/* The nearest integer to value / step (halves away from zero), from the reciprocal in double
+ * (within 2^-40 of a step of the quotient: no libm call in the writer's hottest loop), clamped
+ * beyond any storable magnitude so the conversion is defined. */
+static int64_t quantize(float value, double inverse_step)
 {
-    if (scale == 0) return 0;
-    float x = v / scale;
-    x = x > 32767.f ? 32767.f : x < -32767.f ? -32767.f : x;
-    int32_t i = (int32_t)x;
-    float frac = x - (float)i;
-    i += (frac >= 0.5f) - (frac <= -0.5f);
-    return (int16_t)i;
+    double x = (double)value * inverse_step;
+    x = x > 0x1p40 ? 0x1p40 : x < -0x1p40 ? -0x1p40 : x;
+    return (int64_t)(x < 0 ? x - 0.5 : x + 0.5);
 }
-
-/* |dequantized - exact| of one value stored as q around offset o (0 but in an offset entry). */
-static double quant_error_of(float v, float o, int16_t q, float scale) { return fabs((double)o + (double)q * scale - (double)v); }
-
-/* Largest |dequantized - exact| over the array. */
-static double quant_error(const float *p, size_t n, float scale)
-{
-    double e = 0;
-    for (size_t i = 0; i < n; i++) {
-        double d = quant_error_of(p[i], 0.0f, quantize(p[i], scale), scale);
-        if (d > e) e = d;
-    }
-    return e;
-}
-
-/* An upper bound of quant_error for a normal (not subnormal) scale: v / scale rounds to within
- * 2^-24 of |v / scale| <= 32767.002, i.e. within 2^-9, then to the nearest integer, so every
- * value errs by at most scale (0.5 + 2^-9) before the last double rounding. The bound allows
- * 2^-8: the other 2^-9 covers an offset entry's value - offset, which rounds by at most
- * 2^-24 x 32767 scale < 2^-9 scale (offset_fits). */
-static double quant_error_bound(float scale) { return (double)scale * (0.5 + 1.0 / 256); }
 
 typedef struct target_plan {
     uint32_t flags;
-    float position_scale, normal_scale, tangent_scale;
-    /* A quantized target's entries whose largest |position component| exceeds this are
-     * float32 (INFINITY: none). */
-    float entry_limit;
-    double tolerance;                  /* the mesh's */
+    float position_scale, normal_scale, tangent_scale;   /* the steps of a quantized target */
 } target_plan;
 
 /* The moved vertices [first, end) of a target in one block: from `first`, the target's
@@ -126,112 +100,23 @@ static uint32_t block_end(const mk_raw_target *t, uint32_t first, uint32_t block
     return end;
 }
 
-/* The largest position magnitude an int16 entry may hold: the largest L whose scale
- * L / 32767 keeps quant_error_bound within the tolerance (0 when even the smallest normal
- * scale does not). */
-static float entry_limit_for(double tolerance)
-{
-    float limit = (float)(tolerance / (0.5 + 1.0 / 256) * 32767.0);
-    if (!(limit < FLT_MAX)) limit = FLT_MAX;
-    while (limit > 0 && !(quant_scale(limit) >= FLT_MIN && quant_error_bound(quant_scale(limit)) <= tolerance))
-        limit = quant_scale(limit) >= FLT_MIN ? nextafterf(limit, 0.0f) : 0.0f;
-    return limit;
-}
-
-/* Whether a block's positions fit int16 around a common offset (the middle of each component's
- * range, written to offset[]): every |value - offset| within 0.99 of the entry limit, so a scale
- * these spreads set keeps quant_error_bound a hundredth below the tolerance. The rounding of
- * value - offset (at most 2^-24 |value - offset| <= 2^-9 scale) is within that bound's own
- * allowance. Returns the largest |value - offset|, or -1 when they do not fit. */
-static float offset_fits(const float *positions, uint32_t count, float limit, float offset[3])
-{
-    float spread = 0;
-    for (int c = 0; c < 3; c++) {
-        float lo = INFINITY, hi = -INFINITY;
-        for (uint32_t k = 0; k < count; k++) {
-            const float v = positions[3u * k + (uint32_t)c];
-            lo = v < lo ? v : lo;
-            hi = v > hi ? v : hi;
-        }
-        offset[c] = lo + (hi - lo) * 0.5f;
-        const float d = fmaxf(fabsf(hi - offset[c]), fabsf(lo - offset[c]));
-        if (!(d <= 0.99f * limit)) return -1;
-        spread = d > spread ? d : spread;
-    }
-    return spread;
-}
-
-/* Per-entry precision of a target the tolerance does not fit whole: the blocks whose
- * positions exceed entry_limit_for(tolerance) are int16 around an offset where their spread
- * allows it (offset_fits), else float32; the scales come from the int16 blocks and the offset
- * blocks' spreads. A target without such a rest stays float32. */
-static void plan_entries(const mk_raw_target *t, target_plan *p)
-{
-    const float limit = entry_limit_for(p->tolerance);
-    float pm = 0, nm = 0, tm = 0;
-    int any_int16 = 0, any_outlier = 0;
-    for (uint32_t first = 0; first < t->count;) {
-        const uint32_t start = t->indices[first] / MK_BLOCK_SIZE * MK_BLOCK_SIZE;
-        const uint32_t end = block_end(t, first, start + MK_BLOCK_SIZE), count = end - first;
-        const size_t at = 3u * (size_t)first, n = 3u * (size_t)count;
-        const float bm = max_abs(t->positions + at, n);
-        first = end;
-        float offset[3], spread = bm;
-        if (bm > limit) {
-            any_outlier = 1;
-            spread = offset_fits(t->positions + at, count, limit, offset);
-        }
-        if (spread < 0) continue;   /* float32: its deltas set no scale */
-        any_int16 = 1;   /* int16, or int16 around an offset (its spread then sets the scale too) */
-        pm = spread > pm ? spread : pm;
-        if (t->normals) { float x = max_abs(t->normals + at, n); nm = x > nm ? x : nm; }
-        if (t->tangents) { float x = max_abs(t->tangents + at, n); tm = x > tm ? x : tm; }
-    }
-    if (!any_int16) return;
-    p->flags |= MK_TARGET_QUANTIZED;
-    p->entry_limit = any_outlier ? limit : INFINITY;  /* no block above it: the later passes need not look */
-    p->position_scale = quant_scale(pm);
-    if (t->normals) p->normal_scale = quant_scale(nm);
-    if (t->tangents) p->tangent_scale = quant_scale(tm);
-}
-
-/* Decides a target's storage: int16 with per-attribute scales when the positions' error stays
- * within the tolerance, else per entry (plan_entries); float32 when asked. */
-static void plan_target(const mk_raw_target *t, mk_precision precision, target_plan *p)
+/* A target's storage: packed at the mesh's steps (every entry whose values do not fit 16 bits
+ * around its offsets is float32), or float32 when asked or when a step is 0 (a tolerance too
+ * small for a normal float). */
+static void plan_target(const mk_raw_target *t, mk_precision precision, const float steps[3], target_plan *p)
 {
     p->flags = (t->normals ? MK_TARGET_HAS_NORMALS : 0u) | (t->tangents ? MK_TARGET_HAS_TANGENTS : 0u);
-    p->entry_limit = INFINITY;
-    if (precision == MK_PRECISION_FLOAT) return;
-    size_t n = 3 * (size_t)t->count;
-    float ps = quant_scale(max_abs(t->positions, n));
-    /* The error pass only where the bound cannot decide (the errors reported are measured
-     * while writing the data, in write_block). */
-    if (!(ps >= FLT_MIN && quant_error_bound(ps) <= p->tolerance) && ps != 0) {
-        double pe = quant_error(t->positions, n, ps);
-        if (pe > p->tolerance) { plan_entries(t, p); return; }
-    }
+    if (precision == MK_PRECISION_FLOAT || steps[0] == 0 || (t->normals || t->tangents ? steps[1] == 0 : 0)) return;
     p->flags |= MK_TARGET_QUANTIZED;
-    p->position_scale = ps;
-    if (t->normals) p->normal_scale = quant_scale(max_abs(t->normals, n));
-    if (t->tangents) p->tangent_scale = quant_scale(max_abs(t->tangents, n));
-}
-
-/* How a target's moved vertices [first, end) of one block are stored. */
-typedef enum entry_kind { ENTRY_INT16, ENTRY_FLOAT, ENTRY_OFFSET } entry_kind;
-
-static entry_kind entry_kind_of(const mk_raw_target *t, const target_plan *p, uint32_t first, uint32_t end,
-                                float offset[3])
-{
-    if (!(p->flags & MK_TARGET_QUANTIZED)) return ENTRY_FLOAT;
-    if (p->entry_limit == INFINITY) return ENTRY_INT16;
-    const float *positions = t->positions + 3u * (size_t)first;
-    if (max_abs(positions, 3u * (size_t)(end - first)) <= p->entry_limit) return ENTRY_INT16;
-    return offset_fits(positions, end - first, p->entry_limit, offset) >= 0 ? ENTRY_OFFSET : ENTRY_FLOAT;
+    p->position_scale = steps[0];
+    if (t->normals) p->normal_scale = steps[1];
+    if (t->tangents) p->tangent_scale = steps[1];
 }
 
 typedef struct plan_loop {
     const mk_raw_target **targets;
     target_plan *plans;
+    const float (*steps)[3];           /* per target: its mesh's position and normal steps */
     mk_precision precision;
 } plan_loop;
 
@@ -239,59 +124,218 @@ static void plan_item(void *user, uint32_t item, uint32_t worker)
 {
     plan_loop *l = user;
     (void)worker;
-    plan_target(l->targets[item], l->precision, &l->plans[item]);
+    plan_target(l->targets[item], l->precision, l->steps[item], &l->plans[item]);
 }
 
-/* Writes one entry's data for the vertices of `mask` in block `block`, in bit order: the
- * position triples, then the normal triples, then the tangent triples (`attr` bytes each),
- * int16 when `quantized`, else float32. A vertex the mask covers but the target does not move
- * keeps the zeros dst already holds (the blob is zeroed, and 0 quantizes to 0 without error).
- * cursor is the target's first index in the block; each vertex is looked up once for all
- * attributes. The largest int16 error per attribute is kept in error[] (every value is
- * written once, so this is the error over the whole target). */
-static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p, int quantized,
-                      const float *offset, uint32_t cursor, uint64_t mask, uint32_t block, size_t attr,
-                      double error[3])
+/* How a target's vertices of one block are stored (docs/format.md, "Blocks and entries"). */
+typedef enum entry_kind { ENTRY_PACKED, ENTRY_FLOAT, ENTRY_WIDE } entry_kind;
+
+/* One entry as the writer decides it: its mask, kind, and per component its width and offset
+ * (the smallest value), with every value of the block (zeros where the mask covers a vertex the
+ * target does not move) by mask bit. */
+typedef struct entry_pack {
+    entry_kind kind;
+    uint64_t mask;
+    uint32_t components;               /* the mesh's */
+    uint32_t width[MK_MAX_COMPONENTS];
+    int32_t offset[MK_MAX_COMPONENTS];
+    uint64_t given;                    /* the rows of q written: the target's vertices in the block */
+    int32_t q[MK_BLOCK_SIZE][MK_MAX_COMPONENTS];
+} entry_pack;
+
+/* Component k of the block's vertex i at the steps (0 for a vertex the target does not move). */
+static int32_t entry_value(const entry_pack *e, unsigned i, uint32_t k)
+{
+    return (e->given >> i) & 1u ? e->q[i][k] : 0;
+}
+
+/* Bits of the unsigned range r (0 for 0). */
+static uint32_t bits_of(uint64_t r)
+{
+    uint32_t w = 0;
+    while (r) { w++; r >>= 1; }
+    return w;
+}
+
+/* Decides the entry of a target's vertices [first, end) in the block starting at vertex
+ * `start` (in_block vertices): packed, its vertices those with a nonzero value at the steps
+ * (and the gaps mk_block_mask fills); WIDE when a position offset leaves int16; float32 when a
+ * component spans more than 16 bits or leaves the WIDE range, or the target is float. Returns
+ * 0 when no vertex keeps a nonzero value (the block gets no entry). */
+static int pack_entry(const mk_raw_target *t, const target_plan *p, uint32_t mesh_flags, uint32_t first, uint32_t end,
+                      uint32_t start, uint32_t in_block, uint32_t gap, entry_pack *e)
 {
     const float *src[3] = { t->positions, t->normals, t->tangents };
-    const float scale[3] = { p->position_scale, p->normal_scale, p->tangent_scale };
-    uint8_t *out[3] = { dst, dst + attr, dst + (t->normals ? 2 * attr : attr) };
-    /* Per attribute, what its values are stored relative to: an offset entry's positions to its
-     * offset, everything else to zero. */
-    static const float zero[3] = { 0, 0, 0 };
-    const float *base[3] = { offset ? offset : zero, zero, zero };
-    uint32_t k = cursor;
-    size_t j = 0;
-    for (uint64_t bits = mask; bits; bits &= bits - 1, j++) {
-        uint32_t v = block * MK_BLOCK_SIZE + mk_ctz64(bits);
-        while (k < t->count && t->indices[k] < v) k++;
-        if (k == t->count || t->indices[k] != v) continue;
-        for (int a = 0; a < 3; a++) {
+    const float steps[3] = { p->position_scale, p->normal_scale, p->tangent_scale };
+    e->components = mk_mesh_components(mesh_flags);
+    uint64_t given = 0;
+    for (uint32_t k = first; k < end; k++) given |= 1ull << (t->indices[k] - start);
+    if (!(p->flags & MK_TARGET_QUANTIZED)) {
+        e->kind = ENTRY_FLOAT;
+        e->mask = mk_block_mask(given, in_block, gap);
+        return 1;
+    }
+    /* Rows of q are written for the given vertices only (every component: zero where the target
+     * lacks the attribute); the others read as zero below. */
+    double inverse[3] = { 0, 0, 0 };
+    uint32_t first_component[3] = { 0, 0, 0 };
+    for (uint32_t a = 0; a < 3; a++)
+        if (src[a]) {
+            inverse[a] = 1.0 / (double)steps[a];
+            first_component[a] = mk_attribute_component(mesh_flags, a);
+        }
+    int64_t largest = 0;
+    uint64_t moved = 0;
+    for (uint32_t k = first; k < end; k++) {
+        const unsigned i = t->indices[k] - start;
+        int nonzero = 0;
+        memset(e->q[i], 0, sizeof e->q[i]);
+        for (uint32_t a = 0; a < 3; a++) {
             if (!src[a]) continue;
-            const float *value = &src[a][3u * k];
-            if (quantized) {
-                const float *o = base[a];
-                int16_t q[3] = { quantize(value[0] - o[0], scale[a]), quantize(value[1] - o[1], scale[a]),
-                                 quantize(value[2] - o[2], scale[a]) };
-                memcpy(out[a] + 6 * j, q, 6);
-                for (int c = 0; c < 3; c++) {
-                    double e = quant_error_of(value[c], o[c], q[c], scale[a]);
-                    error[a] = e > error[a] ? e : error[a];
-                }
-            } else {
-                memcpy(out[a] + 12 * j, value, 12);
+            const uint32_t k0 = first_component[a];
+            for (uint32_t c = 0; c < 3; c++) {
+                const int64_t q = quantize(src[a][3u * (size_t)k + c], inverse[a]);
+                const int64_t mag = q < 0 ? -q : q;
+                largest = mag > largest ? mag : largest;
+                e->q[i][k0 + c] = (int32_t)(q > MK_WIDE_OFFSET_MAX ? MK_WIDE_OFFSET_MAX : q < -MK_WIDE_OFFSET_MAX ? -MK_WIDE_OFFSET_MAX : q);
+                nonzero |= q != 0;
             }
         }
+        if (nonzero) moved |= 1ull << i;
+    }
+    if (!moved) return 0;
+    e->kind = ENTRY_PACKED;
+    if (largest > MK_WIDE_OFFSET_MAX) {
+        e->kind = ENTRY_FLOAT;
+        e->mask = mk_block_mask(given, in_block, gap);
+        return 1;
+    }
+    e->mask = mk_block_mask(moved, in_block, gap);
+    e->given = given;
+    for (uint32_t k = 0; k < e->components; k++) {
+        int32_t lo = INT32_MAX, hi = INT32_MIN;
+        for (uint64_t bits = e->mask; bits; bits &= bits - 1) {
+            const int32_t v = entry_value(e, mk_ctz64(bits), k);
+            lo = v < lo ? v : lo;
+            hi = v > hi ? v : hi;
+        }
+        uint32_t w = bits_of((uint64_t)((int64_t)hi - lo));
+        if (w == MK_WIDTH_CODE_16) w = 16;   /* code 15 means 16 bits: 15-bit ranges take 16 */
+        if (w > MK_MAX_WIDTH || (k >= 3 && (lo < INT16_MIN || lo > INT16_MAX))) {
+            e->kind = ENTRY_FLOAT;   /* the exact deltas of the given vertices */
+            e->mask = mk_block_mask(given, in_block, gap);
+            return 1;
+        }
+        if (k < 3 && (lo < INT16_MIN || lo > INT16_MAX)) e->kind = ENTRY_WIDE;
+        e->width[k] = w;
+        e->offset[k] = lo;
+    }
+    return 1;
+}
+
+/* Bytes of an entry's data (before its padding to 4): float32 triples of the target's
+ * attributes, or the WIDE offsets and each component's packed values. */
+static uint64_t pack_bytes(const entry_pack *e, uint32_t target_flags)
+{
+    const uint32_t m = mk_popcount64(e->mask);
+    if (e->kind == ENTRY_FLOAT)
+        return 12u * (uint64_t)m * (1u + ((target_flags & MK_TARGET_HAS_NORMALS) ? 1u : 0u)
+                                       + ((target_flags & MK_TARGET_HAS_TANGENTS) ? 1u : 0u));
+    uint64_t n = e->kind == ENTRY_WIDE ? MK_ENTRY_WIDE_BYTES : 0u;
+    for (uint32_t k = 0; k < e->components; k++) n += mk_packed_bytes(m, e->width[k]);
+    return n;
+}
+
+static size_t pad4(size_t n) { return (n + 3u) & ~(size_t)3u; }
+
+/* ORs u (below 2^w, w <= 16) into the zeroed bytes at bit `bit` of dst: only the bytes its bits
+ * reach, so a neighbour's bytes (another thread's target) are never rewritten. */
+static void put_bits(uint8_t *dst, uint64_t bit, uint32_t w, uint32_t u)
+{
+    uint8_t *p = dst + (bit >> 3);
+    const uint32_t v = u << (bit & 7u), bytes = ((uint32_t)(bit & 7u) + w + 7u) >> 3;
+    for (uint32_t b = 0; b < bytes; b++) p[b] |= (uint8_t)(v >> (8u * b));
+}
+
+/* Writes an entry's data at dst (zeroed): float32 triples of the vertices the mask covers (zeros
+ * for those the target does not move), or the packed values. cursor is the target's first
+ * index in the block, start the block's first vertex. The largest error per attribute of the
+ * target's vertices in the block, dropped ones included, goes into error[]. */
+static void put_entry(uint8_t *dst, const mk_raw_target *t, const target_plan *p, uint32_t mesh_flags,
+                      const entry_pack *e, uint32_t cursor, uint32_t end, uint32_t start, double error[3])
+{
+    const float *src[3] = { t->positions, t->normals, t->tangents };
+    const uint32_t m = mk_popcount64(e->mask);
+    if (e->kind == ENTRY_FLOAT) {
+        uint8_t *out[3] = { dst, dst + 12u * (size_t)m, dst + 12u * (size_t)m * (t->normals ? 2u : 1u) };
+        uint32_t k = cursor;
+        size_t j = 0;
+        for (uint64_t bits = e->mask; bits; bits &= bits - 1, j++) {
+            const uint32_t v = start + mk_ctz64(bits);
+            while (k < end && t->indices[k] < v) k++;
+            if (k == end || t->indices[k] != v) continue;
+            for (int a = 0; a < 3; a++)
+                if (src[a]) memcpy(out[a] + 12 * j, &src[a][3u * (size_t)k], 12);
+        }
+        return;
+    }
+    const float steps[3] = { p->position_scale, p->normal_scale, p->tangent_scale };
+    for (uint32_t k = cursor; k < end; k++) {
+        const unsigned i = t->indices[k] - start;
+        for (uint32_t a = 0; a < 3; a++) {
+            if (!src[a]) continue;
+            const uint32_t k0 = mk_attribute_component(mesh_flags, a);
+            for (uint32_t c = 0; c < 3; c++) {
+                const double d = fabs((double)e->q[i][k0 + c] * steps[a] - (double)src[a][3u * (size_t)k + c]);
+                error[a] = d > error[a] ? d : error[a];
+            }
+        }
+    }
+    if (e->kind == ENTRY_WIDE) {
+        for (uint32_t c = 0; c < 3; c++) {
+            const uint32_t u = (uint32_t)e->offset[c];
+            const uint8_t le[4] = { (uint8_t)u, (uint8_t)(u >> 8), (uint8_t)(u >> 16), (uint8_t)(u >> 24) };
+            memcpy(dst + 4u * c, le, 4);
+        }
+        dst += MK_ENTRY_WIDE_BYTES;
+    }
+    for (uint32_t k = 0; k < e->components; k++) {
+        const uint32_t w = e->width[k];
+        if (w) {
+            uint64_t bit = 0;
+            for (uint64_t bits = e->mask; bits; bits &= bits - 1, bit += w)
+                put_bits(dst, bit, w, (uint32_t)(entry_value(e, mk_ctz64(bits), k) - e->offset[k]));
+        }
+        dst += mk_packed_bytes(m, w);
+    }
+}
+
+/* The entry's head (mk_entry_stride bytes, zeroed): target and flags, data offset (4-byte
+ * units), mask, width codes, int16 offsets (a WIDE entry's position offsets are in its data). */
+static void put_head(uint8_t *head, const entry_pack *e, uint32_t target, uint64_t data)
+{
+    const uint32_t flags = e->kind == ENTRY_FLOAT ? (uint32_t)MK_ENTRY_FLOAT : e->kind == ENTRY_WIDE ? (uint32_t)MK_ENTRY_WIDE : 0u;
+    mk_blob_entry be = { target | flags, (uint32_t)(data / MK_DATA_UNIT), e->mask };
+    memcpy(head, &be, sizeof be);
+    if (e->kind == ENTRY_FLOAT) return;
+    uint8_t *codes = head + MK_ENTRY_HEAD;
+    uint8_t *offsets = codes + mk_entry_code_bytes(e->components);
+    for (uint32_t k = 0; k < e->components; k++) {
+        codes[k >> 1] |= (uint8_t)(mk_code_of_width(e->width[k]) << (4u * (k & 1u)));
+        const int32_t o = e->kind == ENTRY_WIDE && k < 3 ? 0 : e->offset[k];
+        offsets[2u * k] = (uint8_t)((uint32_t)o & 0xFFu);
+        offsets[2u * k + 1u] = (uint8_t)(((uint32_t)o >> 8) & 0xFFu);
     }
 }
 
 /* One target's share of a mesh's block data. */
 typedef struct target_layout {
     const mk_raw_target *t;
-    uint64_t entry_count, data_size;   /* counted first: blocks touched, bytes (entries 16-aligned) */
+    uint64_t entry_count, data_size;   /* counted first: blocks with an entry, bytes (entries 4-aligned) */
     uint64_t first_entry, base;        /* then placed: its first entry, its data's offset */
     uint64_t cursor;                   /* the entry merge's position */
     double error[3];                   /* written: largest quantization error per attribute */
+    uint64_t float_entries, wide_entries;
     mk_raw_target *own;                /* consumed (mk_write_blob_consuming): emptied once written */
 } target_layout;
 
@@ -299,10 +343,10 @@ typedef struct layout_loop {
     const mk_raw_mesh *m;
     const target_plan *plans;
     uint32_t gap;                      /* mk_block_mask's */
+    uint32_t mesh_flags, stride;       /* the mesh's MK_MESH_* and entry size */
     target_layout *targets;
     uint32_t *entry_block;             /* per entry, target-major */
-    uint8_t *entry_kind;               /* per entry: its entry_kind */
-    uint64_t *entry_mask, *entry_data; /* the entry's vertices; its data's offset in the target data */
+    uint8_t *entry_head;               /* per entry, target-major: its head, stride bytes */
     uint8_t *data;                     /* the mesh's target data, in the blob */
     mk_arena *owner;                   /* consuming: the raw arena the written targets go back to */
     mtx_t *owner_lock;
@@ -310,36 +354,32 @@ typedef struct layout_loop {
     const uint8_t *blob;               /* where data lies in it: its ready offsets count from here */
 } layout_loop;
 
-/* Calls fn(user, block, first, end, mask, kind, offset) for each block a target touches, in
- * block order: the target's moved vertices in it are indices [first, end); kind and offset are
- * entry_kind_of's; the mask is mk_block_mask's, or exactly the moved vertices for an offset entry
- * (a covered vertex the target does not move would read as the offset). */
-typedef void (*block_fn)(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask, entry_kind kind,
-                         const float offset[3]);
+/* Calls fn(user, block, first, end, entry) for each block a target touches that gets an entry,
+ * in block order: the target's vertices in it are indices [first, end); the entry is
+ * pack_entry's. error (or NULL) receives, per attribute, the largest error of the target's
+ * blocks that get no entry. */
+typedef void (*block_fn)(void *user, uint32_t block, uint32_t first, uint32_t end, const entry_pack *e);
 
 static void target_blocks(const layout_loop *l, const mk_raw_target *tg, const target_plan *plan, block_fn fn,
-                          void *user)
+                          void *user, double error[3])
 {
     const uint32_t vertex_count = l->m->vertex_count;
+    const float *src[3] = { tg->positions, tg->normals, tg->tangents };
+    entry_pack e;
     for (uint32_t first = 0; first < tg->count;) {
         uint32_t block = tg->indices[first] / MK_BLOCK_SIZE, start = block * MK_BLOCK_SIZE;
         uint32_t in_block = vertex_count - start < MK_BLOCK_SIZE ? vertex_count - start : MK_BLOCK_SIZE;
         uint32_t end = block_end(tg, first, start + in_block);
-        uint64_t moved = 0;
-        for (uint32_t k = first; k < end; k++) moved |= 1ull << (tg->indices[k] - start);
-        float offset[3] = { 0, 0, 0 };
-        const entry_kind kind = entry_kind_of(tg, plan, first, end, offset);
-        const uint64_t mask = kind == ENTRY_OFFSET ? moved : mk_block_mask(moved, in_block, l->gap);
-        fn(user, block, first, end, mask, kind, offset);
+        if (pack_entry(tg, plan, l->mesh_flags, first, end, start, in_block, l->gap, &e)) fn(user, block, first, end, &e);
+        else if (error) {
+            /* No entry: every value rounded to 0 steps, so each one's error is its magnitude
+             * (put_entry never sees this block, and the report must still cover it). */
+            for (uint32_t a = 0; a < 3; a++)
+                for (size_t i = 3u * (size_t)first; src[a] && i < 3u * (size_t)end; i++)
+                    error[a] = fabs((double)src[a][i]) > error[a] ? fabs((double)src[a][i]) : error[a];
+        }
         first = end;
     }
-}
-
-/* Bytes of an entry's data: the offset, then the attributes. */
-static uint64_t entry_bytes(const target_plan *p, entry_kind kind, uint64_t mask)
-{
-    return (kind == ENTRY_OFFSET ? MK_ENTRY_OFFSET_BYTES : 0u) +
-           mk_entry_data_size(mk_entry_flags(p->flags, kind != ENTRY_FLOAT), mk_popcount64(mask));
 }
 
 typedef struct layout_item {
@@ -348,16 +388,13 @@ typedef struct layout_item {
     uint32_t index;
 } layout_item;
 
-static void count_block(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask, entry_kind kind,
-                        const float offset[3])
+static void count_block(void *user, uint32_t block, uint32_t first, uint32_t end, const entry_pack *e)
 {
     layout_item *it = user;
     (void)block;
     (void)first;
     (void)end;
-    (void)offset;
-    uint64_t size = entry_bytes(&it->l->plans[it->index], kind, mask);
-    it->tl->data_size = pad16((size_t)it->tl->data_size) + size;
+    it->tl->data_size = pad4((size_t)it->tl->data_size) + pack_bytes(e, it->l->plans[it->index].flags);
     it->tl->entry_count++;
 }
 
@@ -366,33 +403,23 @@ static void layout_count(void *user, uint32_t item, uint32_t worker)
     layout_loop *l = user;
     (void)worker;
     layout_item it = { l, &l->targets[item], item };
-    target_blocks(l, it.tl->t, &l->plans[item], count_block, &it);
+    target_blocks(l, it.tl->t, &l->plans[item], count_block, &it, NULL);
 }
 
-static void write_block(void *user, uint32_t block, uint32_t first, uint32_t end, uint64_t mask, entry_kind kind,
-                        const float offset[3])
+static void write_block(void *user, uint32_t block, uint32_t first, uint32_t end, const entry_pack *e)
 {
     layout_item *it = user;
     const layout_loop *l = it->l;
     target_layout *tl = it->tl;
-    const mk_raw_target *tg = tl->t;
     const target_plan *p = &l->plans[it->index];
-    (void)end;
-    uint64_t e = tl->cursor++;
-    uint64_t at = pad16((size_t)tl->data_size);
-    tl->data_size = at + entry_bytes(p, kind, mask);
-    l->entry_block[e] = block;
-    l->entry_kind[e] = (uint8_t)kind;
-    l->entry_mask[e] = mask;
-    l->entry_data[e] = tl->base + at;
-    uint8_t *dst = l->data + tl->base + at;
-    if (kind == ENTRY_OFFSET) {   /* x, y, z, then the 4 zero bytes the blob already holds */
-        memcpy(dst, offset, 3 * sizeof(float));
-        dst += MK_ENTRY_OFFSET_BYTES;
-    }
-    const size_t attr = (size_t)mk_entry_data_size(mk_entry_flags(0u, kind != ENTRY_FLOAT), mk_popcount64(mask));
-    put_entry(dst, tg, p, kind != ENTRY_FLOAT, kind == ENTRY_OFFSET ? offset : NULL, first, mask, block, attr,
-              tl->error);
+    uint64_t n = tl->cursor++;
+    uint64_t at = pad4((size_t)tl->data_size);
+    tl->data_size = at + pack_bytes(e, p->flags);
+    tl->float_entries += e->kind == ENTRY_FLOAT && (p->flags & MK_TARGET_QUANTIZED);
+    tl->wide_entries += e->kind == ENTRY_WIDE;
+    l->entry_block[n] = block;
+    put_head(l->entry_head + n * l->stride, e, it->index, tl->base + at);
+    put_entry(l->data + tl->base + at, tl->t, p, l->mesh_flags, e, first, end, block * MK_BLOCK_SIZE, tl->error);
 }
 
 static void layout_write(void *user, uint32_t item, uint32_t worker)
@@ -402,10 +429,10 @@ static void layout_write(void *user, uint32_t item, uint32_t worker)
     layout_item it = { l, &l->targets[item], item };
     it.tl->cursor = it.tl->first_entry;
     it.tl->data_size = 0;
-    target_blocks(l, it.tl->t, &l->plans[item], write_block, &it);
+    target_blocks(l, it.tl->t, &l->plans[item], write_block, &it, it.tl->error);
     if (l->options->ready && it.tl->data_size)
         l->options->ready(l->options->ready_user, l->blob, (uint64_t)(l->data - l->blob) + it.tl->base,
-                          pad16((size_t)it.tl->data_size));
+                          pad4((size_t)it.tl->data_size));
     mk_raw_target *own = it.tl->own;
     if (!own) return;
     void *arrays[] = { own->indices, own->positions, own->normals, own->tangents };
@@ -456,7 +483,9 @@ static mk_result plan_mesh_data(const mk_raw_asset *raw, mk_raw_asset *consume, 
     layout_loop *l = &out->l;
     if (target_count > MK_MAX_MESH_TARGETS)
         return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: more than 2^24 targets", mi);
-    *l = (layout_loop){ .m = m, .plans = plans, .gap = gap, .owner = consume ? &consume->arena : NULL };
+    const uint32_t mesh_flags = (m->normals ? MK_MESH_HAS_NORMALS : 0u) | (m->tangents ? MK_MESH_HAS_TANGENTS : 0u);
+    *l = (layout_loop){ .m = m, .plans = plans, .gap = gap, .mesh_flags = mesh_flags, .stride = mk_entry_stride(mesh_flags),
+                        .owner = consume ? &consume->arena : NULL };
     l->targets = mk_arena_array(arena, target_count + 1, sizeof *l->targets);
     if (!l->targets) return mk_error_oom(err, "planning blocks");
     uint32_t k = 0;
@@ -471,16 +500,17 @@ static mk_result plan_mesh_data(const mk_raw_asset *raw, mk_raw_asset *consume, 
         l->targets[t].first_entry = entry_count;
         l->targets[t].base = total;
         entry_count += l->targets[t].entry_count;
-        total += pad16(l->targets[t].data_size);
+        total += pad4(l->targets[t].data_size);
     }
     if (entry_count > UINT32_MAX)
         return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: more than 2^32 block entries", mi);
-    if (total / MK_ALIGN > UINT32_MAX)
-        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: target data exceeds 64 GiB", mi);
+    if (total / MK_DATA_UNIT > UINT32_MAX)
+        return mk_error_set(err, MK_ERROR_LIMIT, UINT64_MAX, "mesh %u: target data exceeds 16 GiB", mi);
+    total += MK_TARGET_DATA_TAIL;   /* zeros a decoder may load past an entry's last byte */
     out->target_count = target_count;
     out->blocks = (m->vertex_count + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
     out->block_entries = place(cursor, 4u * ((uint64_t)out->blocks + 1));
-    out->entries = place(cursor, entry_count * sizeof(mk_blob_entry));
+    out->entries = place(cursor, entry_count * l->stride);
     out->entry_count = entry_count;
     out->target_data = place(cursor, total);
     out->target_data_size = total;
@@ -505,14 +535,12 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, const mk_write_options *o
     layout_loop *l = &out->l;
     const uint32_t target_count = out->target_count, blocks = out->blocks;
     const uint64_t entry_count = out->entry_count;
-    /* Per target entry (target-major): its block, mask and data offset. */
+    /* Per target entry (target-major): its block and head. */
     uint32_t *block_first = (uint32_t *)(void *)(data + out->block_entries);
     l->entry_block = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_block);
-    l->entry_mask = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_mask);
-    l->entry_data = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_data);
-    l->entry_kind = mk_arena_array(arena, entry_count + 1, sizeof *l->entry_kind);
-    if (!l->entry_block || !l->entry_mask || !l->entry_data || !l->entry_kind)
-        return mk_error_oom(err, "planning blocks");
+    l->entry_head = mk_arena_array(arena, entry_count + 1, l->stride);
+    if (!l->entry_block || !l->entry_head) return mk_error_oom(err, "planning blocks");
+    memset(l->entry_head, 0, (size_t)(entry_count + 1) * l->stride);
     l->data = data + out->target_data;
     l->options = options;
     l->blob = blob;
@@ -524,7 +552,7 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, const mk_write_options *o
     mk_parallel_for(target_count, threads, layout_write, l);
     if (l->owner) mtx_destroy(&lock);
     /* Entries block-major, targets in blob order within a block. */
-    mk_blob_entry *entries = (mk_blob_entry *)(void *)(data + out->entries);
+    uint8_t *entries = data + out->entries;
     uint64_t e = 0;
     for (uint32_t t = 0; t < target_count; t++) l->targets[t].cursor = l->targets[t].first_entry;
     for (uint32_t b = 0; b < blocks; b++) {
@@ -532,26 +560,22 @@ static mk_result write_mesh_data(const mk_raw_mesh *m, const mk_write_options *o
         for (uint32_t t = 0; t < target_count; t++) {
             target_layout *tl = &l->targets[t];
             if (tl->cursor == tl->first_entry + tl->entry_count || l->entry_block[tl->cursor] != b) continue;
-            const entry_kind kind = (entry_kind)l->entry_kind[tl->cursor];
-            const uint32_t flags = kind == ENTRY_FLOAT ? (uint32_t)MK_ENTRY_FLOAT
-                                 : kind == ENTRY_OFFSET ? (uint32_t)MK_ENTRY_OFFSET : 0u;
-            mk_blob_entry be = { t | flags, (uint32_t)(l->entry_data[tl->cursor] / MK_ALIGN), l->entry_mask[tl->cursor] };
-            report->float_entries += kind == ENTRY_FLOAT && (l->plans[t].flags & MK_TARGET_QUANTIZED);
-            report->offset_entries += kind == ENTRY_OFFSET;
-            entries[e++] = be;
+            memcpy(entries + e++ * l->stride, l->entry_head + tl->cursor * l->stride, l->stride);
             tl->cursor++;
         }
     }
     block_first[blocks] = (uint32_t)e;
-    report->target_bytes += entry_count * sizeof(mk_blob_entry) + out->target_data_size;
+    report->target_bytes += entry_count * l->stride + out->target_data_size;
     report->entry_count += entry_count;
     for (uint32_t t = 0; t < target_count; t++) {
         const double *te = l->targets[t].error;
         if (te[0] > report->max_position_error) report->max_position_error = te[0];
         if (te[1] > report->max_normal_error) report->max_normal_error = te[1];
         if (te[2] > report->max_tangent_error) report->max_tangent_error = te[2];
+        report->float_entries += l->targets[t].float_entries;
+        report->wide_entries += l->targets[t].wide_entries;
     }
-    void *scratch[] = { l->targets, l->entry_block, l->entry_mask, l->entry_data, l->entry_kind };
+    void *scratch[] = { l->targets, l->entry_block, l->entry_head };
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) mk_arena_release(arena, scratch[i]);
     l->targets = NULL;
     return MK_OK;
@@ -585,6 +609,8 @@ static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, cons
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "write: unknown precision");
     if (!(opt.tolerance >= 0) || !isfinite(opt.tolerance))
         return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "write: tolerance must be finite and >= 0");
+    if (!(opt.normal_tolerance >= 0) || !isfinite(opt.normal_tolerance))
+        return mk_error_set(err, MK_ERROR_INVALID_ARGUMENT, UINT64_MAX, "write: normal tolerance must be finite and >= 0");
     mk_result r = mk_raw_validate(raw, err);
     if (r) return r;
 
@@ -614,19 +640,25 @@ static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, cons
     /* Per-target precision under each mesh's tolerance, decided on worker threads. */
     const mk_raw_target **all_targets = mk_arena_array(arena, target_count + 1, sizeof *all_targets);
     if (!all_targets) return mk_error_oom(err, "writing the blob tables");
+    float (*steps)[3] = mk_arena_array(arena, target_count + 1, sizeof *steps);
+    if (!steps) return mk_error_oom(err, "writing the blob tables");
+    const float normal_step = step_for(opt.normal_tolerance > 0 ? opt.normal_tolerance : MK_DEFAULT_NORMAL_TOLERANCE);
     for (uint32_t mi = 0, c = 0, k = 0; mi < raw->mesh_count; mi++) {
         double tolerance = opt.tolerance > 0 ? opt.tolerance : 1e-4 * mk_raw_mesh_diagonal(&raw->meshes[mi]);
         if (tolerance > report.tolerance_used) report.tolerance_used = tolerance;
+        const float position_step = step_for(tolerance);
         for (; c < raw->channel_count && raw->channels[c].mesh == mi; c++)
             for (uint32_t j = 0; j < raw->channels[c].target_count; j++, k++) {
                 all_targets[k] = &raw->channels[c].targets[j];
                 memset(&plans[k], 0, sizeof plans[k]);
-                plans[k].tolerance = tolerance;
+                steps[k][0] = position_step;
+                steps[k][1] = steps[k][2] = normal_step;
             }
     }
-    plan_loop pl = { all_targets, plans, opt.precision };
+    plan_loop pl = { all_targets, plans, (const float (*)[3])steps, opt.precision };
     mk_parallel_for(target_count, opt.threads, plan_item, &pl);
     mk_arena_release(arena, all_targets);
+    mk_arena_release(arena, steps);
     for (uint32_t k = 0; k < target_count; k++) {
         if (!(plans[k].flags & MK_TARGET_QUANTIZED)) { report.float_targets++; continue; }
         report.quantized_targets++;

@@ -5,13 +5,14 @@
  * of the mesh one scalar coefficient from the channel weights, sequential stacking included.
  *
  * Per block of 64 vertices: an accumulator per attribute (float xyz triples interleaved like
- * the base arrays, the outputs and the stored deltas, 768 bytes each, in L1) starts as a copy
- * of the base and receives every active target's entry for the block (entries of a block are
- * stored together, so a vertex range finds its data without a search); then each output vertex
- * is written once. Because everything is interleaved the same way, a dense entry is one
- * vectorized loop over 192 values, a sparse entry one short loop per run of moved vertices,
- * and the base and output copies are memcpy. Inactive targets cost one 16-byte entry header
- * per touched block.
+ * the base arrays and the outputs, 768 bytes each, in L1) starts as a copy of the base and
+ * receives every active target's entry for the block (entries of a block are stored together,
+ * so a vertex range finds its data without a search); then each output vertex is written once.
+ * A packed entry (docs/format.md) stores each component's values apart, in as few bits as its
+ * range needs: they are unpacked eight at a time (AVX2 where the CPU has it: a byte shuffle and
+ * a shift per lane; else a portable loop giving the same floats), interleaved, and added: a
+ * whole block as one pass of 192 values, a partial one run by run of consecutive mask bits,
+ * like the float32 entries. Inactive targets cost one entry header per touched block.
  */
 #include <math.h>
 #include <string.h>
@@ -20,6 +21,14 @@
 #define MK_HAVE_STREAMING 1
 #else
 #define MK_HAVE_STREAMING 0
+#endif
+/* The AVX2 unpacking of packed values, picked per call by the CPU (GCC and clang on x86-64);
+ * MK_NO_TARGET_CLONES builds the portable loop alone. Both give the same floats. */
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(MK_NO_TARGET_CLONES)
+#include <immintrin.h>
+#define MK_HAVE_AVX2_UNPACK 1
+#else
+#define MK_HAVE_AVX2_UNPACK 0
 #endif
 #include "format.h"
 #include "morphkit.h"
@@ -121,48 +130,193 @@ MK_INLINE void prefetch_ahead(const uint8_t *p, size_t bytes)
 typedef float block_acc[3 * MK_BLOCK_SIZE];
 
 /* acc[k] += factor * src[k] for k < n. */
-MK_INLINE void add_span_q16(float *restrict acc, const int16_t *restrict src, uint32_t n, float factor)
-{
-    for (uint32_t k = 0; k < n; k++) acc[k] += factor * (float)src[k];
-}
-
 MK_INLINE void add_span_f32(float *restrict acc, const float *restrict src, uint32_t n, float factor)
 {
     for (uint32_t k = 0; k < n; k++) acc[k] += factor * src[k];
 }
 
-/* Adds factor * offset (one xyz triple) to every vertex of the mask: the common part of an
- * MK_ENTRY_OFFSET entry's position deltas. */
-MK_INLINE void add_offset(float *restrict acc, uint64_t mask, const float *restrict offset, float factor)
-{
-    const float o[3] = { factor * offset[0], factor * offset[1], factor * offset[2] };
-    for (; mask; mask &= mask - 1) {
-        float *v = acc + 3 * mk_ctz64(mask);
-        v[0] += o[0];
-        v[1] += o[1];
-        v[2] += o[2];
-    }
-}
-
-/* Adds one attribute of an entry: xyz triples of the mask's vertices in bit order. A run of
- * consecutive mask bits is one contiguous span of both the data and the accumulator, so a
+/* Adds one attribute of a float entry: xyz triples of the mask's vertices in bit order. A run
+ * of consecutive mask bits is one contiguous span of both the data and the accumulator, so a
  * dense block is a single loop of 192 values and a sparse one a short loop per run. */
-MK_INLINE void add_attribute(float *restrict acc, uint64_t mask, const uint8_t *data, int quantized, float factor)
+MK_INLINE void add_float_attribute(float *restrict acc, uint64_t mask, const uint8_t *data, float factor)
 {
-    /* Converted only on the branch that reads them: quantized normal deltas after an odd
-     * number of position triples are 2-byte aligned, never read as float. */
+    const float *src = (const float *)(const void *)data;
     if (mask == ~(uint64_t)0) {     /* constant trip count: no loop epilogue */
-        if (quantized) add_span_q16(acc, (const int16_t *)(const void *)data, 3 * MK_BLOCK_SIZE, factor);
-        else add_span_f32(acc, (const float *)(const void *)data, 3 * MK_BLOCK_SIZE, factor);
+        add_span_f32(acc, src, 3 * MK_BLOCK_SIZE, factor);
         return;
     }
     for (uint32_t j = 0; mask; mask &= mask + (mask & (0 - mask))) {   /* clears the lowest run */
         const unsigned lo = mk_ctz64(mask);
         const uint32_t len = mk_ctz64(~(mask >> lo));   /* mask != ~0, so ~(mask >> lo) != 0 */
-        if (quantized) add_span_q16(acc + 3 * lo, (const int16_t *)(const void *)data + 3 * j, 3 * len, factor);
-        else add_span_f32(acc + 3 * lo, (const float *)(const void *)data + 3 * j, 3 * len, factor);
+        add_span_f32(acc + 3 * lo, src + 3 * j, 3 * len, factor);
         j += len;
     }
+}
+
+/* One packed component's m values as floats, offset + u by rank (docs/format.md). offset + u
+ * is an integer below 2^24, so its conversion is exact whichever way it is computed. */
+MK_INLINE void unpack_portable(float *restrict out, const uint8_t *restrict p, uint32_t m, uint32_t w, int32_t offset)
+{
+    const uint32_t low = (1u << w) - 1u;
+    for (uint32_t j = 0; j < m; j++) {
+        const uint32_t bit = j * w;
+        out[j] = (float)(offset + (int32_t)((mk_load_u32le(p + (bit >> 3)) >> (bit & 7u)) & low));
+    }
+}
+
+/* A packed entry's components: where each one's values start, its width and offset. */
+typedef struct packed_entry {
+    uint32_t m;
+    const uint8_t *at[MK_MAX_COMPONENTS];
+    uint32_t width[MK_MAX_COMPONENTS];
+    int32_t offset[MK_MAX_COMPONENTS];
+} packed_entry;
+
+#if MK_HAVE_AVX2_UNPACK
+/* Eight values of width w lie in w bytes from byte 8 w g on: per width, the byte shuffle that
+ * gives each 32-bit lane l the four bytes from its value's first byte (l w / 8; past the 16
+ * loaded bytes only where no bit of the value lies there), and the lane's bit shift. */
+#define MK_UB(w, l, i) ((((l) * (w)) >> 3) + (i) > 15 ? 0x80 : (((l) * (w)) >> 3) + (i))
+#define MK_ULANE(w, l) MK_UB(w, l, 0), MK_UB(w, l, 1), MK_UB(w, l, 2), MK_UB(w, l, 3)
+#define MK_UROW(w) { MK_ULANE(w, 0), MK_ULANE(w, 1), MK_ULANE(w, 2), MK_ULANE(w, 3), \
+                     MK_ULANE(w, 4), MK_ULANE(w, 5), MK_ULANE(w, 6), MK_ULANE(w, 7) }
+#define MK_USHIFT(w) { 0, ((w) * 1) & 7, ((w) * 2) & 7, ((w) * 3) & 7, ((w) * 4) & 7, ((w) * 5) & 7, \
+                       ((w) * 6) & 7, ((w) * 7) & 7 }
+static const uint8_t unpack_shuffle[MK_MAX_WIDTH + 1][32] __attribute__((aligned(32))) = {
+    MK_UROW(0), MK_UROW(1), MK_UROW(2), MK_UROW(3), MK_UROW(4), MK_UROW(5), MK_UROW(6), MK_UROW(7), MK_UROW(8),
+    MK_UROW(9), MK_UROW(10), MK_UROW(11), MK_UROW(12), MK_UROW(13), MK_UROW(14), MK_UROW(15), MK_UROW(16)
+};
+static const uint32_t unpack_shift[MK_MAX_WIDTH + 1][8] __attribute__((aligned(32))) = {
+    MK_USHIFT(0), MK_USHIFT(1), MK_USHIFT(2), MK_USHIFT(3), MK_USHIFT(4), MK_USHIFT(5), MK_USHIFT(6), MK_USHIFT(7),
+    MK_USHIFT(8), MK_USHIFT(9), MK_USHIFT(10), MK_USHIFT(11), MK_USHIFT(12), MK_USHIFT(13), MK_USHIFT(14),
+    MK_USHIFT(15), MK_USHIFT(16)
+};
+
+/* Eight values (group g) of a packed component as floats. */
+__attribute__((target("avx2"))) static inline __m256 unpack8_avx2(const packed_entry *pe, uint32_t k, uint32_t g)
+{
+    const uint32_t w = pe->width[k];
+    const __m256i shuffle = _mm256_load_si256((const __m256i *)(const void *)unpack_shuffle[w]);
+    const __m256i shift = _mm256_load_si256((const __m256i *)(const void *)unpack_shift[w]);
+    const __m128i bytes = _mm_loadu_si128((const __m128i *)(const void *)(pe->at[k] + (size_t)g * w));
+    __m256i v = _mm256_shuffle_epi8(_mm256_broadcastsi128_si256(bytes), shuffle);
+    v = _mm256_and_si256(_mm256_srlv_epi32(v, shift), _mm256_set1_epi32((int)((1u << w) - 1u)));
+    return _mm256_cvtepi32_ps(_mm256_add_epi32(v, _mm256_set1_epi32(pe->offset[k])));
+}
+
+/* Components k0..k0 + 2 of eight vertices (group g) interleaved in registers: one permute per
+ * component and output vector, two blends:
+ * x0 y0 z0 x1 y1 z1 x2 y2 | z2 x3 y3 z3 x4 y4 z4 x5 | y5 z5 x6 y6 z6 x7 y7 z7. */
+__attribute__((target("avx2"))) static inline void triples8_avx2(const packed_entry *pe, uint32_t k0, uint32_t g,
+                                                                 __m256 o[3])
+{
+    const __m256i i0 = _mm256_setr_epi32(0, 0, 0, 1, 1, 1, 2, 2), i1 = _mm256_setr_epi32(2, 3, 3, 3, 4, 4, 4, 5),
+                  i2 = _mm256_setr_epi32(5, 5, 6, 6, 6, 7, 7, 7);
+    const __m256 x = unpack8_avx2(pe, k0, g), y = unpack8_avx2(pe, k0 + 1, g), z = unpack8_avx2(pe, k0 + 2, g);
+    o[0] = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(x, i0), _mm256_permutevar8x32_ps(y, i0), 0x92),
+                           _mm256_permutevar8x32_ps(z, i0), 0x24);
+    o[1] = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(x, i1), _mm256_permutevar8x32_ps(y, i1), 0x24),
+                           _mm256_permutevar8x32_ps(z, i1), 0x49);
+    o[2] = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(x, i2), _mm256_permutevar8x32_ps(y, i2), 0x49),
+                           _mm256_permutevar8x32_ps(z, i2), 0x92);
+}
+
+/* A whole block's components k0..k0 + 2 added to the interleaved accumulator eight vertices at
+ * a time: acc += factor x value as the portable loop does, so the sums are the same. */
+__attribute__((target("avx2"))) static void add_packed_block_avx2(float *restrict acc, const packed_entry *pe,
+                                                                  uint32_t k0, float factor)
+{
+    const __m256 f = _mm256_set1_ps(factor);
+    for (uint32_t g = 0; g < MK_BLOCK_SIZE / 8; g++) {
+        __m256 o[3];
+        triples8_avx2(pe, k0, g, o);
+        float *a = acc + 24 * g;
+        for (int k = 0; k < 3; k++)
+            _mm256_storeu_ps(a + 8 * k, _mm256_add_ps(_mm256_loadu_ps(a + 8 * k), _mm256_mul_ps(f, o[k])));
+    }
+}
+
+/* The m xyz triples of components k0..k0 + 2 (a multiple of 8 written: triples holds 192). */
+__attribute__((target("avx2"))) static void packed_triples_avx2(float *restrict triples, const packed_entry *pe,
+                                                                uint32_t k0)
+{
+    for (uint32_t g = 0; 8 * g < pe->m; g++) {
+        __m256 o[3];
+        triples8_avx2(pe, k0, g, o);
+        for (int k = 0; k < 3; k++) _mm256_storeu_ps(triples + 24 * g + 8 * k, o[k]);
+    }
+}
+#endif
+
+/* Reads a packed entry's head; returns its data's bytes (prefetched by the caller). */
+MK_INLINE size_t packed_entry_of(packed_entry *pe, const mk_blob_entry *en, uint32_t components, const uint8_t *p)
+{
+    const uint8_t *start = p;
+    pe->m = mk_popcount64(en->mask);
+    const uint8_t *head = (const uint8_t *)en + MK_ENTRY_HEAD;
+    uint64_t codes;   /* at most 5 bytes of codes; the head is at least 24 bytes long */
+    memcpy(&codes, head, sizeof codes);
+    const uint8_t *offsets = head + mk_entry_code_bytes(components);
+    const int wide = mk_entry_wide(en);
+    if (wide) p += MK_ENTRY_WIDE_BYTES;
+    for (uint32_t k = 0; k < components; k++) {
+        const uint32_t w = mk_width_of_code((uint32_t)(codes >> (4u * k)) & 15u);
+        int16_t o;
+        memcpy(&o, offsets + 2u * k, sizeof o);
+        pe->at[k] = p;
+        pe->width[k] = w;
+        pe->offset[k] = o;
+        p += (pe->m * w + 7u) >> 3;
+    }
+    if (wide)
+        for (int c = 0; c < 3; c++) pe->offset[c] = (int32_t)mk_load_u32le(start + 4 * c);
+    return (size_t)(p - start);
+}
+
+/* Adds factor x the values of the packed components k0, k0 + 1, k0 + 2 to the interleaved
+ * accumulator: each component is unpacked by rank; a whole block is added as it is interleaved,
+ * a partial one interleaved into xyz triples first and those added run by run of the mask as a
+ * float entry's are. */
+MK_INLINE void add_packed_attribute(float *restrict acc, uint64_t mask, const packed_entry *pe, uint32_t k0, float factor)
+{
+    block_acc triples;
+#if MK_HAVE_AVX2_UNPACK
+    if (__builtin_cpu_supports("avx2")) {
+        if (mask == ~(uint64_t)0) {
+            add_packed_block_avx2(acc, pe, k0, factor);
+            return;
+        }
+        packed_triples_avx2(triples, pe, k0);
+        add_float_attribute(acc, mask, (const uint8_t *)triples, factor);
+        return;
+    }
+#endif
+    float v[3][MK_BLOCK_SIZE];
+    for (uint32_t c = 0; c < 3; c++) unpack_portable(v[c], pe->at[k0 + c], pe->m, pe->width[k0 + c], pe->offset[k0 + c]);
+    if (mask == ~(uint64_t)0) {   /* a whole block: interleaved as it is added */
+        for (uint32_t i = 0; i < MK_BLOCK_SIZE; i++) {
+            acc[3 * i] += factor * v[0][i];
+            acc[3 * i + 1] += factor * v[1][i];
+            acc[3 * i + 2] += factor * v[2][i];
+        }
+        return;
+    }
+    for (uint32_t j = 0; j < pe->m; j++) {
+        triples[3 * j] = v[0][j];
+        triples[3 * j + 1] = v[1][j];
+        triples[3 * j + 2] = v[2][j];
+    }
+    add_float_attribute(acc, mask, (const uint8_t *)triples, factor);
+}
+
+/* Adds attribute `attribute` (0 positions, 1 normals, 2 tangents) of an entry times factor
+ * (times the attribute's step for a packed entry, which the caller folds into factor). float_at
+ * is the attribute's float triples in a float entry. */
+MK_INLINE void add_entry_attribute(float *restrict acc, const mk_blob_entry *en, const packed_entry *pe, uint32_t k0,
+                                   const uint8_t *float_at, float factor)
+{
+    if (pe) add_packed_attribute(acc, en->mask, pe, k0, factor);
+    else add_float_attribute(acc, en->mask, float_at, factor);
 }
 
 static void normalize3(float *v, const float *fallback)
@@ -309,7 +463,9 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
     const float *base_n = want_normals ? (const float *)(a->data + m->normals) : NULL;
     const float *base_t = want_tangents ? (const float *)(a->data + m->tangents) : NULL;
     const uint32_t *block_first = (const uint32_t *)(a->data + m->block_entries);
-    const mk_blob_entry *entries = (const mk_blob_entry *)(a->data + m->entries);
+    const uint8_t *entries = a->data + m->entries;
+    const uint32_t stride = mk_entry_stride(m->flags), components = mk_mesh_components(m->flags);
+    const uint32_t tangent_component = mk_attribute_component(m->flags, 2);
     const uint8_t *data = a->data + m->target_data;
     const size_t ps = mk_stride_or(job->positions_stride, 12), ns = mk_stride_or(job->normals_stride, 12),
                  ts = mk_stride_or(job->tangents_stride, 16);
@@ -333,26 +489,25 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
         int32_t open_channel = -1;          /* slerp channel whose deltas are being gathered */
         uint64_t touched = 0;
         for (uint32_t e = block_first[b]; e < block_first[b + 1]; e++) {
-            const mk_blob_entry *en = &entries[e];
+            const mk_blob_entry *en = mk_entry_at(entries, stride, e);
             const uint32_t ti = mk_entry_target(en);
             const float c = f.plan.coef[ti];
             if (c == 0.0f) continue;
             const mk_blob_target *tg = &f.targets[ti];
-            const int q = mk_entry_quantized(en);   /* per entry: a quantized target's outliers are float */
-            const size_t attribute_bytes = (size_t)mk_entry_attribute_bytes(en);
-            const uint8_t *p = data + (size_t)en->data * MK_ALIGN;
-            prefetch_ahead(p, (size_t)mk_entry_bytes(en, tg->flags));
-            if (mk_entry_has_offset(en)) {
-                add_offset(acc_p, en->mask, (const float *)(const void *)p, c);
-                p += MK_ENTRY_OFFSET_BYTES;
-            }
-            add_attribute(acc_p, en->mask, p, q, c * (q ? tg->position_scale : 1.0f));
+            const int packed = mk_entry_packed(en);   /* per entry: a quantized target's outliers are float */
+            const uint8_t *p = data + (size_t)en->data * MK_DATA_UNIT;
+            packed_entry pe;
+            const size_t float_bytes = 12u * (size_t)mk_popcount64(en->mask);   /* one attribute of a float entry */
+            prefetch_ahead(p, packed ? packed_entry_of(&pe, en, components, p)
+                                     : (size_t)mk_entry_bytes(en, m->flags, tg->flags));
+            const packed_entry *pk = packed ? &pe : NULL;
+            add_entry_attribute(acc_p, en, pk, 0, p, c * (packed ? tg->position_scale : 1.0f));
             if (!want_normals && !want_tangents) continue;
-            p += attribute_bytes;
+            p += float_bytes;
             if (tg->flags & MK_TARGET_HAS_NORMALS) {
                 const int32_t sc = f.plan.slerp_channel[ti];
                 if (sc < 0) {
-                    if (want_normals) add_attribute(acc_n, en->mask, p, q, c * (q ? tg->normal_scale : 1.0f));
+                    if (want_normals) add_entry_attribute(acc_n, en, pk, 3, p, c * (packed ? tg->normal_scale : 1.0f));
                 } else {
                     /* Gather this channel's two span targets' raw normal deltas. */
                     if (sc != open_channel) {
@@ -363,13 +518,13 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
                         touched = 0;
                     }
                     float *dst = (int32_t)ti == f.plan.spans[sc].target_a ? slerp_a : slerp_b;
-                    add_attribute(dst, en->mask, p, q, q ? tg->normal_scale : 1.0f);
+                    add_entry_attribute(dst, en, pk, 3, p, packed ? tg->normal_scale : 1.0f);
                     touched |= en->mask;
                 }
-                p += attribute_bytes;
+                p += float_bytes;
             }
             if (want_tangents && (tg->flags & MK_TARGET_HAS_TANGENTS))
-                add_attribute(acc_t, en->mask, p, q, c * (q ? tg->tangent_scale : 1.0f));
+                add_entry_attribute(acc_t, en, pk, tangent_component, p, c * (packed ? tg->tangent_scale : 1.0f));
         }
         if (open_channel >= 0) add_slerp_normals(acc_n, slerp_a, slerp_b, touched, &f.plan.spans[open_channel], bn);
 
@@ -424,17 +579,19 @@ uint64_t mk_eval_traffic(const mk_eval_job *job)
     const mk_blob_mesh *m = f.mesh;
     const uint32_t first = job->first_vertex, n = job_vertex_count(job), end = first + n;
     const uint32_t *block_first = (const uint32_t *)(job->asset->data + m->block_entries);
-    const mk_blob_entry *entries = (const mk_blob_entry *)(job->asset->data + m->entries);
+    const uint8_t *entries = job->asset->data + m->entries;
+    const uint32_t stride = mk_entry_stride(m->flags);
     uint32_t strip = 0;
     if (!job->normals) strip |= MK_TARGET_HAS_NORMALS;
     if (!job->tangents) strip |= MK_TARGET_HAS_TANGENTS;
     const uint32_t b0 = first / MK_BLOCK_SIZE, b1 = (end + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
     uint64_t bytes = 4u * (uint64_t)(b1 - b0 + 1);                      /* block table */
     for (uint32_t e = block_first[b0]; e < block_first[b1]; e++) {
-        bytes += sizeof(mk_blob_entry);                                 /* every header is read */
-        const uint32_t ti = mk_entry_target(&entries[e]);
+        const mk_blob_entry *en = mk_entry_at(entries, stride, e);
+        bytes += stride;                                                /* every header is read */
+        const uint32_t ti = mk_entry_target(en);
         if (f.plan.coef[ti] == 0.0f) continue;
-        bytes += mk_entry_bytes(&entries[e], f.targets[ti].flags & ~strip);
+        bytes += mk_entry_bytes(en, m->flags, f.targets[ti].flags & ~strip);
     }
     /* Base arrays read and outputs written. */
     bytes += (uint64_t)n * 12u * 2u * (job->normals ? 2u : 1u);

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The .morph blob layout, version 4 (docs/format.md is the prose description).
+/* The .morph blob layout, version 5 (docs/format.md is the prose description).
  *
  * Little-endian. Every record and array starts at a multiple of 16 bytes from the blob start.
  * Offsets are absolute byte offsets from the blob start. Strings are offsets into the STRINGS
@@ -90,7 +90,7 @@ typedef struct mk_blob_channel {
 } mk_blob_channel;                 /* 32 bytes */
 
 enum {
-    MK_TARGET_QUANTIZED = 1u,      /* has int16 entries: components times the per-attribute scale */
+    MK_TARGET_QUANTIZED = 1u,      /* has packed entries: integers times the per-attribute step */
     MK_TARGET_HAS_NORMALS = 2u,
     MK_TARGET_HAS_TANGENTS = 4u
 };
@@ -100,37 +100,52 @@ typedef struct mk_blob_target {
     uint32_t channel;              /* asset channel index */
     float full_weight;             /* nonzero; strictly increasing within the channel */
     uint32_t flags;                /* MK_TARGET_* */
-    float position_scale;          /* dequantization step (quantized targets), else 0 */
+    float position_scale;          /* step of packed values (quantized targets), else 0 */
     float normal_scale;
     float tangent_scale;
     uint32_t moved_vertices;
 } mk_blob_target;                  /* 32 bytes */
 
-/* One target's data for one block of 64 vertices. Entries of a block are sorted by target
- * (mesh-local index), so a channel's targets are adjacent. The data holds m = popcount(mask)
- * xyz triples in mask-bit order, interleaved like the outputs: the position deltas
- * x0 y0 z0 x1 y1 z1 ..., then the normal deltas if the target has normals, then the tangent
- * deltas (xyz) if it has tangents; float32 when the entry has MK_ENTRY_FLOAT, else int16 times
- * the target's scales (only a quantized target has int16 entries; a float target's entries all
- * have the flag), after the position offset of an MK_ENTRY_OFFSET entry. A run of consecutive
- * mask bits is one contiguous span of data and output. The mask may cover vertices the target
- * does not move: their deltas are zeros, except in an MK_ENTRY_OFFSET entry, whose every
- * covered vertex moves by offset + int16 x scale (the writer covers only moved vertices there). */
+/* One target's data for one block of 64 vertices (docs/format.md, "Blocks and entries").
+ *
+ * An entry is a 16-byte head (mk_blob_entry) followed by its packing: a width code per
+ * component (4 bits, component k in byte k / 2, low nibble first; 0-14 = that many bits, 15 =
+ * 16 bits), then an int16 offset per component (in steps of its attribute). Components are the
+ * mesh's attributes' x, y, z in order positions, normals (mesh with normals), tangents (mesh
+ * with tangents), so an entry is mk_entry_stride(mesh flags) bytes: 24, 32 or 40.
+ *
+ * A packed entry's data (4-byte aligned, at mesh.target_data + 4 x data) holds, with m =
+ * popcount(mask) and after the 12-byte position offsets of an MK_ENTRY_WIDE entry, each
+ * component's m unsigned values u of its width w, in mask-bit order, least significant bit
+ * first, each component from a byte boundary (ceil(m w / 8) bytes); component k of the j-th
+ * vertex is (offset_k + u) x the target's step of that attribute (position_scale, normal_scale,
+ * tangent_scale). Width 0 stores nothing: every vertex has the offset. An MK_ENTRY_FLOAT entry
+ * holds float32 xyz triples instead, interleaved (x0 y0 z0 x1 ...), positions, then normal
+ * deltas (target with normals), then tangent deltas (target with tangents); its codes and
+ * offsets are zero. A mesh's target data ends at least MK_TARGET_DATA_TAIL bytes after its
+ * last entry's data, so a decoder may load 16 bytes at any byte of an entry's data. */
 #define MK_ENTRY_TARGET_MASK 0x00FFFFFFu   /* target_and_flags: the mesh-local target index */
 #define MK_MAX_MESH_TARGETS (MK_ENTRY_TARGET_MASK + 1u)   /* targets per mesh: 2^24 */
 #define MK_ENTRY_FLOAT 0x80000000u       /* target_and_flags: the entry's data is float32 */
-/* target_and_flags: an int16 entry whose position deltas are offset + int16 x scale; its data
- * starts with the offset (MK_ENTRY_OFFSET_BYTES: f32 x, y, z, then 4 zero bytes). Lets a block
- * of large deltas with a narrow spread stay int16 within the tolerance. */
-#define MK_ENTRY_OFFSET 0x40000000u
-#define MK_ENTRY_OFFSET_BYTES 16u
-#define MK_ENTRY_FLAGS_KNOWN (MK_ENTRY_FLOAT | MK_ENTRY_OFFSET)
+/* target_and_flags: a packed entry whose position offsets are int32, the first 12 bytes of its
+ * data (x, y, z; |offset| <= MK_WIDE_OFFSET_MAX), in place of the head's (which are zero). */
+#define MK_ENTRY_WIDE 0x40000000u
+#define MK_ENTRY_WIDE_BYTES 12u
+#define MK_WIDE_OFFSET_MAX 0x7FFFFF          /* 2^23 - 1: offset + u stays exact in float32 */
+#define MK_ENTRY_FLAGS_KNOWN (MK_ENTRY_FLOAT | MK_ENTRY_WIDE)
+#define MK_ENTRY_HEAD 16u                    /* bytes before the width codes */
+#define MK_MAX_WIDTH 16u                     /* bits per value */
+#define MK_WIDTH_CODE_16 15u                 /* the code of width 16 */
+#define MK_DATA_UNIT 4u                      /* entry.data counts 4-byte units */
+#define MK_TARGET_DATA_TAIL 16u
+#define MK_MAX_COMPONENTS 9u                 /* positions, normals, tangents: xyz each */
 
 typedef struct mk_blob_entry {
     uint32_t target_and_flags;     /* mesh-local target index (low 24 bits) | MK_ENTRY_* */
-    uint32_t data;                 /* offset from mesh.target_data, in 16-byte units */
+    uint32_t data;                 /* offset from mesh.target_data, in 4-byte units */
     uint64_t mask;                 /* bit i: vertex block*64 + i has data */
-} mk_blob_entry;                   /* 16 bytes */
+    /* then uint8_t codes[mk_entry_code_bytes], int16_t offsets[components] */
+} mk_blob_entry;                   /* the 16-byte head of an entry */
 
 typedef struct mk_blob_clip {
     uint32_t name;
@@ -177,38 +192,90 @@ static inline unsigned mk_ctz64(uint64_t x)
 uint64_t mk_checksum(const void *data, uint64_t size);
 
 static inline uint32_t mk_entry_target(const mk_blob_entry *e) { return e->target_and_flags & MK_ENTRY_TARGET_MASK; }
-static inline int mk_entry_quantized(const mk_blob_entry *e) { return (e->target_and_flags & MK_ENTRY_FLOAT) == 0; }
-static inline int mk_entry_has_offset(const mk_blob_entry *e) { return (e->target_and_flags & MK_ENTRY_OFFSET) != 0; }
+static inline int mk_entry_packed(const mk_blob_entry *e) { return (e->target_and_flags & MK_ENTRY_FLOAT) == 0; }
+static inline int mk_entry_wide(const mk_blob_entry *e) { return (e->target_and_flags & MK_ENTRY_WIDE) != 0; }
 
-/* The flags that size an entry's data: its target's attributes, MK_TARGET_QUANTIZED when the
- * entry holds int16 (quantized: mk_entry_quantized of a stored entry, or the writer's choice). */
-static inline uint32_t mk_entry_flags(uint32_t target_flags, int quantized)
+/* Components of a mesh's entries: 3 per attribute the mesh has. */
+static inline uint32_t mk_mesh_components(uint32_t mesh_flags)
 {
-    return (target_flags & ~(uint32_t)MK_TARGET_QUANTIZED) | (quantized ? (uint32_t)MK_TARGET_QUANTIZED : 0u);
+    return 3u * (1u + ((mesh_flags & MK_MESH_HAS_NORMALS) ? 1u : 0u) + ((mesh_flags & MK_MESH_HAS_TANGENTS) ? 1u : 0u));
 }
 
-/* Bytes of one entry's data: m values per component, 3 components per attribute; flags as
- * mk_entry_flags gives them (MK_TARGET_QUANTIZED: int16, else float32). */
-static inline uint64_t mk_entry_data_size(uint32_t flags, uint32_t m)
+/* Bytes of the width codes (4 bits per component, rounded up to an even count of bytes). */
+static inline uint32_t mk_entry_code_bytes(uint32_t components) { return (components + 3u) / 4u * 2u; }
+
+/* Bytes of one entry of a mesh: 24 (positions), 32 (and normals) or 40 (and tangents). */
+static inline uint32_t mk_entry_stride(uint32_t mesh_flags)
 {
-    uint64_t elem = (flags & MK_TARGET_QUANTIZED) ? 2u : 4u;
-    uint64_t attributes = 1u + ((flags & MK_TARGET_HAS_NORMALS) ? 1u : 0u)
-                        + ((flags & MK_TARGET_HAS_TANGENTS) ? 1u : 0u);
-    return attributes * 3u * elem * m;
+    const uint32_t c = mk_mesh_components(mesh_flags);
+    return MK_ENTRY_HEAD + mk_entry_code_bytes(c) + 2u * c;
 }
 
-/* Bytes of one attribute (positions, normals or tangents) of a stored entry's data: its m
- * triples at the entry's own precision. */
-static inline uint64_t mk_entry_attribute_bytes(const mk_blob_entry *e)
+/* The first component of an attribute (0 positions, 1 normals, 2 tangents) in a mesh's
+ * entries; the attribute must be one the mesh has. */
+static inline uint32_t mk_attribute_component(uint32_t mesh_flags, uint32_t attribute)
 {
-    return mk_entry_data_size(mk_entry_flags(0u, mk_entry_quantized(e)), mk_popcount64(e->mask));
+    if (attribute == 0) return 0;
+    if (attribute == 1) return 3;
+    return (mesh_flags & MK_MESH_HAS_NORMALS) ? 6u : 3u;
 }
 
-/* Bytes of a stored entry's data (its offset, then its attributes) for its target's flags. */
-static inline uint64_t mk_entry_bytes(const mk_blob_entry *e, uint32_t target_flags)
+/* Entry e of a mesh's entry array (stride from mk_entry_stride). */
+static inline const mk_blob_entry *mk_entry_at(const uint8_t *entries, uint32_t stride, uint64_t e)
 {
-    return (mk_entry_has_offset(e) ? MK_ENTRY_OFFSET_BYTES : 0u) +
-           mk_entry_data_size(mk_entry_flags(target_flags, mk_entry_quantized(e)), mk_popcount64(e->mask));
+    return (const mk_blob_entry *)(const void *)(entries + e * stride);
+}
+
+/* The width code of component k (0-15). */
+static inline uint32_t mk_entry_code(const mk_blob_entry *e, uint32_t k)
+{
+    const uint8_t *codes = (const uint8_t *)e + MK_ENTRY_HEAD;
+    return (uint32_t)(codes[k >> 1] >> (4u * (k & 1u))) & 15u;
+}
+
+static inline uint32_t mk_width_of_code(uint32_t code) { return code == MK_WIDTH_CODE_16 ? 16u : code; }
+static inline uint32_t mk_code_of_width(uint32_t width) { return width == 16u ? MK_WIDTH_CODE_16 : width; }
+
+/* The int16 offset of component k (components = mk_mesh_components of the mesh). */
+static inline int32_t mk_entry_offset(const mk_blob_entry *e, uint32_t components, uint32_t k)
+{
+    const uint8_t *p = (const uint8_t *)e + MK_ENTRY_HEAD + mk_entry_code_bytes(components) + 2u * k;
+    return (int16_t)(uint16_t)(p[0] | (uint32_t)p[1] << 8);
+}
+
+/* Little-endian reads of a packed entry's bytes. */
+static inline uint32_t mk_load_u32le(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+/* Value j (0-based rank in the mask) of a component whose packed bits start at p, width w
+ * (0-16): reads 4 bytes from byte j w / 8. */
+static inline uint32_t mk_unpack(const uint8_t *p, uint32_t w, uint32_t j)
+{
+    const uint32_t bit = j * w;
+    return (mk_load_u32le(p + (bit >> 3)) >> (bit & 7u)) & ((1u << w) - 1u);
+}
+
+/* Bytes of one component's packed values: m values of w bits. */
+static inline uint64_t mk_packed_bytes(uint32_t m, uint32_t w) { return ((uint64_t)m * w + 7u) / 8u; }
+
+/* Bytes of a stored entry's data (before its padding to 4 bytes) that hold the attributes in
+ * target_flags (MK_TARGET_HAS_*; positions always): packed, the WIDE offsets and those
+ * attributes' components (the codes of attributes a target lacks are zero, so its own flags
+ * give the whole entry); float, m triples per attribute. */
+static inline uint64_t mk_entry_bytes(const mk_blob_entry *e, uint32_t mesh_flags, uint32_t target_flags)
+{
+    const uint32_t m = mk_popcount64(e->mask);
+    const int normals = (target_flags & MK_TARGET_HAS_NORMALS) != 0, tangents = (target_flags & MK_TARGET_HAS_TANGENTS) != 0;
+    if (!mk_entry_packed(e)) return (1u + (uint64_t)normals + (uint64_t)tangents) * 12u * m;
+    uint64_t n = mk_entry_wide(e) ? MK_ENTRY_WIDE_BYTES : 0u;
+    for (uint32_t a = 0; a < 3; a++) {
+        if ((a == 1 && !normals) || (a == 2 && !tangents)) continue;
+        const uint32_t k0 = mk_attribute_component(mesh_flags, a);
+        for (uint32_t k = k0; k < k0 + 3; k++) n += mk_packed_bytes(m, mk_width_of_code(mk_entry_code(e, k)));
+    }
+    return n;
 }
 
 #endif

@@ -166,6 +166,14 @@ static size_t first_nonzero(const uint32_t *p, size_t n)
     return n;
 }
 
+/* Index of the first nonzero byte of p[0..n), or n. */
+static uint64_t first_nonzero_byte(const uint8_t *p, uint64_t n)
+{
+    for (uint64_t i = 0; i < n; i++)
+        if (p[i]) return i;
+    return n;
+}
+
 static uint64_t offset_of(const validator *v, const void *p) { return (uint64_t)((const uint8_t *)p - v->data); }
 
 static mk_result validate_sections(validator *v, mk_asset *a)
@@ -434,6 +442,32 @@ static mk_result validate_channels_and_targets(validator *v, const mk_asset *a)
     return MK_OK;
 }
 
+/* The first component of an entry that belongs to an attribute of the mesh its target lacks
+ * and still has a width code or offset, or the mesh's component count. Such a component stores
+ * nothing: a nonzero code would move the later components' data away from where
+ * mk_entry_bytes (which counts the target's attributes only) says it ends. */
+static uint32_t first_absent_component(const mk_blob_entry *en, uint32_t mesh_flags, uint32_t target_flags)
+{
+    const uint32_t components = mk_mesh_components(mesh_flags);
+    static const uint32_t mesh_has[3] = { 0, MK_MESH_HAS_NORMALS, MK_MESH_HAS_TANGENTS };
+    static const uint32_t target_has[3] = { 0, MK_TARGET_HAS_NORMALS, MK_TARGET_HAS_TANGENTS };
+    for (uint32_t attribute = 1; attribute < 3; attribute++) {
+        if (!(mesh_flags & mesh_has[attribute]) || (target_flags & target_has[attribute])) continue;
+        const uint32_t k0 = mk_attribute_component(mesh_flags, attribute);
+        for (uint32_t k = k0; k < k0 + 3; k++)
+            if (mk_entry_code(en, k) != 0 || mk_entry_offset(en, components, k) != 0) return k;
+    }
+    return components;
+}
+
+/* A WIDE entry's int32 position offset at p is within +-MK_WIDE_OFFSET_MAX, so offset + value
+ * stays exact in float32 and cannot overflow int32. */
+static int wide_offset_ok(const uint8_t *p)
+{
+    const int32_t o = (int32_t)mk_load_u32le(p);
+    return o >= -MK_WIDE_OFFSET_MAX && o <= MK_WIDE_OFFSET_MAX;
+}
+
 /* Checks the block table, entries and delta data of one mesh. */
 static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
 {
@@ -442,14 +476,16 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
     if ((r = CHECK_ARRAY("mesh.block_table", m->block_entries, (uint64_t)m->block_count + 1, 4, &v->data_section, "mesh ",
                          mi, " block table")))
         return r;
-    if ((r = CHECK_ARRAY("mesh.entries", m->entries, m->entry_count, sizeof(mk_blob_entry), &v->data_section, "mesh ", mi,
+    const uint32_t stride = mk_entry_stride(m->flags), components = mk_mesh_components(m->flags);
+    const uint32_t code_bytes = mk_entry_code_bytes(components);
+    if ((r = CHECK_ARRAY("mesh.entries", m->entries, m->entry_count, stride, &v->data_section, "mesh ", mi,
                          " entries")))
         return r;
     if ((r = CHECK_ARRAY("mesh.target_data", m->target_data, m->target_data_size, 1, &v->data_section, "mesh ", mi,
                          " target data")))
         return r;
     const uint32_t *first = (const uint32_t *)(v->data + m->block_entries);
-    const mk_blob_entry *entries = (const mk_blob_entry *)(v->data + m->entries);
+    const uint8_t *entries = v->data + m->entries;
     if (FAILS("block_table.first", first[0] != 0))
         return fail2(v->err, MK_ERROR_CORRUPT, m->block_entries, "mesh ", mi, ": block table starts at entry ", first[0],
                      " instead of 0");
@@ -467,8 +503,8 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
         if (in_block > MK_BLOCK_SIZE) in_block = MK_BLOCK_SIZE;
         uint64_t allowed = in_block == 64 ? ~0ull : ((1ull << in_block) - 1);
         for (uint32_t e = first[b]; e < first[b + 1]; e++) {
-            const mk_blob_entry *en = &entries[e];
-            uint64_t at = m->entries + (uint64_t)e * sizeof(mk_blob_entry);
+            const mk_blob_entry *en = mk_entry_at(entries, stride, e);
+            uint64_t at = m->entries + (uint64_t)e * stride;
             const uint32_t target = mk_entry_target(en);
             if (FAILS("entry.flags", (en->target_and_flags & ~(MK_ENTRY_TARGET_MASK | MK_ENTRY_FLAGS_KNOWN)) != 0))
                 return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": unknown flag bits ",
@@ -476,7 +512,7 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
             if (FAILS("entry.target", target >= m->target_count))
                 return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": target index ", target,
                              " is out of range");
-            if (FAILS("entry.order", e > first[b] && target <= mk_entry_target(&entries[e - 1])))
+            if (FAILS("entry.order", e > first[b] && target <= mk_entry_target(mk_entry_at(entries, stride, e - 1))))
                 return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": target ", target,
                              " repeats or precedes the previous entry's (a block's targets strictly increase)");
             if (FAILS("entry.mask_empty", en->mask == 0))
@@ -485,31 +521,51 @@ static mk_result validate_blocks(validator *v, const mk_asset *a, uint32_t mi)
                 return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": vertex mask has bits past the mesh's last vertex (block ",
                              b, ")");
             const mk_blob_target *tg = &a->targets[m->first_target + target];
-            if (FAILS("entry.precision", mk_entry_quantized(en) && !(tg->flags & MK_TARGET_QUANTIZED)))
-                return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": int16 data for float target ", target,
+            if (FAILS("entry.precision", mk_entry_packed(en) && !(tg->flags & MK_TARGET_QUANTIZED)))
+                return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": packed data for float target ", target,
                              "");
-            if (FAILS("entry.offset_precision", mk_entry_has_offset(en) && !mk_entry_quantized(en)))
+            if (FAILS("entry.wide_precision", mk_entry_wide(en) && !mk_entry_packed(en)))
                 return fail2(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e,
-                             ": a position offset on float32 data (only int16 entries have one)");
-            uint64_t bytes = mk_entry_bytes(en, tg->flags);
-            uint64_t offset = (uint64_t)en->data * MK_ALIGN;
-            if (FAILS("entry.data", offset > m->target_data_size || bytes > m->target_data_size - offset))
+                             ": WIDE on float32 data (only packed entries have int32 position offsets)");
+            /* The packing (width codes, then offsets) must say exactly what the data holds, so
+             * that every decoder finds the same bytes: zero where nothing is stored. */
+            const uint8_t *codes = (const uint8_t *)en + MK_ENTRY_HEAD;
+            const uint64_t codes_at = at + MK_ENTRY_HEAD, offsets_at = codes_at + code_bytes;
+            uint64_t stray = first_nonzero_byte(codes, stride - MK_ENTRY_HEAD);
+            if (FAILS("entry.float_packing", !mk_entry_packed(en) && stray < stride - MK_ENTRY_HEAD))
+                return fail2(v->err, MK_ERROR_CORRUPT, codes_at + stray, "mesh ", mi, " entry ", e,
+                             ": float32 entry has a nonzero width code or offset");
+            uint32_t nibble = components;
+            while (nibble < 2 * code_bytes && mk_entry_code(en, nibble) == 0) nibble++;   /* the codes' padding */
+            if (FAILS("entry.code_padding", nibble < 2 * code_bytes))
+                return fail3(v->err, MK_ERROR_CORRUPT, codes_at + nibble / 2, "mesh ", mi, " entry ", e, ": width code ",
+                             nibble, " is not zero (it pads the codes past the mesh's last component)");
+            const uint32_t absent = first_absent_component(en, m->flags, tg->flags);
+            const int absent_tangent = (m->flags & MK_MESH_HAS_TANGENTS) && absent >= mk_attribute_component(m->flags, 2);
+            if (FAILS("entry.absent_attribute", absent < components))
+                return fail3(v->err, MK_ERROR_CORRUPT, mk_entry_code(en, absent) ? codes_at + absent / 2 : offsets_at + 2ull * absent,
+                             "mesh ", mi, " entry ", e, ": component ", absent,
+                             absent_tangent ? " has a width code or offset but its target has no tangent deltas"
+                                            : " has a width code or offset but its target has no normal deltas");
+            uint32_t head = 0;
+            while (head < 3 && mk_entry_offset(en, components, head) == 0) head++;
+            if (FAILS("entry.wide_head", mk_entry_wide(en) && head < 3))
+                return fail3(v->err, MK_ERROR_CORRUPT, offsets_at + 2ull * head, "mesh ", mi, " entry ", e, ": WIDE entry's head position offset ",
+                             head, " is not zero (its offsets are the int32 ones in its data)");
+            uint64_t bytes = mk_entry_bytes(en, m->flags, tg->flags);
+            uint64_t offset = (uint64_t)en->data * MK_DATA_UNIT;   /* no overflow: at most 2^34 */
+            /* The tail lets decoders load 16 bytes at any byte of the data. */
+            if (FAILS("entry.data", offset > m->target_data_size || bytes + MK_TARGET_DATA_TAIL > m->target_data_size - offset))
                 return fail3(v->err, MK_ERROR_CORRUPT, at, "mesh ", mi, " entry ", e, ": its ", bytes,
-                             " bytes of data run past the mesh's target data");
-            if (mk_entry_has_offset(en)) {
-                const float *o = (const float *)(v->data + m->target_data + offset);
-                uint64_t bad_offset = first_not_finite(o, 3);
-                if (FAILS("entry.offset_finite", bad_offset < 3))
-                    return fail3(v->err, MK_ERROR_NOT_FINITE, m->target_data + offset + 4 * bad_offset, "mesh ", mi,
-                                 " entry ", e, ": position offset component ", bad_offset, " is not finite");
-                uint32_t pad;
-                memcpy(&pad, o + 3, 4);
-                if (FAILS("entry.offset_pad", pad != 0))
-                    return fail2(v->err, MK_ERROR_CORRUPT, m->target_data + offset + 12, "mesh ", mi, " entry ", e,
-                                 ": the 4 bytes after its position offset are not zero");
-            }
-            if (mk_entry_quantized(en)) continue;   /* int16 values are finite; only they have an offset */
-            uint64_t bad = first_not_finite((const float *)(v->data + m->target_data + offset), bytes / 4);
+                             " bytes of data and the 16-byte tail run past the mesh's target data");
+            const uint8_t *d = v->data + m->target_data + offset;
+            uint32_t wide = 0;
+            while (mk_entry_wide(en) && wide < 3 && wide_offset_ok(d + 4 * wide)) wide++;
+            if (FAILS("entry.wide_range", mk_entry_wide(en) && wide < 3))
+                return fail3(v->err, MK_ERROR_CORRUPT, m->target_data + offset + 4ull * wide, "mesh ", mi, " entry ", e,
+                             ": WIDE position offset ", wide, " is beyond +-8388607 (2^23 - 1)");
+            if (mk_entry_packed(en)) continue;   /* packed values are finite */
+            uint64_t bad = first_not_finite((const float *)(const void *)d, bytes / 4);
             if (FAILS("entry.data_finite", bad < bytes / 4))
                 return fail3(v->err, MK_ERROR_NOT_FINITE, m->target_data + offset + 4 * bad, "mesh ", mi, " entry ", e,
                              ": delta value ", bad, " is not finite");
@@ -616,9 +672,13 @@ mk_result mk_asset_open(const void *data, size_t size, mk_asset *out, mk_error *
     const mk_blob_header *h = a.header;
     if (FAILS("header.magic", memcmp(h->magic, MK_MAGIC, 8) != 0))
         return fail(err, MK_ERROR_BAD_MAGIC, 0, "not a .morph blob (magic is not MORPHKIT)", NONE, "");
+    /* Versions 2-4 are this format's earlier layouts, which the tools wrote from sources:
+     * the message says how to get a current blob. */
+    const char *older = h->version >= 2 && h->version < MK_FORMAT_VERSION
+                      ? ": the format is older, re-import the source with this version's tools" : "";
     if (FAILS("header.version", h->version != MK_FORMAT_VERSION))
         return fail2(err, MK_ERROR_BAD_VERSION, 8, "blob format version ", h->version,
-                     " is not supported; this runtime reads version ", MK_FORMAT_VERSION, "");
+                     " is not supported; this runtime reads version ", MK_FORMAT_VERSION, older);
     if (FAILS("header.size", h->header_size != sizeof(mk_blob_header)))
         return fail(err, MK_ERROR_CORRUPT, 12, "header size ", h->header_size, " is not 64");
     if (FAILS("header.flags", h->flags != 0))
@@ -670,18 +730,18 @@ static uint64_t count_outlier_entries(const mk_asset *a, uint32_t mesh, int offs
 {
     if (!a || mesh >= a->mesh_count) return 0;
     const mk_blob_mesh *m = &a->meshes[mesh];
-    const mk_blob_entry *entries = (const mk_blob_entry *)(a->data + m->entries);
+    const uint32_t stride = mk_entry_stride(m->flags);
     uint64_t n = 0;
     for (uint64_t e = 0; e < m->entry_count; e++) {
-        const mk_blob_entry *en = &entries[e];
-        if (offsets) n += mk_entry_has_offset(en) != 0;
-        else n += !mk_entry_quantized(en) && (a->targets[m->first_target + mk_entry_target(en)].flags & MK_TARGET_QUANTIZED);
+        const mk_blob_entry *en = mk_entry_at(a->data + m->entries, stride, e);
+        if (offsets) n += mk_entry_wide(en) != 0;
+        else n += !mk_entry_packed(en) && (a->targets[m->first_target + mk_entry_target(en)].flags & MK_TARGET_QUANTIZED);
     }
     return n;
 }
 
 uint64_t mk_mesh_float_entries(const mk_asset *a, uint32_t mesh) { return count_outlier_entries(a, mesh, 0); }
-uint64_t mk_mesh_offset_entries(const mk_asset *a, uint32_t mesh) { return count_outlier_entries(a, mesh, 1); }
+uint64_t mk_mesh_wide_entries(const mk_asset *a, uint32_t mesh) { return count_outlier_entries(a, mesh, 1); }
 
 int mk_mesh_get(const mk_asset *a, uint32_t mesh, mk_mesh_info *out)
 {

@@ -67,8 +67,8 @@ void cli_progress_init(cli_progress *p, int quiet);
 void cli_progress_update(cli_progress *p, const char *stage, double fraction);
 double cli_now_seconds(void);
 
-/* Prints a blob writer's precision report to stdout: int16 and float targets, the outlier
- * blocks (float32, or int16 around a position offset), the largest quantization errors and the
+/* Prints a blob writer's precision report to stdout: packed and float targets, the outlier
+ * blocks (float32, or packed with int32 position offsets), the largest quantization errors and the
  * tolerance applied. */
 void cli_print_write_report(const mk_write_report *r);
 

@@ -157,10 +157,10 @@ void cli_progress_update(cli_progress *p, const char *stage, double fraction)
 
 void cli_print_write_report(const mk_write_report *r)
 {
-    printf("precision: %u int16 targets (%llu of %llu blocks float, %llu around an offset), %u float targets; "
+    printf("precision: %u packed targets (%llu of %llu blocks float, %llu wide), %u float targets; "
            "max position quantization error %.3g (tolerance %.3g)\n",
            r->quantized_targets, (unsigned long long)r->float_entries, (unsigned long long)r->entry_count,
-           (unsigned long long)r->offset_entries, r->float_targets, r->max_position_error, r->tolerance_used);
+           (unsigned long long)r->wide_entries, r->float_targets, r->max_position_error, r->tolerance_used);
     if (r->max_normal_error > 0 || r->max_tangent_error > 0)
         printf("max normal quantization error %.3g, tangent %.3g\n", r->max_normal_error, r->max_tangent_error);
 }

@@ -10,7 +10,7 @@
 typedef struct import_args {
     const char *input, *output, *channels, *depfile;
     int stacking, precision, stacking_given, quiet, all_meshes, timings, target_normals;
-    double tolerance;
+    double tolerance, normal_tolerance;
     uint64_t threads;
 } import_args;
 
@@ -24,9 +24,9 @@ static const cli_option options[] = {
       "one (which this option replaces).",
       NULL, "additive|sequential", 0, 0, 0, offsetof(import_args, stacking_given) },
     { "--precision", "P", CLI_CHOICE, offsetof(import_args, precision),
-      "How deltas are stored: q16 (int16 with a per-target scale; a 64-vertex block whose deltas would exceed "
-      "--tolerance with int16 is stored as int16 around a position offset where its deltas spread narrowly enough, "
-      "else as float32, and the scale comes from the others) or float (lossless float32).",
+      "How deltas are stored: q16 (quantized: integers at the step --tolerance sets for positions and "
+      "--normal-tolerance for normals and tangents, each 64-vertex block packed at the bits its range needs, up to "
+      "16; a block that needs more is stored as float32) or float (lossless float32).",
       "q16", "q16|float", 0, 0, 0, 0 },
     { "--target-normals", "HOW", CLI_CHOICE, offsetof(import_args, target_normals),
       "The targets' normal deltas: auto (the file's own; FBX also computes them where the file has none) or none "
@@ -35,9 +35,12 @@ static const cli_option options[] = {
       "are kept.",
       "auto", "auto|none", 0, 0, 0, 0 },
     { "--tolerance", "D", CLI_NUMBER, offsetof(import_args, tolerance),
-      "Largest quantization error of a position, in mesh units (q16: blocks that would exceed it are stored around "
-      "an offset or as float32). "
+      "Largest quantization error of a position, in mesh units (q16). "
       "Default: 1e-4 x each mesh's bounding-box diagonal.",
+      NULL, NULL, 1e-30, 1e30, 0, 0 },
+    { "--normal-tolerance", "D", CLI_NUMBER, offsetof(import_args, normal_tolerance),
+      "Largest quantization error of a normal or tangent delta component (q16; unit vectors, so 1e-3 turns a normal "
+      "by at most about 0.06 degree per target). Default: 1e-3.",
       NULL, NULL, 1e-30, 1e30, 0, 0 },
     { "--channels", "SIDECAR.json", CLI_STRING, offsetof(import_args, channels),
       "glTF input only: a channel sidecar (written by 'morphkit export') that groups targets into progressive "
@@ -105,7 +108,8 @@ static int run_import(void *p)
                              .file_read = a->depfile ? cli_depfile_add : NULL, .file_read_user = &deps };
     if (a->stacking_given) io.stacking = a->stacking ? MK_STACKING_SEQUENTIAL : MK_STACKING_ADDITIVE;
     mk_write_options wo = { .precision = a->precision ? MK_PRECISION_FLOAT : MK_PRECISION_Q16,
-                            .tolerance = (float)a->tolerance, .phases = io.phases,
+                            .tolerance = (float)a->tolerance, .normal_tolerance = (float)a->normal_tolerance,
+                            .phases = io.phases,
                             .threads = (uint32_t)a->threads };
     /* Progress only for inputs big enough to take a while. */
     struct stat st;

@@ -11,7 +11,7 @@
 #include "json_write.h"
 
 /* Block entries over all meshes: of quantized targets stored as float32 (mk_mesh_float_entries),
- * or around a position offset (mk_mesh_offset_entries). */
+ * or with int32 position offsets (mk_mesh_wide_entries). */
 static uint64_t all_meshes(const mk_asset *a, uint64_t (*count)(const mk_asset *, uint32_t))
 {
     uint64_t n = 0;
@@ -25,7 +25,7 @@ static void print_text(FILE *f, const pb_asset *l, const char *path)
     uint32_t nq, nf;
     double bound;
     cli_precision_of(a, &nq, &nf, &bound);
-    uint64_t fe = all_meshes(a, mk_mesh_float_entries), oe = all_meshes(a, mk_mesh_offset_entries);
+    uint64_t fe = all_meshes(a, mk_mesh_float_entries), oe = all_meshes(a, mk_mesh_wide_entries);
     fprintf(f, "%s: %zu bytes, format v%u\n", path, l->blob_size, MK_FORMAT_VERSION);
     if (l->imported) {
         fprintf(f, "source: %s%s%s\n", l->raw.source_format[0] ? l->raw.source_format : "?",
@@ -34,7 +34,7 @@ static void print_text(FILE *f, const pb_asset *l, const char *path)
         if (l->raw.up_axis >= 0) fprintf(f, "up axis: %c\n", "XYZ"[l->raw.up_axis % 3]);
         fprintf(f, "import warnings: %u\n", l->raw.warning_count);
     }
-    fprintf(f, "precision: %u quantized (int16) targets (%llu float blocks, %llu around an offset), %u float targets; "
+    fprintf(f, "precision: %u quantized (packed) targets (%llu float blocks, %llu wide), %u float targets; "
                "max quantization error <= %.3g\n",
             nq, (unsigned long long)fe, (unsigned long long)oe, nf, bound);
     for (uint32_t i = 0; i < a->mesh_count; i++) {
@@ -45,10 +45,10 @@ static void print_text(FILE *f, const pb_asset *l, const char *path)
                 m.has_tangents ? "tangents, " : "", m.stacking == MK_STACKING_SEQUENTIAL ? "sequential" : "additive");
         if (m.gltf_node >= 0)
             fprintf(f, ", glTF node %d mesh %d primitive %d", m.gltf_node, m.gltf_mesh, m.gltf_primitive);
-        fprintf(f, "\n  target data: %llu bytes in %llu block entries (%llu float in quantized targets, %llu around an "
-                   "offset)\n",
+        fprintf(f, "\n  target data: %llu bytes in %llu block entries (%llu float in quantized targets, %llu "
+                   "wide)\n",
                 (unsigned long long)m.target_bytes, (unsigned long long)m.entry_count,
-                (unsigned long long)mk_mesh_float_entries(a, i), (unsigned long long)mk_mesh_offset_entries(a, i));
+                (unsigned long long)mk_mesh_float_entries(a, i), (unsigned long long)mk_mesh_wide_entries(a, i));
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
             mk_channel_info ch;
             mk_channel_get(a, c, &ch);
@@ -58,7 +58,7 @@ static void print_text(FILE *f, const pb_asset *l, const char *path)
                 mk_target_info t;
                 mk_target_get(a, c, k, &t);
                 fprintf(f, "    target '%s': full weight %g, %u vertices, %s%s%s\n", t.name, (double)t.full_weight,
-                        t.moved_vertices, t.quantized ? "int16" : "float", t.has_normals ? ", normals" : "",
+                        t.moved_vertices, t.quantized ? "packed" : "float", t.has_normals ? ", normals" : "",
                         t.has_tangents ? ", tangents" : "");
             }
             if (ch.origin[0]) fprintf(f, "    baked from recipe: %s\n", ch.origin);
@@ -78,7 +78,7 @@ static void print_json(FILE *f, const pb_asset *l, const char *path)
     uint32_t nq, nf;
     double bound;
     cli_precision_of(a, &nq, &nf, &bound);
-    uint64_t fe = all_meshes(a, mk_mesh_float_entries), oe = all_meshes(a, mk_mesh_offset_entries);
+    uint64_t fe = all_meshes(a, mk_mesh_float_entries), oe = all_meshes(a, mk_mesh_wide_entries);
     json_writer w;
     json_begin(&w, f, 1);
     json_object(&w, NULL);
@@ -95,7 +95,7 @@ static void print_json(FILE *f, const pb_asset *l, const char *path)
     json_int(&w, "quantized_targets", nq);
     json_int(&w, "float_targets", nf);
     json_int(&w, "float_entries", (long long)fe);
-    json_int(&w, "offset_entries", (long long)oe);
+    json_int(&w, "wide_entries", (long long)oe);
     json_number(&w, "max_quantization_error", bound);
     json_array(&w, "meshes");
     for (uint32_t i = 0; i < a->mesh_count; i++) {
@@ -107,7 +107,7 @@ static void print_json(FILE *f, const pb_asset *l, const char *path)
         json_string(&w, "stacking", m.stacking == MK_STACKING_SEQUENTIAL ? "sequential" : "additive");
         json_int(&w, "target_bytes", (long long)m.target_bytes);
         json_int(&w, "float_entries", (long long)mk_mesh_float_entries(a, i));
-        json_int(&w, "offset_entries", (long long)mk_mesh_offset_entries(a, i));
+        json_int(&w, "wide_entries", (long long)mk_mesh_wide_entries(a, i));
         json_array(&w, "channels");
         for (uint32_t c = m.first_channel; c < m.first_channel + m.channel_count; c++) {
             mk_channel_info ch;

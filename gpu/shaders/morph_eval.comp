@@ -37,11 +37,15 @@ layout(push_constant) uniform Params {
     uint out_p, out_p_stride;  // words
     uint out_n, out_n_stride;
     uint out_t, out_t_stride;
+    uint entry_words;     // words of one entry: mk_entry_stride of the mesh's flags / 4
+    uint components;      // the mesh's entry components: mk_mesh_components
+    uint mesh_flags;      // MK_MESH_HAS_*
 } pc;
 
 const uint ENTRY_FLOAT = 0x80000000u;
-const uint ENTRY_OFFSET = 0x40000000u;
+const uint ENTRY_WIDE = 0x40000000u;
 const uint ENTRY_TARGET_MASK = 0x00FFFFFFu;
+const uint MESH_HAS_NORMALS = 1u;
 const uint TARGET_HAS_NORMALS = 2u;
 const uint TARGET_HAS_TANGENTS = 4u;
 const uint WANT_NORMALS = 1u;
@@ -52,24 +56,82 @@ vec3 load3(uint w)
     return vec3(uintBitsToFloat(data[w]), uintBitsToFloat(data[w + 1u]), uintBitsToFloat(data[w + 2u]));
 }
 
-// One int16 of the target data, by its index in 16-bit units.
-float load_q16(uint h)
+// What the whole workgroup reads once from an entry (runtime/format.h, mk_blob_entry).
+struct Entry {
+    uint head;     // word of the entry's head: target_and_flags, data, mask, then codes and offsets
+    uint at;       // word of its data (the data field counts 4-byte units)
+    bool packed;   // else float32 triples
+    bool wide;     // a packed entry whose position offsets are the first 3 words of its data
+    uint m;        // vertices in its mask
+    uint tflags;   // its target's MK_TARGET_* flags
+};
+
+// The first component of attribute a (0 positions, 1 normals, 2 tangents) in the mesh's
+// entries, as mk_attribute_component.
+uint attribute_component(uint a)
 {
-    return float(bitfieldExtract(int(data[h >> 1u]), int((h & 1u) * 16u), 16));
+    if (a == 0u) return 0u;
+    if (a == 1u) return 3u;
+    return (pc.mesh_flags & MESH_HAS_NORMALS) != 0u ? 6u : 3u;
 }
 
-// The stored delta of one vertex: attribute `attr` (0 positions, then normals, then
-// tangents as the target has them) of the vertex at `rank` among the entry's m vertices, from
-// the entry's data at word `at`: int16 (times the attribute's scale, applied by the caller) or
-// float32. This is the one place that decodes the block format.
-vec3 entry_delta(uint at, bool quantized, uint m, uint attr, uint rank)
+// Bits per value of component k: its 4-bit code after the 16-byte head, low nibble first.
+uint entry_width(uint head, uint k)
 {
-    uint i = 3u * (attr * m + rank);
-    if (quantized) {
-        uint h = 2u * at + i;
-        return vec3(load_q16(h), load_q16(h + 1u), load_q16(h + 2u));
+    uint code = bitfieldExtract(data[head + 4u + (k >> 3u)], int(4u * (k & 7u)), 4);
+    return code == 15u ? 16u : code;
+}
+
+// The int16 offset of component k, after the codes (an even count of bytes, so an offset never
+// straddles a word).
+int entry_offset(uint head, uint k)
+{
+    uint byte = 16u + (pc.components + 3u) / 4u * 2u + 2u * k;
+    return bitfieldExtract(int(data[head + (byte >> 2u)]), int(8u * (byte & 2u)), 16);
+}
+
+// Value `rank` (w <= 16 bits) of a component whose values start `byte` bytes after word `at`.
+// The start need not be word-aligned, so the value's bit address is split into a word and a bit
+// within it (at + byte / 4 words, then (byte & 3) * 8 + rank * w bits: no 32-bit overflow of
+// a bit address even in a 4 GiB window), and the value is cut from that word and the next. The
+// 16 zero bytes after a mesh's last entry keep the second word inside the target data.
+uint unpack(uint at, uint byte, uint w, uint rank)
+{
+    uint bit = 8u * (byte & 3u) + rank * w;
+    uint word = at + (byte >> 2u) + (bit >> 5u);
+    uint s = bit & 31u;
+    uint low = data[word] >> s;
+    // The next word's bits above the first's, shifted in two steps: s may be 0, and a shift by
+    // 32 is undefined.
+    uint high = (data[word + 1u] << 1u) << (31u - s);
+    return (low | high) & ((1u << w) - 1u);
+}
+
+// The stored delta of one vertex: attribute `attr` (0 positions, 1 normals, 2 tangents; one
+// the target has) of the vertex at `rank` among the entry's m vertices. Packed: offset + u
+// per component, in steps of the attribute (applied by the caller); float: the float32 triple.
+// This is the one place that decodes the block format.
+vec3 entry_delta(Entry en, uint attr, uint rank)
+{
+    if (!en.packed) {
+        // Triples of the target's attributes one after the other: positions, normals, tangents.
+        uint slot = attr == 0u ? 0u : attr == 1u || (en.tflags & TARGET_HAS_NORMALS) == 0u ? 1u : 2u;
+        return load3(en.at + 3u * (slot * en.m + rank));
     }
-    return load3(at + i);
+    // Components are stored one after the other, each from a byte boundary; the codes of the
+    // attributes the target lacks are 0, so they take no bytes.
+    uint k0 = attribute_component(attr);
+    uint byte = en.wide ? 12u : 0u;
+    for (uint k = 0u; k < k0; k++) byte += (en.m * entry_width(en.head, k) + 7u) >> 3u;
+    vec3 d;
+    for (uint c = 0u; c < 3u; c++) {
+        uint k = k0 + c;
+        uint w = entry_width(en.head, k);
+        int offset = en.wide && k < 3u ? int(data[en.at + k]) : entry_offset(en.head, k);
+        d[c] = float(offset + int(unpack(en.at, byte, w, rank)));
+        byte += (en.m * w + 7u) >> 3u;
+    }
+    return d;
 }
 
 float plan_coef(uint t) { return uintBitsToFloat(plan[t]); }
@@ -184,7 +246,7 @@ void main()
 
     uint e_end = data[pc.block_table + block + 1u];
     for (uint e = data[pc.block_table + block]; e < e_end; e++) {
-        uint h = pc.entries + 4u * e;
+        uint h = pc.entries + pc.entry_words * e;
         uint target_and_flags = data[h];
         uint ti = target_and_flags & ENTRY_TARGET_MASK;
         float c = plan_coef(ti);
@@ -199,39 +261,31 @@ void main()
         float position_scale = q ? uintBitsToFloat(targets[tr + 4u]) : 1.0;
         float normal_scale = q ? uintBitsToFloat(targets[tr + 5u]) : 1.0;
         float tangent_scale = q ? uintBitsToFloat(targets[tr + 6u]) : 1.0;
-        uint at = pc.target_data + 4u * data[h + 1u];
-        if ((target_and_flags & ENTRY_OFFSET) != 0u) {
-            if (has) acc_p += c * load3(at);
-            at += 4u;
-        }
-        if (has) acc_p += (c * position_scale) * entry_delta(at, q, m, 0u, rank);
-        uint attr = 1u;
-        if ((tflags & TARGET_HAS_NORMALS) != 0u) {
-            if (want_n) {
-                int sc = plan_slerp_channel(ti);
-                if (sc < 0) {
-                    if (has) acc_n += (c * normal_scale) * entry_delta(at, q, m, attr, rank);
-                } else {
-                    if (sc != open_channel) {
-                        if (open_channel >= 0 && touched) acc_n += slerp_displacement(open_channel, base_n, slerp_a, slerp_b);
-                        slerp_a = vec3(0.0);
-                        slerp_b = vec3(0.0);
-                        open_channel = sc;
-                        open_target_a = int(plan[plan_span_at(sc)]);
-                        touched = false;
-                    }
-                    if (has) {
-                        vec3 d = normal_scale * entry_delta(at, q, m, attr, rank);
-                        if (int(ti) == open_target_a) slerp_a += d;
-                        else slerp_b += d;
-                        touched = true;
-                    }
+        Entry en = Entry(h, pc.target_data + data[h + 1u], q, (target_and_flags & ENTRY_WIDE) != 0u, m, tflags);
+        if (has) acc_p += (c * position_scale) * entry_delta(en, 0u, rank);
+        if (want_n && (tflags & TARGET_HAS_NORMALS) != 0u) {
+            int sc = plan_slerp_channel(ti);
+            if (sc < 0) {
+                if (has) acc_n += (c * normal_scale) * entry_delta(en, 1u, rank);
+            } else {
+                if (sc != open_channel) {
+                    if (open_channel >= 0 && touched) acc_n += slerp_displacement(open_channel, base_n, slerp_a, slerp_b);
+                    slerp_a = vec3(0.0);
+                    slerp_b = vec3(0.0);
+                    open_channel = sc;
+                    open_target_a = int(plan[plan_span_at(sc)]);
+                    touched = false;
+                }
+                if (has) {
+                    vec3 d = normal_scale * entry_delta(en, 1u, rank);
+                    if (int(ti) == open_target_a) slerp_a += d;
+                    else slerp_b += d;
+                    touched = true;
                 }
             }
-            attr++;
         }
         if (want_t && (tflags & TARGET_HAS_TANGENTS) != 0u && has)
-            acc_t += (c * tangent_scale) * entry_delta(at, q, m, attr, rank);
+            acc_t += (c * tangent_scale) * entry_delta(en, 2u, rank);
     }
     if (open_channel >= 0 && touched) acc_n += slerp_displacement(open_channel, base_n, slerp_a, slerp_b);
 

@@ -35,7 +35,7 @@ extern "C" {
 #define MK_VERSION_STRING "0.2.0"
 
 /* The version of the blob format this runtime reads and the tools write. */
-#define MK_FORMAT_VERSION 4u
+#define MK_FORMAT_VERSION 5u
 
 /* Consecutive key points of a channel (its full weights and the implicit 0) are at least this
  * far apart, so span parameters stay finite (docs/semantics.md). */
@@ -184,14 +184,13 @@ typedef struct mk_clip_info {
 } mk_clip_info;
 
 int mk_mesh_get(const mk_asset *asset, uint32_t mesh, mk_mesh_info *out);
-/* Block entries of the mesh's quantized targets stored as float32 (outlier blocks whose deltas
- * do not fit int16 within the import tolerance); 0 for an invalid mesh. Counted by reading
+/* Block entries of the mesh's quantized targets stored as float32 (outlier blocks whose values
+ * span more than 16 bits at the import tolerance's step); 0 for an invalid mesh. Counted by reading
  * every entry header of the mesh: for tools, not for a frame loop. */
 uint64_t mk_mesh_float_entries(const mk_asset *asset, uint32_t mesh);
-/* Block entries of the mesh stored as int16 around a position offset (outlier blocks whose
- * deltas are too large for int16 within the tolerance but spread narrowly); 0 for an invalid
- * mesh. Counted like mk_mesh_float_entries. */
-uint64_t mk_mesh_offset_entries(const mk_asset *asset, uint32_t mesh);
+/* Packed block entries of the mesh whose position offsets are int32 (deltas beyond 32,767
+ * steps that spread narrowly); 0 for an invalid mesh. Counted like mk_mesh_float_entries. */
+uint64_t mk_mesh_wide_entries(const mk_asset *asset, uint32_t mesh);
 int mk_channel_get(const mk_asset *asset, uint32_t channel, mk_channel_info *out);
 /* Targets of a channel are numbered 0..target_count-1 in increasing full weight. */
 int mk_target_get(const mk_asset *asset, uint32_t channel, uint32_t target, mk_target_info *out);

@@ -214,20 +214,26 @@ rc, out, err = expect("import skips a plain mesh with a warning naming it", ["im
 rc, out, err = run("import", two_nodes, "-o", path("t.morph"))
 check("import of meshes with targets prints no skipped-mesh warning", rc == 0 and "no morph targets" not in err, err)
 
-# Outlier blocks: deltas too large for int16 within a tiny tolerance but narrowly spread are
-# stored around a position offset, and info counts them (text and --json, whole and per mesh).
+# Outlier blocks: deltas of 0.5 at a tolerance of 1e-7 are 2.5e6 steps (step = 1e-7 / (0.5 + 2^-8)),
+# beyond the int16 offsets of an entry's head but below 2^23 steps, and spread over 1500 steps: the
+# block is packed around int32 position offsets (a WIDE entry), and info counts it (text and
+# --json, whole and per mesh). At 1e-8 the same deltas are 2.5e7 steps, beyond what float32 holds
+# exactly: the block is stored as float32.
 offset_gltf = path("offset.gltf")
 plain_gltf(offset_gltf, with_targets=True, delta=[0, 0, 0.5, 0, 0, 0.5001, 0, 0, 0.5002, 0, 0, 0.5003])
-rc, out, err = expect("import with a tolerance the block exceeds as int16",
+rc, out, err = expect("import with a tolerance the block's offsets exceed int16 at",
                       ["import", offset_gltf, "--tolerance", "1e-7", "-o", path("offset.morph")], 0)
-check("... reports one block around an offset", "0 of 1 blocks float, 1 around an offset" in out, out)
+check("... reports one wide block", "0 of 1 blocks float, 1 wide" in out, out)
 rc, out, err = run("info", path("offset.morph"), "--json")
 info = json.loads(out) if rc == 0 else {}
-check("info --json counts the offset entry", info.get("offset_entries") == 1 and info.get("float_entries") == 0
-      and info["meshes"][0]["offset_entries"] == 1 and info["meshes"][0]["float_entries"] == 0, out)
+check("info --json counts the wide entry", info.get("wide_entries") == 1 and info.get("float_entries") == 0
+      and info["meshes"][0]["wide_entries"] == 1 and info["meshes"][0]["float_entries"] == 0, out)
 rc, out, err = run("info", path("offset.morph"))
-check("info's text counts it", "(0 float blocks, 1 around an offset)" in out
-      and "(0 float in quantized targets, 1 around an offset)" in out, out)
+check("info's text counts it", "(0 float blocks, 1 wide)" in out
+      and "(0 float in quantized targets, 1 wide)" in out, out)
+rc, out, err = expect("import with a tolerance the deltas exceed 2^23 steps at",
+                      ["import", offset_gltf, "--tolerance", "1e-8", "-o", path("beyond.morph")], 0)
+check("... reports one float block, none wide", "1 of 1 blocks float, 0 wide" in out, out)
 
 # ---- 8. Sizes ----
 for args, what in [(["--vertices", "5000000000"], "out of range"), (["--vertices", "-5"], "not a whole number"),

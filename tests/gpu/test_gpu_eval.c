@@ -6,7 +6,7 @@
  * The tolerance is docs/gpu.md's: positions within 1e-6 of the evaluated mesh's bounding-box
  * diagonal, normals and tangents within 1e-4 rad. Cases: random assets (in-betweens with
  * negative and positive full weights, additive and sequential, weights beyond the keys, both
- * normal modes, float and int16 blobs, partial and whole blocks), the rich fixture's four meshes
+ * normal modes, float and quantized blobs, partial and whole blocks), the rich fixture's four meshes
  * over its clips, entries stored around a position offset and as float32 outliers, outputs
  * interleaved at an engine's stride and offsets, refused frames (NaN weights, a bad slot) and
  * refused outputs. Without any Vulkan device every case reports itself skipped. */
@@ -147,7 +147,7 @@ static void close_raw(opened *o)
     mk_arena_free_all(&o->arena);
 }
 
-/* The rich fixture (raw, initialized here) as an int16 blob, opened and uploaded; 0 (everything
+/* The rich fixture (raw, initialized here) as a quantized blob, opened and uploaded; 0 (everything
  * freed, a CHECK failed) when that did not work. */
 static int open_rich(mkg_harness *h, mk_raw_asset *raw, opened *o)
 {
@@ -191,7 +191,7 @@ static void test_random_assets(void)
                         if (!within(&d)) {
                             char what[96];
                             snprintf(what, sizeof what, "asset %d (%s), weights %d, stacking %d, %s", seed,
-                                     precision ? "float" : "int16", set, s, mode ? "slerp" : "nlerp");
+                                     precision ? "float" : "q16", set, s, mode ? "slerp" : "nlerp");
                             check_within(&d, what);
                             failed++;
                         }
@@ -251,9 +251,9 @@ static void test_rich_clips(void)
     check_no_validation_messages(h);
 }
 
-/* A mesh whose int16 blob has an entry around a position offset (block 0: deltas of about 30
- * spread by 0.06) and a float32 outlier (block 1: deltas from -40 to 40), beside plain int16
- * blocks. */
+/* A mesh whose quantized blob has a WIDE entry (block 0: deltas of about 30 spread by 0.06, at a
+ * 1e-5 tolerance beyond int16 offsets) and a float32 outlier (block 1: deltas from -40 to 40,
+ * more than 16 bits of range), beside plain packed blocks. */
 static void test_offset_and_float_entries(void)
 {
     NEED_DEVICE(h);
@@ -280,7 +280,7 @@ static void test_offset_and_float_entries(void)
     CHECK(mk_write_blob(&raw, &o, &arena, &blob, &size, &rep, &err) == MK_OK);
     mk_asset a;
     CHECK(mk_asset_open(blob, size, &a, &err) == MK_OK);
-    CHECK(mk_mesh_offset_entries(&a, 0) > 0);
+    CHECK(mk_mesh_wide_entries(&a, 0) > 0);
     CHECK(mk_mesh_float_entries(&a, 0) > 0);
     mkg_asset *ga = NULL;
     CHECK(mkg_asset_upload(h->ctx, &a, h->queue, h->family, &ga, &err) == MK_OK);
@@ -415,7 +415,7 @@ static void reseal(uint8_t *blob, size_t size)
     memcpy(blob + 24, &sum, sizeof sum);
 }
 
-/* Hostile blobs: bytes of the rich fixture's int16 blob changed at random (checksum rewritten so
+/* Hostile blobs: bytes of the rich fixture's quantized blob changed at random (checksum rewritten so
  * the structural checks are reached); every one mk_asset_open accepts is evaluated on every mesh.
  * Under GPU-assisted validation (the gpu_bounds test sets VK_LAYER_ENABLES) a read or write
  * outside a binding is a validation message, which fails the case. */
@@ -469,10 +469,13 @@ static void test_hostile_blobs(void)
     check_no_validation_messages(h);
 }
 
-/* A blob whose mesh's target data ends 2 bytes into a 32-bit word (open.c does not ask sizes to
- * be multiples of 4): the shader reads that whole word, so the bound window must hold it. One
- * target moving 3 vertices, positions only, int16: 18 bytes of data, the stored size cut to them. */
-static void test_data_ending_mid_word(void)
+/* A blob whose mesh's target data is cut to the least mk_asset_open accepts: its last entry's
+ * data, then exactly the MK_TARGET_DATA_TAIL bytes a decoder may read past it, the size not a
+ * multiple of 4 (the window's end is rounded up to a whole word). The GPU must still match the
+ * CPU. A window cut short of the tail goes unseen here: the bits read past a value are masked
+ * off, and test_gpu_bounds's GPU-assisted validation reported nothing when it was tried. One
+ * target moving 3 vertices, positions only, packed. */
+static void test_data_cut_to_tail(void)
 {
     NEED_DEVICE(h);
     mk_raw_asset raw;
@@ -486,18 +489,28 @@ static void test_data_ending_mid_word(void)
     mk_asset a;
     mk_error err;
     CHECK(mk_asset_open(blob, size, &a, &err) == MK_OK);
-    const size_t at = (size_t)((const uint8_t *)&a.meshes[0].target_data_size - blob);
-    uint64_t data_size = 18;
-    CHECK(a.meshes[0].target_data_size >= data_size);
+    const mk_blob_mesh *m = &a.meshes[0];
+    uint64_t end = 0;
+    for (uint64_t e = 0; e < m->entry_count; e++) {
+        const mk_blob_entry *en = mk_entry_at(a.data + m->entries, mk_entry_stride(m->flags), e);
+        const uint64_t at = (uint64_t)en->data * MK_DATA_UNIT
+                          + mk_entry_bytes(en, m->flags, a.targets[m->first_target + mk_entry_target(en)].flags);
+        if (at > end) end = at;
+    }
+    uint64_t data_size = end + MK_TARGET_DATA_TAIL;
+    CHECK(m->target_data_size >= data_size);
+    CHECK_MSG(data_size % 4 != 0, "the entry's data ends on a word (%llu bytes): the case tests less than it says",
+              (unsigned long long)end);
+    const size_t at = (size_t)((const uint8_t *)&m->target_data_size - blob);
     memcpy(blob + at, &data_size, sizeof data_size);
     reseal(blob, size);
     CHECK(mk_asset_open(blob, size, &a, &err) == MK_OK);
-    CHECK(a.meshes[0].target_data_size == 18);
+    CHECK(a.meshes[0].target_data_size == data_size);
     mkg_asset *ga = NULL;
     CHECK(mkg_asset_upload(h->ctx, &a, h->queue, h->family, &ga, &err) == MK_OK);
     const float w[1] = { 1.0f };
     diff d;
-    if (ga && compare_mesh(h, ga, &a, 0, w, MK_STACKING_ASSET, MK_NORMALS_NLERP, &d)) check_within(&d, "data ending mid-word");
+    if (ga && compare_mesh(h, ga, &a, 0, w, MK_STACKING_ASSET, MK_NORMALS_NLERP, &d)) check_within(&d, "data cut to the tail");
     mkg_asset_destroy(ga);
     mk_arena_free_all(&arena);
     mk_raw_free(&raw);
@@ -515,4 +528,4 @@ static void test_close(void)
 
 CHECK_MAIN(CASE(test_random_assets), CASE(test_rich_clips), CASE(test_offset_and_float_entries),
            CASE(test_interleaved_outputs), CASE(test_refusals), CASE(test_hostile_blobs),
-           CASE(test_data_ending_mid_word), CASE(test_close))
+           CASE(test_data_cut_to_tail), CASE(test_close))

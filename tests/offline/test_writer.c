@@ -82,8 +82,9 @@ static void test_quantization_tolerance(void)
     mk_raw_asset raw;
     mk_raw_init(&raw, NULL);
     fixture_line(&raw, 300, 4, 1);
-    /* One target with a huge delta next to tiny ones: int16 error = range / 65534, so its block
-     * (block 0 of 5) is stored as float and the rest of the target as int16. */
+    /* One target with a huge delta next to tiny ones: at the tolerance's step (0.001 / (0.5 +
+     * 2^-8)) its block (block 0 of 5) spans 2^19 steps, more than 16 bits, so that entry is
+     * float32 and the rest of the target packed. */
     raw.channels[3].targets[0].positions[1] = 1000.0f;
     mk_write_options o = { .precision = MK_PRECISION_Q16, .tolerance = 0.001f };
     void *blob;
@@ -116,17 +117,46 @@ static void test_quantization_tolerance(void)
         }
     }
     CHECK_MSG(worst <= rep.max_position_error + 1e-9, "worst %g > reported %g", worst, rep.max_position_error);
-    /* A tolerance below the worst int16 error: more blocks (at least the worst one's) are stored
-     * as float or around an offset now, and every int16 value errs by no more than the tolerance. */
+    /* A tolerance below the worst error: the step follows the tolerance (format v5 has one step
+     * per attribute and mesh, where v4 scaled int16 to each target's largest value and needed
+     * float or offset blocks to go finer), so the same blocks stay packed, at a smaller step,
+     * and the error stays within the new tolerance. */
     const double before = rep.max_position_error;
+    mk_target_info ti;
+    CHECK(mk_target_get(&a, 3, 0, &ti));
+    const float before_step = ti.position_scale;
     o.tolerance = (float)(0.75 * before);
     CHECK(before > 0 && mk_write_blob(&raw, &o, &raw.arena, &blob, &size, &rep, &err) == MK_OK);
-    CHECK_MSG(rep.float_entries + rep.float_targets + rep.offset_entries >= 2,
-              "tolerance %g below the worst error %g: %llu float blocks, %llu offset blocks, %u float targets",
-              (double)o.tolerance, before, (unsigned long long)rep.float_entries,
-              (unsigned long long)rep.offset_entries, rep.float_targets);
+    CHECK_EQ_INT(rep.float_entries, 1);
+    CHECK_EQ_INT(rep.float_targets, 0);
+    CHECK_EQ_INT(rep.wide_entries, 0);
+    CHECK(mk_asset_open(blob, size, &a, &err) == MK_OK && mk_target_get(&a, 3, 0, &ti));
+    CHECK_MSG(ti.position_scale > 0 && ti.position_scale < 0.76f * before_step, "step %g at tolerance %g, %g before",
+              (double)ti.position_scale, (double)o.tolerance, (double)before_step);
     CHECK_MSG(rep.max_position_error <= o.tolerance, "a quantized target errs by %g, over the tolerance %g",
               rep.max_position_error, (double)o.tolerance);
+    /* Block 1 of target 2 moved 200 units along x: 10^5 steps, beyond the int16 offsets of
+     * the entry's head, with a spread of a few dozen steps: one WIDE entry (int32 position
+     * offsets in its data), still within the tolerance when read back. */
+    mk_raw_target *t2 = &raw.channels[2].targets[0];
+    for (uint32_t j = 0; j < t2->count; j++)
+        if (t2->indices[j] / 64 == 1) t2->positions[3 * j] += 200.0f;
+    CHECK(mk_write_blob(&raw, &o, &raw.arena, &blob, &size, &rep, &err) == MK_OK);
+    CHECK_EQ_INT(rep.wide_entries, 1);
+    CHECK_EQ_INT(rep.float_entries, 1);
+    CHECK(mk_asset_open(blob, size, &a, &err) == MK_OK);
+    CHECK_EQ_INT(mk_mesh_wide_entries(&a, 0), 1);
+    CHECK_MSG(rep.max_position_error <= o.tolerance, "error %g with a WIDE entry, tolerance %g", rep.max_position_error,
+              (double)o.tolerance);
+    mk_raw_free(&back);
+    mk_raw_init(&back, NULL);
+    CHECK(mk_read_blob(&a, &back, &err) == MK_OK);
+    const mk_raw_target *u2 = &back.channels[2].targets[0];
+    CHECK_EQ_INT(u2->count, t2->count);
+    worst = 0;
+    for (uint32_t j = 0; j < u2->count && j < t2->count; j++)
+        for (uint32_t d = 0; d < 3; d++) worst = fmax(worst, fabs((double)u2->positions[3 * j + d] - t2->positions[3 * j + d]));
+    CHECK_MSG(worst <= rep.max_position_error + 1e-9, "WIDE read back %g, reported %g", worst, rep.max_position_error);
     mk_raw_free(&back);
     mk_raw_free(&raw);
 }
@@ -264,8 +294,9 @@ static void test_atomic_write(void)
     rmdir(dir);
 }
 
-/* Normal and tangent deltas are quantized too: the report gives their error, which int16 of a
- * unit-vector difference keeps below 3.1e-5, and read-back stays within it. */
+/* Normal and tangent deltas are quantized too, at the step of the normal tolerance (default
+ * MK_DEFAULT_NORMAL_TOLERANCE; v4 scaled int16 to each target's range and erred below 3.1e-5):
+ * the report gives their error, within that tolerance, and read-back stays within it. */
 static void test_normal_tangent_error_reported(void)
 {
     mk_raw_asset raw;
@@ -286,8 +317,10 @@ static void test_normal_tangent_error_reported(void)
     mk_write_report rep;
     mk_error err;
     CHECK(mk_write_blob(&raw, &o, &raw.arena, &blob, &size, &rep, &err) == MK_OK);
-    CHECK_MSG(rep.max_tangent_error > 0 && rep.max_tangent_error < 3.1e-5, "tangent error %g", rep.max_tangent_error);
-    CHECK_MSG(rep.max_normal_error > 0 && rep.max_normal_error < 3.1e-5, "normal error %g", rep.max_normal_error);
+    CHECK_MSG(rep.max_tangent_error > 0 && rep.max_tangent_error <= MK_DEFAULT_NORMAL_TOLERANCE, "tangent error %g",
+              rep.max_tangent_error);
+    CHECK_MSG(rep.max_normal_error > 0 && rep.max_normal_error <= MK_DEFAULT_NORMAL_TOLERANCE, "normal error %g",
+              rep.max_normal_error);
     mk_asset a;
     mk_raw_asset back;
     mk_raw_init(&back, NULL);

@@ -9,7 +9,7 @@
  *     float operations per channel (t, 1 - t, beta, 1 - beta, the products), errs by at most
  *     gamma * (|B| + sum_c (1 + |t_c|)(|delta_a| + |delta_b|)), gamma = u (8C + 16) for C
  *     channels: a few ulps per operation on the chain, of the magnitudes involved;
- *   - int16 deltas: each stored component is within the writer's reported error q of the
+ *   - quantized deltas: each stored component is within the writer's reported error q of the
  *     exact delta, so a sum errs by q * sum |coefficients| (the stacked coefficient sum);
  *   - normalizing: a vector error e moves the direction of a vector of length L by at most
  *     asin(e / L); slerp's sensitivity to its ends and to the angle's rounding is bounded by
@@ -218,7 +218,7 @@ static double slerp_error(const double *na, const double *nb, double t, double d
 }
 
 /* Error bound of the runtime's unit vector normalize(x), x = B_n + delta (exact here): the
- * stored delta's error (an int16 delta also rounds when scaled back, by u |delta|; a float
+ * stored delta's error (a quantized delta also rounds when scaled back, by u |delta|; a float
  * one is read exactly), the float sum's rounding (u |x| per component, so an exact zero stays
  * zero) and the normalization's (4u), divided by |x|. Sets *unstable when |x| is so close to
  * 1e-8 that the fallback choice is uncertain. */

@@ -7,7 +7,7 @@
  * as written, not its unrolled form.
  *
  * Besides the values it returns bounds on how far a correct float32 runtime reading the
- * written blob may be from them (float rounding, and the quantization error of int16 deltas
+ * written blob may be from them (float rounding, and the quantization error of quantized deltas
  * the writer reports), and ref_compare checks runtime outputs against both. */
 #ifndef MK_REFERENCE_EVAL_H
 #define MK_REFERENCE_EVAL_H
@@ -16,7 +16,7 @@
 #include "raw.h"
 
 /* Largest error of one stored delta component, per attribute: 0 for a float32 blob, the
- * writer's reported max quantization errors (mk_write_report) for an int16 one. */
+ * writer's reported max quantization errors (mk_write_report) for a quantized one. */
 typedef struct ref_stored_error {
     double position, normal, tangent;
 } ref_stored_error;

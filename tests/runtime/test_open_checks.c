@@ -86,7 +86,9 @@ static mk_blob_section *section(blob_case *c, uint32_t kind)
         if (section_at(c, i)->kind == kind) return section_at(c, i);
     abort();
 }
-static uint64_t data_end(blob_case *c) { return section(c, MK_SECTION_DATA)->offset + section(c, MK_SECTION_DATA)->size; }
+/* The DATA section's end rounded down to 16 bytes: where an aligned array may start to run
+ * over it (the section itself may end unaligned, its last target data in 4-byte units). */
+static uint64_t data_end(blob_case *c) { return (section(c, MK_SECTION_DATA)->offset + section(c, MK_SECTION_DATA)->size) & ~(uint64_t)15; }
 static mk_blob_mesh *mesh(blob_case *c, uint32_t i) { return WRITABLE(&c->a.meshes[i]); }
 static mk_blob_channel *channel(blob_case *c, uint32_t i) { return WRITABLE(&c->a.channels[i]); }
 static mk_blob_target *target(blob_case *c, uint32_t i) { return WRITABLE(&c->a.targets[i]); }
@@ -94,9 +96,33 @@ static mk_blob_clip *clip(blob_case *c, uint32_t i) { return WRITABLE(&c->a.clip
 static mk_blob_track *track(blob_case *c, uint32_t i) { return WRITABLE(&c->a.tracks[i]); }
 static mk_key *key(blob_case *c, uint32_t i) { return WRITABLE(&c->a.keys[i]); }
 static uint32_t *block_table(blob_case *c, uint32_t m) { return (uint32_t *)(void *)(c->b + mesh(c, m)->block_entries); }
+static uint32_t stride(blob_case *c, uint32_t m) { return mk_entry_stride(mesh(c, m)->flags); }
+static uint32_t components(blob_case *c, uint32_t m) { return mk_mesh_components(mesh(c, m)->flags); }
 static mk_blob_entry *entry(blob_case *c, uint32_t m, uint32_t e)
 {
-    return (mk_blob_entry *)(void *)(c->b + mesh(c, m)->entries) + e;
+    return (mk_blob_entry *)(void *)(c->b + mesh(c, m)->entries + (uint64_t)e * stride(c, m));
+}
+/* Where entry e of mesh m has its data (entry.data counts 4-byte units). */
+static unsigned char *entry_data(blob_case *c, uint32_t m, uint32_t e)
+{
+    return c->b + mesh(c, m)->target_data + (uint64_t)MK_DATA_UNIT * entry(c, m, e)->data;
+}
+/* The width codes (4 bits per component, low nibble first) and the int16 offsets after them. */
+static void set_code(blob_case *c, uint32_t m, uint32_t e, uint32_t k, uint32_t code)
+{
+    unsigned char *codes = (unsigned char *)entry(c, m, e) + MK_ENTRY_HEAD;
+    const unsigned shift = 4u * (k & 1u);
+    codes[k / 2] = (unsigned char)((codes[k / 2] & ~(15u << shift)) | code << shift);
+}
+static void set_offset(blob_case *c, uint32_t m, uint32_t e, uint32_t k, int16_t offset)
+{
+    unsigned char *p = (unsigned char *)entry(c, m, e) + MK_ENTRY_HEAD + mk_entry_code_bytes(components(c, m)) + 2 * k;
+    memcpy(p, &offset, 2);
+}
+/* Clears an entry's codes and offsets (as a float entry has them). */
+static void clear_packing(blob_case *c, uint32_t m, uint32_t e)
+{
+    memset((unsigned char *)entry(c, m, e) + MK_ENTRY_HEAD, 0, stride(c, m) - MK_ENTRY_HEAD);
 }
 static float *floats_at(blob_case *c, uint64_t offset) { return (float *)(void *)(c->b + offset); }
 static uint32_t *u32_at(blob_case *c, uint64_t offset) { return (uint32_t *)(void *)(c->b + offset); }
@@ -156,6 +182,7 @@ PATCH(magic_last_byte) { c->b[7] = 'k'; }
 PATCH(version_next) { header(c)->version = MK_FORMAT_VERSION + 1; }
 PATCH(version_2) { header(c)->version = 2; }
 PATCH(version_3) { header(c)->version = 3; }
+PATCH(version_4) { header(c)->version = 4; }
 PATCH(version_1) { header(c)->version = 1; }
 PATCH(header_size) { header(c)->header_size = 72; }
 PATCH(header_flags) { header(c)->flags = 1; }
@@ -305,7 +332,7 @@ PATCH(target_position_scale_negative) { target(c, 7)->position_scale = -0.5f; }
 PATCH(block_table_misaligned) { mesh(c, 2)->block_entries += 4; }
 PATCH(block_table_past_data) { mesh(c, 2)->block_entries = data_end(c); }
 PATCH(entries_misaligned) { mesh(c, 0)->entries += 8; }
-PATCH(entries_past_data) { mesh(c, last_mesh(c))->entries = data_end(c) - 16 * (mesh(c, last_mesh(c))->entry_count - 1); }
+PATCH(entries_past_data) { mesh(c, last_mesh(c))->entries = data_end(c) - 16; }   /* 1 entry of 24 bytes */
 PATCH(entries_count_overflow) { mesh(c, 2)->entry_count = (uint64_t)1 << 60; }
 PATCH(target_data_misaligned) { mesh(c, 2)->target_data += 4; }
 PATCH(target_data_past_data) { mesh(c, last_mesh(c))->target_data_size += 16; }
@@ -319,7 +346,7 @@ PATCH(entry_target) { entry(c, 0, 3)->target_and_flags = 4 | MK_ENTRY_FLOAT; }
 PATCH(entry_target_huge) { entry(c, 3, 0)->target_and_flags = MK_ENTRY_TARGET_MASK - 15; }
 PATCH(entry_flags) { entry(c, 0, 1)->target_and_flags |= 1u << 24; }
 PATCH(entry_flags_top) { entry(c, 2, 3)->target_and_flags |= 0x20000000u; }
-PATCH(entry_int16_of_float_target) { entry(c, 2, 4)->target_and_flags &= ~MK_ENTRY_FLOAT; }
+PATCH(entry_packed_of_float_target) { entry(c, 2, 4)->target_and_flags &= ~MK_ENTRY_FLOAT; }
 PATCH(entry_duplicate) { entry(c, 0, 1)->target_and_flags = entry(c, 0, 0)->target_and_flags; }
 PATCH(entry_misordered) { entry(c, 2, 2)->target_and_flags = 0; }
 PATCH(entry_mask_empty) { entry(c, 2, 5)->mask = 0; }
@@ -327,42 +354,56 @@ PATCH(entry_mask_past_end_small) { entry(c, 0, 2)->mask |= 1ull << 4; }
 PATCH(entry_mask_past_end_block) { entry(c, 2, mesh(c, 2)->entry_count - 1)->mask |= 1ull << 22; }
 PATCH(entry_data_straddles) { entry(c, last_mesh(c), entry_with_last_data(c, last_mesh(c)))->data += 1; }
 PATCH(entry_data_far) { entry(c, 2, dense_entry(c, 2))->data = 0xFFFFFFF0u; }
-PATCH(entry_data_nan)
+/* The target data 4 bytes shorter: the last entry's data ends less than 16 bytes before it,
+ * where a decoder's 16-byte loads would run past. */
+PATCH(entry_data_no_tail) { mesh(c, last_mesh(c))->target_data_size -= 4; }
+PATCH(entry_data_nan) { ((float *)(void *)entry_data(c, 2, dense_entry(c, 2)))[100] = NAN; }
+/* A quantized blob's last entry flagged float (its packing cleared): 3 float triples where
+ * the packed entry stored none, past the target data. */
+PATCH(entry_float_last)
 {
-    mk_blob_entry *e = entry(c, 2, dense_entry(c, 2));
-    floats_at(c, mesh(c, 2)->target_data + 16ull * e->data)[100] = NAN;
+    const uint32_t m = last_mesh(c), e = entry_with_last_data(c, m);
+    entry(c, m, e)->target_and_flags |= MK_ENTRY_FLOAT;
+    clear_packing(c, m, e);
 }
-/* A quantized blob's last entry flagged float: twice the bytes, past the target data. */
-PATCH(entry_float_last) { entry(c, last_mesh(c), entry_with_last_data(c, last_mesh(c)))->target_and_flags |= MK_ENTRY_FLOAT; }
-/* A quantized target's dense entry flagged float, with a NaN among its (now float) deltas. */
+/* A quantized target's entry flagged float (packing cleared, data moved to the start of the
+ * target data, where its 4 position triples fit), with a NaN among its now float deltas. */
 PATCH(entry_float_nan)
 {
-    mk_blob_entry *e = entry(c, 2, dense_entry(c, 2));
+    mk_blob_entry *e = entry(c, 0, 3);    /* target 3: positions only, 4 vertices */
     e->target_and_flags |= MK_ENTRY_FLOAT;
-    floats_at(c, mesh(c, 2)->target_data + 16ull * e->data)[7] = NAN;
-}
-/* A float entry with a position offset (only int16 entries have one). */
-PATCH(entry_offset_on_float) { entry(c, 2, 3)->target_and_flags |= MK_ENTRY_OFFSET; }
-/* A quantized dense entry given an offset: its first 16 data bytes are read as one. */
-PATCH(entry_offset_nan)
-{
-    mk_blob_entry *e = entry(c, 2, dense_entry(c, 2));
-    e->target_and_flags |= MK_ENTRY_OFFSET;
-    float *o = floats_at(c, mesh(c, 2)->target_data + 16ull * e->data);
-    o[0] = 0.5f; o[1] = NAN; o[2] = 0; o[3] = 0;
-}
-PATCH(entry_offset_pad)
-{
-    mk_blob_entry *e = entry(c, 2, dense_entry(c, 2));
-    e->target_and_flags |= MK_ENTRY_OFFSET;
-    float *o = floats_at(c, mesh(c, 2)->target_data + 16ull * e->data);
-    o[0] = 0.5f; o[1] = -2; o[2] = 0; o[3] = 1e-30f;
+    e->data = 0;
+    clear_packing(c, 0, 3);
+    ((float *)(void *)entry_data(c, 0, 3))[7] = NAN;
 }
 PATCH(entry_normal_delta_inf)
 {
-    mk_blob_entry *e = entry(c, 0, 2);    /* target 2: 3 vertices, positions then normals */
-    floats_at(c, mesh(c, 0)->target_data + 16ull * e->data)[9 + 4] = INFINITY;
+    /* target 2: 4 vertices, 12 position floats, then normals */
+    ((float *)(void *)entry_data(c, 0, 2))[12 + 4] = INFINITY;
 }
+PATCH(entry_wide_on_float) { entry(c, 2, 3)->target_and_flags |= MK_ENTRY_WIDE; }
+PATCH(entry_float_code) { set_code(c, 0, 1, 4, 3); }
+PATCH(entry_float_offset) { set_offset(c, 3, 0, 2, 1); }   /* the entry's last byte */
+/* Mesh 3 has 3 components: code 3 is the high nibble of the second code byte. */
+PATCH(entry_code_padding_nibble) { set_code(c, 3, 0, 3, 1); }
+/* Mesh 0 has 9 components in 6 code bytes: codes 9-11 pad. */
+PATCH(entry_code_padding_byte) { set_code(c, 0, 2, 11, 15); }
+/* Target 3 of mesh 0 and target 3 of mesh 2 (asset 7) move positions only. */
+PATCH(entry_absent_normal_code) { set_code(c, 2, 3, 3, 15); }
+PATCH(entry_absent_tangent_offset) { set_offset(c, 0, 3, 8, -1); }
+/* An entry with a position offset in its head flagged WIDE. */
+PATCH(entry_wide_head) { entry(c, 0, 0)->target_and_flags |= MK_ENTRY_WIDE; }
+/* Entry 0 of mesh 0 made WIDE (head offsets zero): its first 12 data bytes are the int32
+ * position offsets, one of them out of range. */
+static void make_wide(blob_case *c, int32_t x, int32_t y, int32_t z)
+{
+    entry(c, 0, 0)->target_and_flags |= MK_ENTRY_WIDE;
+    for (uint32_t k = 0; k < 3; k++) set_offset(c, 0, 0, k, 0);
+    const int32_t o[3] = { x, y, z };
+    memcpy(entry_data(c, 0, 0), o, sizeof o);
+}
+PATCH(entry_wide_past_max) { make_wide(c, 5, MK_WIDE_OFFSET_MAX + 1, -MK_WIDE_OFFSET_MAX); }
+PATCH(entry_wide_int32_min) { make_wide(c, 0, 0, INT32_MIN); }
 
 /* clips, tracks, keys */
 PATCH(clip_name) { clip(c, 1)->name = (uint32_t)c->a.strings_size; }
@@ -420,10 +461,11 @@ static const corruption corruptions[] = {
     { "header.truncated", size_0, "0 bytes", MK_ERROR_TRUNCATED, "blob of 0 bytes is shorter", 0 },
     { "header.magic", magic, "magic XORPHKIT", MK_ERROR_BAD_MAGIC, "magic is not MORPHKIT", 0 },
     { "header.magic", magic_last_byte, "magic MORPHKIt", MK_ERROR_BAD_MAGIC, "magic is not MORPHKIT", 0 },
-    { "header.version", version_next, "next version", MK_ERROR_BAD_VERSION, "version 5 is not supported; this runtime reads version 4 (byte offset 8)", 0 },
-    { "header.version", version_2, "version 2 (no entry flags)", MK_ERROR_BAD_VERSION, "version 2 is not supported; this runtime reads version 4 (byte offset 8)", 0 },
-    { "header.version", version_3, "version 3 (no offset entries)", MK_ERROR_BAD_VERSION, "version 3 is not supported; this runtime reads version 4 (byte offset 8)", 0 },
-    { "header.version", version_1, "version 1", MK_ERROR_BAD_VERSION, "blob format version 1 is not supported", 0 },
+    { "header.version", version_next, "next version", MK_ERROR_BAD_VERSION, "version 6 is not supported; this runtime reads version 5 (byte offset 8)", 0 },
+    { "header.version", version_2, "version 2 (no entry flags)", MK_ERROR_BAD_VERSION, "version 2 is not supported; this runtime reads version 5: the format is older, re-import the source with this version's tools (byte offset 8)", 0 },
+    { "header.version", version_3, "version 3 (no offset entries)", MK_ERROR_BAD_VERSION, "version 3 is not supported; this runtime reads version 5: the format is older, re-import the source", 0 },
+    { "header.version", version_4, "version 4 (int16 entries)", MK_ERROR_BAD_VERSION, "version 4 is not supported; this runtime reads version 5: the format is older, re-import the source", 0 },
+    { "header.version", version_1, "version 1 (never released)", MK_ERROR_BAD_VERSION, "blob format version 1 is not supported; this runtime reads version 5 (byte offset 8)", 0 },
     { "header.size", header_size, "header size 72", MK_ERROR_CORRUPT, "header size 72 is not 64", 0 },
     { "header.flags", header_flags, "header flags 1", MK_ERROR_CORRUPT, "header flags (1) are not zero", 0 },
     { "header.reserved", header_reserved_first, "reserved[0]", MK_ERROR_CORRUPT, "header reserved field 0 is not zero (byte offset 40)", 0 },
@@ -540,8 +582,8 @@ static const corruption corruptions[] = {
     { "mesh.block_table.align", block_table_misaligned, "block table at +4", MK_ERROR_BAD_ALIGNMENT, "mesh 2 block table: array is not 16-byte aligned", 0 },
     { "mesh.block_table.bounds", block_table_past_data, "block table at the end", MK_ERROR_CORRUPT, "mesh 2 block table: array of 4 x 4 bytes is not inside the DATA section", 0 },
     { "mesh.entries.align", entries_misaligned, "entries at +8", MK_ERROR_BAD_ALIGNMENT, "mesh 0 entries: array is not 16-byte aligned", 0 },
-    { "mesh.entries.bounds", entries_past_data, "entries over the end", MK_ERROR_CORRUPT, "mesh 3 entries: array of 1 x 16 bytes is not inside the DATA section", 0 },
-    { "mesh.entries.bounds", entries_count_overflow, "2^60 entries (the size overflows)", MK_ERROR_CORRUPT, "mesh 2 entries: array of 1152921504606846976 x 16 bytes", 0 },
+    { "mesh.entries.bounds", entries_past_data, "entries over the end", MK_ERROR_CORRUPT, "mesh 3 entries: array of 1 x 24 bytes is not inside the DATA section", 0 },
+    { "mesh.entries.bounds", entries_count_overflow, "2^60 entries (the size overflows)", MK_ERROR_CORRUPT, "mesh 2 entries: array of 1152921504606846976 x 32 bytes", 0 },
     { "mesh.target_data.align", target_data_misaligned, "target data at +4", MK_ERROR_BAD_ALIGNMENT, "mesh 2 target data: array is not 16-byte aligned", 0 },
     { "mesh.target_data.bounds", target_data_past_data, "target data 16 bytes longer", MK_ERROR_CORRUPT, "mesh 3 target data: array of", 0 },
     { "block_table.first", block_table_first, "table starts at 1", MK_ERROR_CORRUPT, "mesh 2: block table starts at entry 1 instead of 0", 0 },
@@ -555,22 +597,31 @@ static const corruption corruptions[] = {
     { "entry.target", entry_target_huge, "quantized: target 2^24 - 16", MK_ERROR_CORRUPT, "mesh 3 entry 0: target index 16777200 is out of range", Q16 },
     { "entry.flags", entry_flags, "flag bit 24", MK_ERROR_CORRUPT, "mesh 0 entry 1: unknown flag bits 16777216", 0 },
     { "entry.flags", entry_flags_top, "quantized: flag bit 29", MK_ERROR_CORRUPT, "mesh 2 entry 3: unknown flag bits 536870912", Q16 },
-    { "entry.precision", entry_int16_of_float_target, "a float target's entry without the float flag", MK_ERROR_CORRUPT, "mesh 2 entry 4: int16 data for float target", 0 },
+    { "entry.precision", entry_packed_of_float_target, "a float target's entry without the float flag", MK_ERROR_CORRUPT, "mesh 2 entry 4: packed data for float target 0", 0 },
     { "entry.order", entry_duplicate, "two entries for target 0 in block 0", MK_ERROR_CORRUPT, "mesh 0 entry 1: target 0 repeats or precedes the previous entry's", 0 },
     { "entry.order", entry_misordered, "target 0 after target 1", MK_ERROR_CORRUPT, "mesh 2 entry 2: target 0 repeats or precedes", 0 },
     { "entry.mask_empty", entry_mask_empty, "mask 0", MK_ERROR_CORRUPT, "mesh 2 entry 5: vertex mask is empty", 0 },
     { "entry.mask_past_end", entry_mask_past_end_small, "vertex 4 of 4", MK_ERROR_CORRUPT, "mesh 0 entry 2: vertex mask has bits past the mesh's last vertex (block 0)", 0 },
     { "entry.mask_past_end", entry_mask_past_end_block, "vertex 150 of 150", MK_ERROR_CORRUPT, "mesh 2 entry 10: vertex mask has bits past the mesh's last vertex (block 2)", 0 },
-    { "entry.data", entry_data_straddles, "the last data 16 bytes on, over the end", MK_ERROR_CORRUPT, "bytes of data run past the mesh's target data", 0 },
-    { "entry.data", entry_data_straddles, "quantized: the last data over the end", MK_ERROR_CORRUPT, "bytes of data run past the mesh's target data", Q16 },
-    { "entry.data", entry_data_far, "data at 64 GiB", MK_ERROR_CORRUPT, "mesh 2 entry 0: its 1536 bytes of data run past", 0 },
+    { "entry.data", entry_data_straddles, "the last data 4 bytes on, into the tail", MK_ERROR_CORRUPT, "mesh 3 entry 0: its 36 bytes of data and the 16-byte tail run past the mesh's target data", 0 },
+    { "entry.data", entry_data_straddles, "quantized: the last data 4 bytes on", MK_ERROR_CORRUPT, "mesh 3 entry 0: its 0 bytes of data and the 16-byte tail run past", Q16 },
+    { "entry.data", entry_data_far, "data at 16 GiB", MK_ERROR_CORRUPT, "mesh 2 entry 0: its 1536 bytes of data and the 16-byte tail run past", 0 },
+    { "entry.data", entry_data_no_tail, "a 12-byte tail", MK_ERROR_CORRUPT, "mesh 3 entry 0: its 36 bytes of data and the 16-byte tail run past", 0 },
+    { "entry.data", entry_data_no_tail, "quantized: a 12-byte tail", MK_ERROR_CORRUPT, "mesh 3 entry 0: its 0 bytes of data and the 16-byte tail run past", Q16 },
+    { "entry.data", entry_float_last, "quantized: the last entry flagged float", MK_ERROR_CORRUPT, "mesh 3 entry 0: its 36 bytes of data and the 16-byte tail run past", Q16 },
     { "entry.data_finite", entry_data_nan, "a dense position delta NaN", MK_ERROR_NOT_FINITE, "mesh 2 entry 0: delta value 100 is not finite", 0 },
-    { "entry.data", entry_float_last, "quantized: the last entry flagged float", MK_ERROR_CORRUPT, "bytes of data run past the mesh's target data", Q16 },
-    { "entry.data_finite", entry_float_nan, "quantized: a float-flagged entry's delta NaN", MK_ERROR_NOT_FINITE, "mesh 2 entry 0: delta value 7 is not finite", Q16 },
-    { "entry.data_finite", entry_normal_delta_inf, "a normal delta inf", MK_ERROR_NOT_FINITE, "mesh 0 entry 2: delta value 13 is not finite", 0 },
-    { "entry.offset_precision", entry_offset_on_float, "an offset on a float entry", MK_ERROR_CORRUPT, "mesh 2 entry 3: a position offset on float32 data", 0 },
-    { "entry.offset_finite", entry_offset_nan, "quantized: an offset component NaN", MK_ERROR_NOT_FINITE, "mesh 2 entry 0: position offset component 1 is not finite", Q16 },
-    { "entry.offset_pad", entry_offset_pad, "quantized: nonzero bytes after the offset", MK_ERROR_CORRUPT, "mesh 2 entry 0: the 4 bytes after its position offset are not zero", Q16 },
+    { "entry.data_finite", entry_float_nan, "quantized: a float-flagged entry's delta NaN", MK_ERROR_NOT_FINITE, "mesh 0 entry 3: delta value 7 is not finite", Q16 },
+    { "entry.data_finite", entry_normal_delta_inf, "a normal delta inf", MK_ERROR_NOT_FINITE, "mesh 0 entry 2: delta value 16 is not finite", 0 },
+    { "entry.wide_precision", entry_wide_on_float, "WIDE on a float entry", MK_ERROR_CORRUPT, "mesh 2 entry 3: WIDE on float32 data", 0 },
+    { "entry.float_packing", entry_float_code, "a float entry's width code", MK_ERROR_CORRUPT, "mesh 0 entry 1: float32 entry has a nonzero width code or offset", 0 },
+    { "entry.float_packing", entry_float_offset, "a float entry's last offset", MK_ERROR_CORRUPT, "mesh 3 entry 0: float32 entry has a nonzero width code or offset", 0 },
+    { "entry.code_padding", entry_code_padding_nibble, "quantized: the padding nibble of 3 codes", MK_ERROR_CORRUPT, "mesh 3 entry 0: width code 3 is not zero (it pads the codes", Q16 },
+    { "entry.code_padding", entry_code_padding_byte, "quantized: the last padding nibble of 9 codes", MK_ERROR_CORRUPT, "mesh 0 entry 2: width code 11 is not zero", Q16 },
+    { "entry.absent_attribute", entry_absent_normal_code, "quantized: a normal code of a positions-only target", MK_ERROR_CORRUPT, "mesh 2 entry 3: component 3 has a width code or offset but its target has no normal deltas", Q16 },
+    { "entry.absent_attribute", entry_absent_tangent_offset, "quantized: a tangent offset of a positions-only target", MK_ERROR_CORRUPT, "mesh 0 entry 3: component 8 has a width code or offset but its target has no tangent deltas", Q16 },
+    { "entry.wide_head", entry_wide_head, "quantized: WIDE with a head position offset", MK_ERROR_CORRUPT, "mesh 0 entry 0: WIDE entry's head position offset 2 is not zero", Q16 },
+    { "entry.wide_range", entry_wide_past_max, "quantized: a WIDE offset of 2^23", MK_ERROR_CORRUPT, "mesh 0 entry 0: WIDE position offset 1 is beyond +-8388607", Q16 },
+    { "entry.wide_range", entry_wide_int32_min, "quantized: a WIDE offset of -2^31", MK_ERROR_CORRUPT, "mesh 0 entry 0: WIDE position offset 2 is beyond", Q16 },
 
     { "clip.name", clip_name, "name = string section size", MK_ERROR_CORRUPT, "clip 1: name string offset", 0 },
     { "clip.first_track", clip_first_track, "clip 2 starts at track 2", MK_ERROR_CORRUPT, "clip 2: first track 2 does not follow the previous clip's tracks (expected 3)", 0 },
@@ -920,16 +971,22 @@ static void test_fixture_has_every_structure(void)
         CHECK_EQ_INT(a.meshes[2].entry_count, 11);
         CHECK_EQ_INT(a.targets[2].flags & ~(uint32_t)MK_TARGET_QUANTIZED, MK_TARGET_HAS_NORMALS | MK_TARGET_HAS_TANGENTS);
         CHECK(a.targets[0].full_weight < 0);
-        int dense = 0, sparse = 0, quantized = 0, float_entries = 0, entries = 0;
+        /* Entries of every stride: positions (mesh 3), and normals (mesh 2), and tangents (mesh 0). */
+        CHECK_EQ_INT(mk_entry_stride(a.meshes[0].flags), 40);
+        CHECK_EQ_INT(mk_entry_stride(a.meshes[2].flags), 32);
+        CHECK_EQ_INT(mk_entry_stride(a.meshes[3].flags), 24);
+        int dense = 0, sparse = 0, quantized = 0, float_entries = 0, wide = 0, entries = 0;
         for (uint32_t m = 0; m < a.mesh_count; m++)
             for (uint64_t e = 0; e < a.meshes[m].entry_count; e++) {
-                const mk_blob_entry *en = (const mk_blob_entry *)(a.data + a.meshes[m].entries) + e;
+                const mk_blob_entry *en = mk_entry_at(a.data + a.meshes[m].entries, mk_entry_stride(a.meshes[m].flags), e);
                 dense += en->mask == ~0ull;
                 sparse += mk_popcount64(en->mask) < 8;
-                float_entries += !mk_entry_quantized(en);
+                float_entries += !mk_entry_packed(en);
+                wide += mk_entry_wide(en);
                 entries++;
             }
         CHECK(p ? float_entries == 0 : float_entries == entries);   /* a float blob's entries all say so */
+        CHECK_EQ_INT(wide, 0);                                       /* the WIDE patches make their own */
         for (uint32_t t = 0; t < a.target_count; t++) quantized += (a.targets[t].flags & MK_TARGET_QUANTIZED) != 0;
         CHECK(dense >= 2);
         CHECK(sparse >= 4);
@@ -937,10 +994,55 @@ static void test_fixture_has_every_structure(void)
         CHECK_NEAR(a.keys[3].right_weight, 0.25f, 0);
         CHECK_EQ_INT(a.keys[0].interp, MK_INTERP_CUBIC);
         CHECK_EQ_INT(a.clips[1].track_count, 0);
-        CHECK(a.meshes[3].target_data + a.meshes[3].target_data_size == intact->size);   /* the data ends the blob */
+        /* The data ends the blob (but for the padding of the blob to 16 bytes). */
+        CHECK(intact->size - (a.meshes[3].target_data + a.meshes[3].target_data_size) < MK_ALIGN);
         use_asset(&a);
         free(b);
     }
 }
 
-CHECK_MAIN(CASE(test_fixture_has_every_structure), CASE(test_every_corruption), CASE(test_every_check_has_a_test))
+/* The WIDE checks are not too strict: offsets of +-(2^23 - 1) open and evaluate to
+ * (offset + value) x step exactly as the head's int16 offsets would. */
+static void test_wide_entry_at_the_limits_opens(void)
+{
+    const fixture_blob_cache *intact = rich_blob(MK_PRECISION_Q16);
+    blob_case c;
+    memset(&c, 0, sizeof c);
+    c.size = intact->size;
+    c.b = aligned_copy(intact->data, intact->size, intact->size);
+    mk_error err;
+    CHECK(mk_asset_open(c.b, c.size, &c.a, &err) == MK_OK);
+    const int16_t head_z = (int16_t)mk_entry_offset(entry(&c, 0, 0), components(&c, 0), 2);
+    make_wide(&c, MK_WIDE_OFFSET_MAX, -MK_WIDE_OFFSET_MAX, head_z);
+    uint64_t sum = mk_checksum(c.b + 32, c.size - 32);
+    memcpy(c.b + 24, &sum, 8);
+    mk_asset a;
+    CHECK_MSG(mk_asset_open(c.b, c.size, &a, &err) == MK_OK, "%s", err.message);
+    CHECK_EQ_INT(mk_mesh_wide_entries(&a, 0), 1);
+    /* Only target 0 weighted: vertex v moves by (offset + value) x step; x and y store width
+     * 0 (every vertex has the offset), z keeps its offset and values. */
+    mk_mesh_info m;
+    mk_mesh_get(&a, 0, &m);
+    float weights[4] = { 0 }, out[12], base[12];
+    weights[0] = a.targets[0].full_weight;   /* channel 0 at target 0's full weight: its coefficient 1 */
+    size_t scratch_size = mk_eval_scratch_size(&a, 0);
+    void *scratch = NULL;
+    if (posix_memalign(&scratch, 16, scratch_size ? scratch_size : 16) != 0) abort();
+    mk_eval_job j = { .asset = &a, .mesh = 0, .vertex_count = MK_VERTICES_TO_END, .weights = weights, .weight_count = m.channel_count,
+                      .scratch = scratch, .scratch_size = scratch_size, .positions = out, .positions_size = sizeof out };
+    CHECK_MSG(mk_eval_run(&j, &err) == MK_OK, "%s", err.message);
+    const mk_blob_entry *en = entry(&c, 0, 0);
+    CHECK_EQ_INT(mk_entry_code(en, 0), 0);
+    CHECK_EQ_INT(mk_entry_code(en, 1), 0);
+    memcpy(base, m.positions, sizeof base);
+    const float step = a.targets[0].position_scale;
+    for (int v = 0; v < 4; v++) {
+        CHECK_NEAR(out[3 * v], base[3 * v] + (float)MK_WIDE_OFFSET_MAX * step, 1e-3);
+        CHECK_NEAR(out[3 * v + 1], base[3 * v + 1] - (float)MK_WIDE_OFFSET_MAX * step, 1e-3);
+    }
+    free(scratch);
+    free(c.b);
+}
+
+CHECK_MAIN(CASE(test_fixture_has_every_structure), CASE(test_every_corruption), CASE(test_every_check_has_a_test),
+           CASE(test_wide_entry_at_the_limits_opens))

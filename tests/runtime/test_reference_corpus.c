@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The corpus frames under the modes its references do not cover. The corpus references
  * (ufbx, three.js, the authoring tools) are additive stacking with nlerp normals only; here
- * every case of cases.json is imported (mk_import_file), written as a float32 and an int16
+ * every case of cases.json is imported (mk_import_file), written as a float32 and a quantized
  * blob, and for every frame's weights (the clip sampled at the frame time, or the static
  * state: default weights, forced weights where the frame gives them) every mesh with channels
  * is evaluated with sequential stacking and with slerp normals (and additive/nlerp) through

@@ -7,11 +7,11 @@
  * scattered; meshes mostly of 65-300 vertices, not multiples of 64, so blocks are crossed and
  * the last one is partial; base normals unit or not, normals and tangents present or not) and
  * random weights in [-2, 3] (also exactly 0, exactly at full weights, beyond the first and
- * last key). Each asset is written as a float32 and as an int16 blob (mk_write_blob), opened,
+ * last key). Each asset is written as a float32 and as a quantized blob (mk_write_blob), opened,
  * and evaluated (mk_eval_run) for both normal modes and every job stacking (the blob's own,
  * which is random, and both overrides), over the whole mesh and a random vertex range.
  * Tolerances are derived, not tuned (reference_eval.c): a few float ulps of the magnitudes
- * involved, plus for int16 the writer's reported quantization error times the sum of the
+ * involved, plus for quantized blobs the writer's reported quantization error times the sum of the
  * |coefficients|; normals and tangents as angles.
  *
  *   MK_REF_SEED=N    runs only asset N, printing details (every failure prints its seed)
