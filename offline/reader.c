@@ -15,27 +15,20 @@ static void *copy(mk_arena *arena, const void *src, size_t n)
     return p;
 }
 
-/* Component c (0-2) of attribute `attribute` of the j-th vertex of an entry whose data starts at
- * p (docs/format.md): float32 triples, or the packed value (offset + u) times the step. */
-static float decode(const mk_blob_entry *en, const uint8_t *p, uint32_t mesh_flags, uint32_t target_flags,
-                    uint32_t attribute, uint32_t c, uint32_t j, float step)
+/* Component c (0-2) of attribute `attribute` of the j-th vertex of an entry (docs/format.md):
+ * the packed value (offset + u) times the step from the entry's layout, or (layout NULL) the
+ * float32 triple from p, the entry's data. */
+static float decode(const mk_blob_entry *en, const mk_packed_layout *layout, const uint8_t *p, uint32_t mesh_flags,
+                    uint32_t target_flags, uint32_t attribute, uint32_t c, uint32_t j, float step)
 {
-    const uint32_t m = mk_popcount64(en->mask);
-    if (!mk_entry_packed(en)) {
-        const uint32_t before = attribute == 0 ? 0u : attribute == 1 ? 1u : 1u + ((target_flags & MK_TARGET_HAS_NORMALS) ? 1u : 0u);
-        float f;
-        memcpy(&f, p + 12u * ((size_t)before * m + j) + 4u * c, 4);
-        return f;
+    if (layout) {
+        const uint32_t k = mk_attribute_component(mesh_flags, attribute) + c;
+        return (float)(layout->offset[k] + (int32_t)mk_unpack(layout->at[k], layout->width[k], j)) * step;
     }
-    const uint32_t components = mk_mesh_components(mesh_flags), k = mk_attribute_component(mesh_flags, attribute) + c;
-    int32_t offset = mk_entry_offset(en, components, k);
-    if (mk_entry_wide(en)) {
-        if (k < 3) offset = (int32_t)mk_load_u32le(p + 4u * k);
-        p += MK_ENTRY_WIDE_BYTES;
-    }
-    for (uint32_t i = 0; i < k; i++) p += mk_packed_bytes(m, mk_width_of_code(mk_entry_code(en, i)));
-    const uint32_t w = mk_width_of_code(mk_entry_code(en, k));
-    return (float)(offset + (int32_t)mk_unpack(p, w, j)) * step;
+    const uint32_t before = attribute == 0 ? 0u : attribute == 1 ? 1u : 1u + ((target_flags & MK_TARGET_HAS_NORMALS) ? 1u : 0u);
+    float f;
+    memcpy(&f, p + 12u * ((size_t)before * mk_popcount64(en->mask) + j) + 4u * c, 4);
+    return f;
 }
 
 static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t local, mk_raw_target *t,
@@ -63,14 +56,17 @@ static mk_result read_target(const mk_asset *a, const mk_blob_mesh *bm, uint32_t
             if (mk_entry_target(en) != local) continue;
             const int q = mk_entry_packed(en);   /* per entry: a quantized target's outliers are float */
             const uint8_t *p = a->data + bm->target_data + (size_t)en->data * MK_DATA_UNIT;
+            mk_packed_layout layout;
+            if (q) mk_packed_layout_of(&layout, en, mk_mesh_components(bm->flags), p);
+            const mk_packed_layout *pl = q ? &layout : NULL;
             uint32_t j = 0;
             for (uint64_t bits = en->mask; bits; bits &= bits - 1, j++) {
                 float pv[3], nv[3] = { 0, 0, 0 }, tv[3] = { 0, 0, 0 };
                 int nonzero = 0;
                 for (uint32_t c = 0; c < 3; c++) {
-                    pv[c] = decode(en, p, bm->flags, bt->flags, 0, c, j, q ? bt->position_scale : 1.0f);
-                    if (hn) nv[c] = decode(en, p, bm->flags, bt->flags, 1, c, j, q ? bt->normal_scale : 1.0f);
-                    if (ht) tv[c] = decode(en, p, bm->flags, bt->flags, 2, c, j, q ? bt->tangent_scale : 1.0f);
+                    pv[c] = decode(en, pl, p, bm->flags, bt->flags, 0, c, j, q ? bt->position_scale : 1.0f);
+                    if (hn) nv[c] = decode(en, pl, p, bm->flags, bt->flags, 1, c, j, q ? bt->normal_scale : 1.0f);
+                    if (ht) tv[c] = decode(en, pl, p, bm->flags, bt->flags, 2, c, j, q ? bt->tangent_scale : 1.0f);
                     nonzero |= pv[c] != 0 || nv[c] != 0 || tv[c] != 0;
                 }
                 if (!nonzero) continue;   /* a vertex the mask covers but the target does not move */

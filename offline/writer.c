@@ -103,7 +103,7 @@ static uint32_t block_end(const mk_raw_target *t, uint32_t first, uint32_t block
 /* A target's storage: packed at the mesh's steps (every entry whose values do not fit 16 bits
  * around its offsets is float32), or float32 when asked or when a step is 0 (a tolerance too
  * small for a normal float). */
-static void plan_target(const mk_raw_target *t, mk_precision precision, const float steps[3], target_plan *p)
+static void plan_target(const mk_raw_target *t, mk_precision precision, const float steps[2], target_plan *p)
 {
     p->flags = (t->normals ? MK_TARGET_HAS_NORMALS : 0u) | (t->tangents ? MK_TARGET_HAS_TANGENTS : 0u);
     if (precision == MK_PRECISION_FLOAT || steps[0] == 0 || (t->normals || t->tangents ? steps[1] == 0 : 0)) return;
@@ -116,7 +116,7 @@ static void plan_target(const mk_raw_target *t, mk_precision precision, const fl
 typedef struct plan_loop {
     const mk_raw_target **targets;
     target_plan *plans;
-    const float (*steps)[3];           /* per target: its mesh's position and normal steps */
+    const float (*steps)[2];           /* per target: its mesh's position and normal (and tangent) steps */
     mk_precision precision;
 } plan_loop;
 
@@ -231,19 +231,6 @@ static int pack_entry(const mk_raw_target *t, const target_plan *p, uint32_t mes
         e->offset[k] = lo;
     }
     return 1;
-}
-
-/* Bytes of an entry's data (before its padding to 4): float32 triples of the target's
- * attributes, or the WIDE offsets and each component's packed values. */
-static uint64_t pack_bytes(const entry_pack *e, uint32_t target_flags)
-{
-    const uint32_t m = mk_popcount64(e->mask);
-    if (e->kind == ENTRY_FLOAT)
-        return 12u * (uint64_t)m * (1u + ((target_flags & MK_TARGET_HAS_NORMALS) ? 1u : 0u)
-                                       + ((target_flags & MK_TARGET_HAS_TANGENTS) ? 1u : 0u));
-    uint64_t n = e->kind == ENTRY_WIDE ? MK_ENTRY_WIDE_BYTES : 0u;
-    for (uint32_t k = 0; k < e->components; k++) n += mk_packed_bytes(m, e->width[k]);
-    return n;
 }
 
 static size_t pad4(size_t n) { return (n + 3u) & ~(size_t)3u; }
@@ -388,13 +375,22 @@ typedef struct layout_item {
     uint32_t index;
 } layout_item;
 
+/* Bytes of an entry's data (before its padding to 4) as every reader sizes it: mk_entry_bytes
+ * of its head (8-aligned, mk_entry_stride bytes) for target `index` of the mesh. */
+static uint64_t entry_bytes(const uint8_t *head, const layout_loop *l, uint32_t index)
+{
+    return mk_entry_bytes((const mk_blob_entry *)(const void *)head, l->mesh_flags, l->plans[index].flags);
+}
+
 static void count_block(void *user, uint32_t block, uint32_t first, uint32_t end, const entry_pack *e)
 {
     layout_item *it = user;
     (void)block;
     (void)first;
     (void)end;
-    it->tl->data_size = pad4((size_t)it->tl->data_size) + pack_bytes(e, it->l->plans[it->index].flags);
+    _Alignas(8) uint8_t head[MK_ENTRY_MAX_BYTES] = { 0 };
+    put_head(head, e, 0, 0);
+    it->tl->data_size = pad4((size_t)it->tl->data_size) + entry_bytes(head, it->l, it->index);
     it->tl->entry_count++;
 }
 
@@ -414,11 +410,12 @@ static void write_block(void *user, uint32_t block, uint32_t first, uint32_t end
     const target_plan *p = &l->plans[it->index];
     uint64_t n = tl->cursor++;
     uint64_t at = pad4((size_t)tl->data_size);
-    tl->data_size = at + pack_bytes(e, p->flags);
+    uint8_t *head = l->entry_head + n * l->stride;
+    put_head(head, e, it->index, tl->base + at);
+    tl->data_size = at + entry_bytes(head, l, it->index);
     tl->float_entries += e->kind == ENTRY_FLOAT && (p->flags & MK_TARGET_QUANTIZED);
     tl->wide_entries += e->kind == ENTRY_WIDE;
     l->entry_block[n] = block;
-    put_head(l->entry_head + n * l->stride, e, it->index, tl->base + at);
     put_entry(l->data + tl->base + at, tl->t, p, l->mesh_flags, e, first, end, block * MK_BLOCK_SIZE, tl->error);
 }
 
@@ -640,7 +637,7 @@ static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, cons
     /* Per-target precision under each mesh's tolerance, decided on worker threads. */
     const mk_raw_target **all_targets = mk_arena_array(arena, target_count + 1, sizeof *all_targets);
     if (!all_targets) return mk_error_oom(err, "writing the blob tables");
-    float (*steps)[3] = mk_arena_array(arena, target_count + 1, sizeof *steps);
+    float (*steps)[2] = mk_arena_array(arena, target_count + 1, sizeof *steps);
     if (!steps) return mk_error_oom(err, "writing the blob tables");
     const float normal_step = step_for(opt.normal_tolerance > 0 ? opt.normal_tolerance : MK_DEFAULT_NORMAL_TOLERANCE);
     for (uint32_t mi = 0, c = 0, k = 0; mi < raw->mesh_count; mi++) {
@@ -652,10 +649,10 @@ static mk_result write_blob(const mk_raw_asset *raw, mk_raw_asset *consume, cons
                 all_targets[k] = &raw->channels[c].targets[j];
                 memset(&plans[k], 0, sizeof plans[k]);
                 steps[k][0] = position_step;
-                steps[k][1] = steps[k][2] = normal_step;
+                steps[k][1] = normal_step;
             }
     }
-    plan_loop pl = { all_targets, plans, (const float (*)[3])steps, opt.precision };
+    plan_loop pl = { all_targets, plans, (const float (*)[2])steps, opt.precision };
     mk_parallel_for(target_count, opt.threads, plan_item, &pl);
     mk_arena_release(arena, all_targets);
     mk_arena_release(arena, steps);

@@ -22,7 +22,7 @@
 #else
 #define MK_HAVE_STREAMING 0
 #endif
-/* The AVX2 unpacking of packed values, picked per call by the CPU (GCC and clang on x86-64);
+/* The AVX2 unpacking of packed values, picked once per job by the CPU (GCC and clang on x86-64);
  * MK_NO_TARGET_CLONES builds the portable loop alone. Both give the same floats. */
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(MK_NO_TARGET_CLONES)
 #include <immintrin.h>
@@ -157,20 +157,8 @@ MK_INLINE void add_float_attribute(float *restrict acc, uint64_t mask, const uin
  * is an integer below 2^24, so its conversion is exact whichever way it is computed. */
 MK_INLINE void unpack_portable(float *restrict out, const uint8_t *restrict p, uint32_t m, uint32_t w, int32_t offset)
 {
-    const uint32_t low = (1u << w) - 1u;
-    for (uint32_t j = 0; j < m; j++) {
-        const uint32_t bit = j * w;
-        out[j] = (float)(offset + (int32_t)((mk_load_u32le(p + (bit >> 3)) >> (bit & 7u)) & low));
-    }
+    for (uint32_t j = 0; j < m; j++) out[j] = (float)(offset + (int32_t)mk_unpack(p, w, j));
 }
-
-/* A packed entry's components: where each one's values start, its width and offset. */
-typedef struct packed_entry {
-    uint32_t m;
-    const uint8_t *at[MK_MAX_COMPONENTS];
-    uint32_t width[MK_MAX_COMPONENTS];
-    int32_t offset[MK_MAX_COMPONENTS];
-} packed_entry;
 
 #if MK_HAVE_AVX2_UNPACK
 /* Eight values of width w lie in w bytes from byte 8 w g on: per width, the byte shuffle that
@@ -193,7 +181,7 @@ static const uint32_t unpack_shift[MK_MAX_WIDTH + 1][8] __attribute__((aligned(3
 };
 
 /* Eight values (group g) of a packed component as floats. */
-__attribute__((target("avx2"))) static inline __m256 unpack8_avx2(const packed_entry *pe, uint32_t k, uint32_t g)
+__attribute__((target("avx2"))) static inline __m256 unpack8_avx2(const mk_packed_layout *pe, uint32_t k, uint32_t g)
 {
     const uint32_t w = pe->width[k];
     const __m256i shuffle = _mm256_load_si256((const __m256i *)(const void *)unpack_shuffle[w]);
@@ -207,7 +195,7 @@ __attribute__((target("avx2"))) static inline __m256 unpack8_avx2(const packed_e
 /* Components k0..k0 + 2 of eight vertices (group g) interleaved in registers: one permute per
  * component and output vector, two blends:
  * x0 y0 z0 x1 y1 z1 x2 y2 | z2 x3 y3 z3 x4 y4 z4 x5 | y5 z5 x6 y6 z6 x7 y7 z7. */
-__attribute__((target("avx2"))) static inline void triples8_avx2(const packed_entry *pe, uint32_t k0, uint32_t g,
+__attribute__((target("avx2"))) static inline void triples8_avx2(const mk_packed_layout *pe, uint32_t k0, uint32_t g,
                                                                  __m256 o[3])
 {
     const __m256i i0 = _mm256_setr_epi32(0, 0, 0, 1, 1, 1, 2, 2), i1 = _mm256_setr_epi32(2, 3, 3, 3, 4, 4, 4, 5),
@@ -223,7 +211,7 @@ __attribute__((target("avx2"))) static inline void triples8_avx2(const packed_en
 
 /* A whole block's components k0..k0 + 2 added to the interleaved accumulator eight vertices at
  * a time: acc += factor x value as the portable loop does, so the sums are the same. */
-__attribute__((target("avx2"))) static void add_packed_block_avx2(float *restrict acc, const packed_entry *pe,
+__attribute__((target("avx2"))) static void add_packed_block_avx2(float *restrict acc, const mk_packed_layout *pe,
                                                                   uint32_t k0, float factor)
 {
     const __m256 f = _mm256_set1_ps(factor);
@@ -237,7 +225,7 @@ __attribute__((target("avx2"))) static void add_packed_block_avx2(float *restric
 }
 
 /* The m xyz triples of components k0..k0 + 2 (a multiple of 8 written: triples holds 192). */
-__attribute__((target("avx2"))) static void packed_triples_avx2(float *restrict triples, const packed_entry *pe,
+__attribute__((target("avx2"))) static void packed_triples_avx2(float *restrict triples, const mk_packed_layout *pe,
                                                                 uint32_t k0)
 {
     for (uint32_t g = 0; 8 * g < pe->m; g++) {
@@ -248,40 +236,16 @@ __attribute__((target("avx2"))) static void packed_triples_avx2(float *restrict 
 }
 #endif
 
-/* Reads a packed entry's head; returns its data's bytes (prefetched by the caller). */
-MK_INLINE size_t packed_entry_of(packed_entry *pe, const mk_blob_entry *en, uint32_t components, const uint8_t *p)
-{
-    const uint8_t *start = p;
-    pe->m = mk_popcount64(en->mask);
-    const uint8_t *head = (const uint8_t *)en + MK_ENTRY_HEAD;
-    uint64_t codes;   /* at most 5 bytes of codes; the head is at least 24 bytes long */
-    memcpy(&codes, head, sizeof codes);
-    const uint8_t *offsets = head + mk_entry_code_bytes(components);
-    const int wide = mk_entry_wide(en);
-    if (wide) p += MK_ENTRY_WIDE_BYTES;
-    for (uint32_t k = 0; k < components; k++) {
-        const uint32_t w = mk_width_of_code((uint32_t)(codes >> (4u * k)) & 15u);
-        int16_t o;
-        memcpy(&o, offsets + 2u * k, sizeof o);
-        pe->at[k] = p;
-        pe->width[k] = w;
-        pe->offset[k] = o;
-        p += (pe->m * w + 7u) >> 3;
-    }
-    if (wide)
-        for (int c = 0; c < 3; c++) pe->offset[c] = (int32_t)mk_load_u32le(start + 4 * c);
-    return (size_t)(p - start);
-}
-
 /* Adds factor x the values of the packed components k0, k0 + 1, k0 + 2 to the interleaved
  * accumulator: each component is unpacked by rank; a whole block is added as it is interleaved,
  * a partial one interleaved into xyz triples first and those added run by run of the mask as a
  * float entry's are. */
-MK_INLINE void add_packed_attribute(float *restrict acc, uint64_t mask, const packed_entry *pe, uint32_t k0, float factor)
+MK_INLINE void add_packed_attribute(float *restrict acc, uint64_t mask, const mk_packed_layout *pe, uint32_t k0,
+                                    float factor, int avx2)
 {
     block_acc triples;
 #if MK_HAVE_AVX2_UNPACK
-    if (__builtin_cpu_supports("avx2")) {
+    if (avx2) {
         if (mask == ~(uint64_t)0) {
             add_packed_block_avx2(acc, pe, k0, factor);
             return;
@@ -290,6 +254,8 @@ MK_INLINE void add_packed_attribute(float *restrict acc, uint64_t mask, const pa
         add_float_attribute(acc, mask, (const uint8_t *)triples, factor);
         return;
     }
+#else
+    (void)avx2;
 #endif
     float v[3][MK_BLOCK_SIZE];
     for (uint32_t c = 0; c < 3; c++) unpack_portable(v[c], pe->at[k0 + c], pe->m, pe->width[k0 + c], pe->offset[k0 + c]);
@@ -309,13 +275,14 @@ MK_INLINE void add_packed_attribute(float *restrict acc, uint64_t mask, const pa
     add_float_attribute(acc, mask, (const uint8_t *)triples, factor);
 }
 
-/* Adds attribute `attribute` (0 positions, 1 normals, 2 tangents) of an entry times factor
- * (times the attribute's step for a packed entry, which the caller folds into factor). float_at
- * is the attribute's float triples in a float entry. */
-MK_INLINE void add_entry_attribute(float *restrict acc, const mk_blob_entry *en, const packed_entry *pe, uint32_t k0,
-                                   const uint8_t *float_at, float factor)
+/* Adds the attribute whose first component is k0 of an entry times factor (times the
+ * attribute's step for a packed entry, which the caller folds into factor): from its packed
+ * layout pe, or (pe NULL) from float_at, its float triples in a float entry. avx2: the CPU has
+ * AVX2 (asked once per job). */
+MK_INLINE void add_entry_attribute(float *restrict acc, const mk_blob_entry *en, const mk_packed_layout *pe, uint32_t k0,
+                                   const uint8_t *float_at, float factor, int avx2)
 {
-    if (pe) add_packed_attribute(acc, en->mask, pe, k0, factor);
+    if (pe) add_packed_attribute(acc, en->mask, pe, k0, factor, avx2);
     else add_float_attribute(acc, en->mask, float_at, factor);
 }
 
@@ -471,6 +438,11 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
                  ts = mk_stride_or(job->tangents_stride, 16);
 
     const int stream = job_streams(job);
+#if MK_HAVE_AVX2_UNPACK
+    const int avx2 = __builtin_cpu_supports("avx2");
+#else
+    const int avx2 = 0;
+#endif
     block_acc acc_p, acc_n, acc_t, slerp_a, slerp_b;
     const uint32_t block_end = (end + MK_BLOCK_SIZE - 1) / MK_BLOCK_SIZE;
     for (uint32_t b = first / MK_BLOCK_SIZE; b < block_end; b++) {
@@ -496,18 +468,18 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
             const mk_blob_target *tg = &f.targets[ti];
             const int packed = mk_entry_packed(en);   /* per entry: a quantized target's outliers are float */
             const uint8_t *p = data + (size_t)en->data * MK_DATA_UNIT;
-            packed_entry pe;
+            mk_packed_layout pe;
             const size_t float_bytes = 12u * (size_t)mk_popcount64(en->mask);   /* one attribute of a float entry */
-            prefetch_ahead(p, packed ? packed_entry_of(&pe, en, components, p)
-                                     : (size_t)mk_entry_bytes(en, m->flags, tg->flags));
-            const packed_entry *pk = packed ? &pe : NULL;
-            add_entry_attribute(acc_p, en, pk, 0, p, c * (packed ? tg->position_scale : 1.0f));
+            prefetch_ahead(p, (size_t)(packed ? mk_packed_layout_of(&pe, en, components, p)
+                                              : mk_entry_bytes(en, m->flags, tg->flags)));
+            const mk_packed_layout *pk = packed ? &pe : NULL;
+            add_entry_attribute(acc_p, en, pk, 0, p, c * (packed ? tg->position_scale : 1.0f), avx2);
             if (!want_normals && !want_tangents) continue;
             p += float_bytes;
             if (tg->flags & MK_TARGET_HAS_NORMALS) {
                 const int32_t sc = f.plan.slerp_channel[ti];
                 if (sc < 0) {
-                    if (want_normals) add_entry_attribute(acc_n, en, pk, 3, p, c * (packed ? tg->normal_scale : 1.0f));
+                    if (want_normals) add_entry_attribute(acc_n, en, pk, 3, p, c * (packed ? tg->normal_scale : 1.0f), avx2);
                 } else {
                     /* Gather this channel's two span targets' raw normal deltas. */
                     if (sc != open_channel) {
@@ -518,13 +490,13 @@ static MK_CLONES void eval_blocks(const mk_eval_job *job, const frame *frame_in)
                         touched = 0;
                     }
                     float *dst = (int32_t)ti == f.plan.spans[sc].target_a ? slerp_a : slerp_b;
-                    add_entry_attribute(dst, en, pk, 3, p, packed ? tg->normal_scale : 1.0f);
+                    add_entry_attribute(dst, en, pk, 3, p, packed ? tg->normal_scale : 1.0f, avx2);
                     touched |= en->mask;
                 }
                 p += float_bytes;
             }
             if (want_tangents && (tg->flags & MK_TARGET_HAS_TANGENTS))
-                add_entry_attribute(acc_t, en, pk, tangent_component, p, c * (packed ? tg->tangent_scale : 1.0f));
+                add_entry_attribute(acc_t, en, pk, tangent_component, p, c * (packed ? tg->tangent_scale : 1.0f), avx2);
         }
         if (open_channel >= 0) add_slerp_normals(acc_n, slerp_a, slerp_b, touched, &f.plan.spans[open_channel], bn);
 

@@ -139,6 +139,7 @@ typedef struct mk_blob_target {
 #define MK_DATA_UNIT 4u                      /* entry.data counts 4-byte units */
 #define MK_TARGET_DATA_TAIL 16u
 #define MK_MAX_COMPONENTS 9u                 /* positions, normals, tangents: xyz each */
+#define MK_ENTRY_MAX_BYTES 40u               /* mk_entry_stride with normals and tangents */
 
 typedef struct mk_blob_entry {
     uint32_t target_and_flags;     /* mesh-local target index (low 24 bits) | MK_ENTRY_* */
@@ -259,6 +260,33 @@ static inline uint32_t mk_unpack(const uint8_t *p, uint32_t w, uint32_t j)
 
 /* Bytes of one component's packed values: m values of w bits. */
 static inline uint64_t mk_packed_bytes(uint32_t m, uint32_t w) { return ((uint64_t)m * w + 7u) / 8u; }
+
+/* Where a packed entry's components lie (docs/format.md): per component its first byte, width
+ * and offset (a WIDE entry's position offsets from its data), read once per entry by every
+ * decoder (the evaluation, the blob reader). */
+typedef struct mk_packed_layout {
+    uint32_t m;                                /* values per component: popcount(mask) */
+    const uint8_t *at[MK_MAX_COMPONENTS];
+    uint32_t width[MK_MAX_COMPONENTS];
+    int32_t offset[MK_MAX_COMPONENTS];
+} mk_packed_layout;
+
+/* Fills l for a packed entry whose data starts at data; components = mk_mesh_components of the
+ * mesh. Returns the data's bytes (every component's, the WIDE offsets included). */
+static inline uint64_t mk_packed_layout_of(mk_packed_layout *l, const mk_blob_entry *e, uint32_t components,
+                                           const uint8_t *data)
+{
+    const uint8_t *p = data + (mk_entry_wide(e) ? MK_ENTRY_WIDE_BYTES : 0u);
+    l->m = mk_popcount64(e->mask);
+    for (uint32_t k = 0; k < components; k++) {
+        const uint32_t w = mk_width_of_code(mk_entry_code(e, k));
+        l->at[k] = p;
+        l->width[k] = w;
+        l->offset[k] = k < 3 && mk_entry_wide(e) ? (int32_t)mk_load_u32le(data + 4u * k) : mk_entry_offset(e, components, k);
+        p += mk_packed_bytes(l->m, w);
+    }
+    return (uint64_t)(p - data);
+}
 
 /* Bytes of a stored entry's data (before its padding to 4 bytes) that hold the attributes in
  * target_flags (MK_TARGET_HAS_*; positions always): packed, the WIDE offsets and those

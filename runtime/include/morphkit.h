@@ -172,7 +172,7 @@ typedef struct mk_target_info {
     float full_weight;            /* normalized (FBX FullWeights / 100) */
     uint32_t channel;
     uint32_t moved_vertices;      /* vertices with stored data */
-    int quantized;                /* int16 with per-target scale (outlier blocks float32), else float32 */
+    int quantized;                /* packed at the mesh's steps (outlier blocks float32), else float32 */
     int has_normals, has_tangents;
     float position_scale;         /* quantization step of positions (0 for float) */
 } mk_target_info;
